@@ -1,0 +1,99 @@
+"""Input validation shared by the public API, the config loader and the CLI.
+
+Every check raises :class:`InputError` with a one-line message that names the
+parameter, the allowed range and the value received, e.g.::
+
+    n must be > 0 (got -1)
+
+The CLI turns an ``InputError`` into that line on stderr and exit code 2.
+"""
+from __future__ import annotations
+
+import math
+from typing import Iterable
+
+import numpy as np
+
+
+class InputError(ValueError):
+    """Invalid user input (parameter out of range, wrong type, unknown key)."""
+
+
+def _fmt(value) -> str:
+    try:
+        return f"{value:.6g}"
+    except (TypeError, ValueError):
+        return repr(value)
+
+
+def as_float(name: str, value) -> float:
+    """Convert ``value`` to a finite float or raise ``InputError``."""
+    if isinstance(value, bool):
+        raise InputError(f"{name} must be a number (got {value!r})")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number (got {value!r})") from None
+    if not math.isfinite(x):
+        raise InputError(f"{name} must be a finite number (got {_fmt(x)})")
+    return x
+
+
+def check_range(name: str, value, lo=None, hi=None, lo_open=False, hi_open=False) -> float:
+    """Return ``value`` as float, checking ``lo <= value <= hi`` (open ends optional).
+
+    The message states the allowed interval in mathematical notation.
+    """
+    x = as_float(name, value)
+    bad = (lo is not None and (x < lo or (lo_open and x == lo))) or (
+        hi is not None and (x > hi or (hi_open and x == hi))
+    )
+    if bad:
+        if hi is None:
+            allowed = f"{'>' if lo_open else '>='} {_fmt(lo)}"
+            raise InputError(f"{name} must be {allowed} (got {_fmt(x)})")
+        if lo is None:
+            allowed = f"{'<' if hi_open else '<='} {_fmt(hi)}"
+            raise InputError(f"{name} must be {allowed} (got {_fmt(x)})")
+        left = "(" if lo_open else "["
+        right = ")" if hi_open else "]"
+        raise InputError(f"{name} must be in {left}{_fmt(lo)}, {_fmt(hi)}{right} (got {_fmt(x)})")
+    return x
+
+
+def check_positive(name: str, value) -> float:
+    """Return ``value`` as a float > 0."""
+    return check_range(name, value, lo=0.0, lo_open=True)
+
+
+def check_int(name: str, value, lo=None, hi=None) -> int:
+    """Return ``value`` as an int within [lo, hi]."""
+    if isinstance(value, bool) or not (
+        isinstance(value, (int, np.integer)) or (isinstance(value, float) and value.is_integer())
+    ):
+        raise InputError(f"{name} must be an integer (got {value!r})")
+    v = int(value)
+    if (lo is not None and v < lo) or (hi is not None and v > hi):
+        lo_s = "-inf" if lo is None else str(lo)
+        hi_s = "inf" if hi is None else str(hi)
+        raise InputError(f"{name} must be an integer in [{lo_s}, {hi_s}] (got {v})")
+    return v
+
+
+def check_choice(name: str, value, choices: Iterable[str]) -> str:
+    """Return ``value`` if it is one of ``choices``."""
+    choices = list(choices)
+    if value not in choices:
+        raise InputError(f"{name} must be one of {', '.join(map(str, choices))} (got {value!r})")
+    return value
+
+
+def check_array(name: str, values, lo=None, hi=None, lo_open=False, hi_open=False) -> np.ndarray:
+    """Return ``values`` as a float64 array, every element checked like :func:`check_range`."""
+    try:
+        arr = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be numbers (got {values!r})") from None
+    for x in arr.ravel():
+        check_range(name, x, lo, hi, lo_open, hi_open)
+    return arr
