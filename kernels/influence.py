@@ -1,0 +1,151 @@
+"""Influence matrix of the axisymmetric half-space for overlapping-triangle tractions.
+
+Pure Numba kernels on arrays. Dimensionless units of DESIGN.md section 2 (E0* = 1):
+the deflection at node i due to nodal tractions p_j is ``u_i = sum_j A_ij p_j`` with
+
+    A_ij = int phi_j(s) G(r_i, s) s ds,
+    G(r, s) = 4/(pi r) K(s/r)  (s < r),   4/(pi s) K(r/s)  (s > r),   G(0, s) = 2/s,
+
+where K is the complete elliptic integral of the first kind of *modulus* k, and phi_j
+is the hat function of node j on the uniform mesh r_j = j * dr (phi_0 is the half-hat on
+[0, dr]; the last node has a full hat, i.e. its traction falls to zero one spacing beyond
+the mesh). A scales linearly with dr, so the kernel assembles it for dr = 1.
+
+The logarithmic singularity of K at s = r always sits at an end of a piece of a hat
+(the r_i are nodes), so it is integrated exactly enough by Gauss-Legendre after the
+graded substitution ``s - r_i = L t^6`` on the pieces that touch r_i (error of order
+n^-12 for n points); the other pieces are smooth and use plain Gauss-Legendre (16 points
+next to the singularity, 8 points from three spacings on, where the nearest singularity
+is far enough that the rule is exact to rounding).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# Gauss-Legendre rules on [0, 1]
+_x8, _w8 = np.polynomial.legendre.leggauss(8)
+GL8_X = 0.5 * (_x8 + 1.0)
+GL8_W = 0.5 * _w8
+_x16, _w16 = np.polynomial.legendre.leggauss(16)
+GL16_X = 0.5 * (_x16 + 1.0)
+GL16_W = 0.5 * _w16
+_x32, _w32 = np.polynomial.legendre.leggauss(32)
+GL32_X = 0.5 * (_x32 + 1.0)
+GL32_W = 0.5 * _w32
+GRADING = 6.0
+
+
+@njit(cache=True)
+def ellipk_complement(kc):
+    """K(k) from the complementary modulus kc = sqrt(1 - k^2), by the AGM (machine precision).
+
+    Taking kc (not k) keeps full relative accuracy near the logarithmic singularity k -> 1.
+    """
+    a = 1.0
+    b = kc
+    for _ in range(60):
+        if abs(a - b) <= 1e-16 * a:
+            break
+        a, b = 0.5 * (a + b), np.sqrt(a * b)
+    return np.pi / (2.0 * a)
+
+
+@njit(cache=True)
+def kernel_times_s(r, s, d):
+    """G(r, s) * s, the integrand weight of the axisymmetric Boussinesq kernel.
+
+    ``d = |s - r|`` is passed separately so that it keeps full relative accuracy when s
+    is closer to r than a float can resolve (the graded quadrature samples there).
+    """
+    if r == 0.0:
+        return 2.0
+    if s == 0.0:
+        return 0.0
+    if s < r:
+        kc = np.sqrt(d * (r + s)) / r
+        return 4.0 / np.pi * ellipk_complement(kc) * s / r
+    kc = np.sqrt(d * (s + r)) / s
+    return 4.0 / np.pi * ellipk_complement(kc)
+
+
+@njit(cache=True)
+def _piece(r, sa, sb, phi_a, phi_b, singular_at, xs_smooth, ws_smooth, xs_sing, ws_sing,
+           xs_far, ws_far):
+    """int_{sa}^{sb} phi(s) G(r,s) s ds, phi linear from phi_a at sa to phi_b at sb.
+
+    singular_at: 0 none, -1 singularity at sa, +1 at sb.
+    """
+    L = sb - sa
+    total = 0.0
+    if singular_at == 0:
+        if abs(0.5 * (sa + sb) - r) > 3.0 * L:
+            xs_smooth = xs_far
+            ws_smooth = ws_far
+        for q in range(xs_smooth.size):
+            s = sa + L * xs_smooth[q]
+            phi = phi_a + (phi_b - phi_a) * xs_smooth[q]
+            total += ws_smooth[q] * phi * kernel_times_s(r, s, abs(s - r))
+        return total * L
+    p = GRADING
+    for q in range(xs_sing.size):
+        t = xs_sing[q]
+        x = L * t ** p           # distance from the singular end
+        jac = L * p * t ** (p - 1.0)
+        if singular_at < 0:
+            s = sa + x
+            phi = phi_a + (phi_b - phi_a) * (x / L)
+        else:
+            s = sb - x
+            phi = phi_b + (phi_a - phi_b) * (x / L)
+        total += ws_sing[q] * phi * kernel_times_s(r, s, x) * jac
+    return total
+
+
+@njit(cache=True)
+def influence_matrix_unit(N, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws_far):
+    """Influence matrix A (N x N) for unit node spacing; multiply by dr for spacing dr."""
+    A = np.zeros((N, N))
+    for i in range(N):
+        r = float(i)
+        for j in range(N):
+            rj = float(j)
+            val = 0.0
+            # left piece [r_{j-1}, r_j]: phi rises 0 -> 1
+            if j > 0:
+                sing = 0
+                if i == j:
+                    sing = 1
+                elif i == j - 1:
+                    sing = -1
+                if i == 0:
+                    sing = 0
+                val += _piece(r, rj - 1.0, rj, 0.0, 1.0, sing, xs_smooth, ws_smooth, xs_sing, ws_sing,
+                          xs_far, ws_far)
+            # right piece [r_j, r_{j+1}]: phi falls 1 -> 0
+            sing = 0
+            if i == j:
+                sing = -1
+            elif i == j + 1:
+                sing = 1
+            if i == 0:
+                sing = 0
+            val += _piece(r, rj, rj + 1.0, 1.0, 0.0, sing, xs_smooth, ws_smooth, xs_sing, ws_sing,
+                          xs_far, ws_far)
+            A[i, j] = val
+    return A
+
+
+def assemble_unit(N: int) -> np.ndarray:
+    """Assemble the unit-spacing influence matrix with the module's quadrature rules."""
+    return influence_matrix_unit(int(N), GL16_X, GL16_W, GL32_X, GL32_W, GL8_X, GL8_W)
+
+
+@njit(cache=True)
+def load_weights(N, dr):
+    """Weights w_j with P = 2 pi sum_j w_j p_j (exact for the piecewise-linear traction)."""
+    w = np.empty(N)
+    w[0] = dr * dr / 6.0
+    for j in range(1, N):
+        w[j] = j * dr * dr
+    return w

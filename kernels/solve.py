@@ -1,0 +1,387 @@
+"""Per-step Newton solve on the gap and the Prony unloading loop (Numba kernels).
+
+Each time step solves, for the nodal gaps h (DESIGN.md sections 2 and 4),
+
+    F(h) = h - g - A [ C_eff sigma(h) - H ] = 0,     g = -delta + h0 + r^2/2,
+
+where A is the influence matrix (already scaled by the node spacing), sigma the
+Lennard-Jones law and (C_eff, H) the hereditary-integral coefficients of the step.
+Newton's Jacobian is J = I - C_eff A diag(sigma'(h)). Its inverse is reused from step to
+step (chord iterations, one matrix-vector product each) and recomputed only when the
+residual stops contracting fast, which keeps the cost per step close to a few dense
+matrix-vector products. A backtracking line search keeps every gap positive and the
+residual decreasing; a step whose Newton solve fails is halved by the caller.
+
+Status codes returned by :func:`unload`:
+0 finished (stop criterion met), 1 Newton failed at the minimum step, 2 step limit,
+3 contact reached the mesh edge (domain too small).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .history import history_vector, step_coefficients, update_modes
+from .interface import crossing_radius, lj_traction, lj_traction_and_stiffness
+
+STATUS_DONE = 0
+STATUS_NEWTON_FAILED = 1
+STATUS_STEP_LIMIT = 2
+STATUS_DOMAIN = 3
+
+# stats vector layout
+STAT_ITER = 0
+STAT_FACTOR = 1
+STAT_REJECTED = 2
+STAT_FAILED_SOLVES = 3
+STAT_COLUMNS = 4
+STAT_REFACTOR_OVERFLOW = 5
+STAT_REFACTOR_LINESEARCH = 6
+N_STATS = 7
+
+#: a node joins the low-rank correction when its Jacobian diagonal moved by more than this
+#: fraction, C A_ii |d_i - d_base_i| / max(|J_b,ii|, 1); smaller changes are left out, which
+#: makes Newton slightly inexact (linear convergence with about this factor)
+WOODBURY_ETA = 0.02
+#: most corrected nodes before the Jacobian is refactorized
+WOODBURY_MAX = 96
+
+
+class JacobianCache:
+    """Arrays that carry a factorized Jacobian and its low-rank corrections between steps.
+
+    A plain container built in Python (see :func:`new_jacobian_cache`); the kernels only
+    see its arrays: ``Jinv`` (N, N) inverse of J_b = I - C_b A diag(d_b); ``d_base`` (N)
+    the stiffness d_b = sigma'(h_b) it was built with; ``W`` (N, K) columns J_b^-1 A[:, i]
+    of the corrected nodes, ``slot_of`` (N) their slot or -1, ``state`` = [valid, slots],
+    ``c_base`` = [C_b].
+    """
+
+
+def new_jacobian_cache(N, kmax=WOODBURY_MAX, eta=WOODBURY_ETA):
+    """(Jinv, d_base, W, slot_of, node_of, state, c_base) work arrays for N nodes.
+
+    ``c_base`` = [C_b, eta]: the C_eff of the factorization and the correction threshold.
+    """
+    kmax = min(int(kmax), N)
+    return (np.empty((N, N)), np.zeros(N), np.empty((N, kmax)), np.full(N, -1, np.int64),
+            np.full(kmax, -1, np.int64), np.zeros(2, np.int64), np.array([0.0, eta]))
+
+
+@njit(cache=True)
+def residual(h, g, A, ceff, H, h0, c, sig, w, F):
+    """F = h - g - A (ceff sigma(h) - H); returns max |F|. sig, w are work arrays."""
+    lj_traction(h, h0, c, sig)
+    for j in range(h.size):
+        w[j] = ceff * sig[j] - H[j]
+    u = A @ w
+    norm = 0.0
+    for i in range(h.size):
+        F[i] = h[i] - g[i] - u[i]
+        if abs(F[i]) > norm:
+            norm = abs(F[i])
+    return norm
+
+
+@njit(cache=True)
+def factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base):
+    """Jinv <- inverse of J = I - ceff A diag(sigma'(h)); clears the low-rank corrections."""
+    N = h.size
+    sig = np.empty(N)
+    lj_traction_and_stiffness(h, h0, c, sig, d_base)
+    J = np.empty((N, N))
+    for i in range(N):
+        for j in range(N):
+            J[i, j] = -ceff * A[i, j] * d_base[j]
+        J[i, i] += 1.0
+    Jinv[:, :] = np.linalg.inv(J)
+    for i in range(N):
+        slot_of[i] = -1
+    state[0] = 1
+    state[1] = 0
+    c_base[0] = ceff
+
+
+@njit(cache=True)
+def newton_direction(F, d, A, ceff, eta, Jinv, d_base, W, slot_of, node_of, state, stats):
+    """Newton step dh = -J(h)^-1 F with J(h) = J_b - ceff A_S diag(d_S - d_b,S) E_S^T.
+
+    S holds the nodes whose stiffness moved away from the factorized one; the correction
+    is exact for them (Woodbury identity), nodes outside S differ by less than
+    WOODBURY_ETA. Returns (dh, ok); ok is False when S outgrew the cache (refactorize).
+    """
+    N = F.size
+    kmax = W.shape[1]
+    c_base0 = ceff
+    S = np.empty(N, np.int64)
+    k = 0
+    for i in range(N):
+        jb = abs(1.0 - c_base0 * A[i, i] * d_base[i])
+        if ceff * A[i, i] * abs(d[i] - d_base[i]) > eta * max(jb, 1.0):
+            S[k] = i
+            k += 1
+    if k > kmax:
+        return np.empty(0), False
+    col = np.empty(N)
+    for a in range(k):
+        i = S[a]
+        if slot_of[i] < 0:
+            if state[1] >= kmax:
+                return np.empty(0), False
+            slot = state[1]
+            state[1] += 1
+            for r in range(N):
+                col[r] = A[r, i]
+            W[:, slot] = Jinv @ col
+            slot_of[i] = slot
+            node_of[slot] = i
+            stats[STAT_COLUMNS] += 1
+    y = Jinv @ F
+    if k == 0:
+        return -y, True
+    K = np.empty((k, k))
+    delta = np.empty(k)
+    rhs = np.empty(k)
+    for b in range(k):
+        delta[b] = d[S[b]] - d_base[S[b]]
+    for a in range(k):
+        rhs[a] = y[S[a]]
+        for b in range(k):
+            K[a, b] = -ceff * W[S[a], slot_of[S[b]]] * delta[b]
+        K[a, a] += 1.0
+    z = np.linalg.solve(K, rhs)
+    dh = -y
+    for b in range(k):
+        coef = ceff * delta[b] * z[b]
+        sl = slot_of[S[b]]
+        for r in range(N):
+            dh[r] -= coef * W[r, sl]
+    return dh, True
+
+
+@njit(cache=True)
+def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, node_of,
+           state, c_base, stats):
+    """Solve F(h) = 0 in place, starting from ``h``. Returns True on convergence.
+
+    The Jacobian factorization in (Jinv, d_base, ...) is reused and corrected (see
+    :func:`newton_direction`); it is rebuilt when C_eff changed, when too many nodes need
+    a correction, or when a line search fails with a reused factorization.
+    """
+    N = h.size
+    sig = np.empty(N)
+    d = np.empty(N)
+    w = np.empty(N)
+    F = np.empty(N)
+    Ft = np.empty(N)
+    ht = np.empty(N)
+    norm = residual(h, g, A, ceff, H, h0, c, sig, w, F)
+    if norm <= tol:
+        return True
+    if state[0] == 0 or abs(ceff - c_base[0]) > 1e-12 * abs(ceff):
+        factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
+        stats[STAT_FACTOR] += 1
+    fresh = True
+    for it in range(max_iter):
+        stats[STAT_ITER] += 1
+        lj_traction_and_stiffness(h, h0, c, sig, d)
+        dh, ok = newton_direction(F, d, A, ceff, c_base[1], Jinv, d_base, W, slot_of, node_of,
+                                 state, stats)
+        if not ok:
+            factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
+            stats[STAT_FACTOR] += 1
+            stats[STAT_REFACTOR_OVERFLOW] += 1
+            dh, ok = newton_direction(F, d, A, ceff, c_base[1], Jinv, d_base, W, slot_of,
+                                      node_of, state, stats)
+        # largest step keeping every gap above 30% of its current value
+        lam = 1.0
+        for i in range(N):
+            if dh[i] < 0.0:
+                lim = -0.7 * h[i] / dh[i]
+                if lim < lam:
+                    lam = lim
+        accepted = False
+        for _ls in range(12):
+            for i in range(N):
+                ht[i] = h[i] + lam * dh[i]
+            nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
+            if nt < norm:
+                accepted = True
+                break
+            lam *= 0.5
+        if not accepted:
+            if fresh and state[1] == 0:
+                return False
+            factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
+            stats[STAT_FACTOR] += 1
+            stats[STAT_REFACTOR_LINESEARCH] += 1
+            fresh = True
+            continue
+        for i in range(N):
+            h[i] = ht[i]
+            F[i] = Ft[i]
+        norm = nt
+        if norm <= tol:
+            return True
+        fresh = False
+    return False
+
+
+@njit(cache=True)
+def load(sigma, wP):
+    """P = 2 pi sum_j w_j sigma_j (positive = compressive)."""
+    return 2.0 * np.pi * np.dot(wP, sigma)
+
+
+@njit(cache=True)
+def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
+           step_max, step_min, da_max, tol, max_iter, max_steps, stop_mode,
+           Jinv, d_base, W, slot_of, node_of, state, c_base,
+           t_out, d_out, P_out, a_out, ai_out, stats):
+    """Unload at constant rate from the relaxed state ``h_init`` with the Prony recursion.
+
+    Parameters (dimensionless, DESIGN.md section 2)
+    ----------
+    A : (N, N) influence matrix for the node spacing ``dr``.
+    wP : (N,) load weights, P = 2 pi wP . sigma.
+    h_init : (N,) relaxed gap at indentation ``delta0`` (elastic LJ solution).
+    rate : r-hat; d delta/dt = -rate h0.
+    weights, times : Prony modes of Chat (times may be inf: lumped glassy constant).
+    step_max, step_min : indentation steps in units of h0.
+    da_max : largest contact-radius change per step (a_ref units).
+    stop_mode : 0 stop after pull-off and load recovery, 1 follow to separation.
+    Jinv, d_base, W, slot_of, node_of, state, c_base : Jacobian cache arrays
+        (:func:`new_jacobian_cache`); may carry the factorization of the initial solve.
+    t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
+    stats : int64 array of length N_STATS (incremented).
+
+    Returns
+    -------
+    (status, n_records)
+    """
+    N = h_init.size
+    M = weights.size
+    hm = 3.0 ** (1.0 / 6.0) * h0
+    r2half = np.empty(N)
+    for i in range(N):
+        r2half[i] = 0.5 * (i * dr) ** 2
+    q = np.zeros((M, N))
+    e = np.empty(M)
+    b = np.empty(M)
+    H = np.empty(N)
+    g = np.empty(N)
+    h = h_init.copy()
+    h_prev = h_init.copy()
+    h_prev2 = h_init.copy()
+    hp = np.empty(N)
+    sigma = np.empty(N)
+    sig_new = np.empty(N)
+    lj_traction(h, h0, c, sigma)
+
+    t = 0.0
+    delta = delta0
+    a_cur = crossing_radius(h, dr, hm)
+    t_out[0] = 0.0
+    d_out[0] = delta
+    P_out[0] = load(sigma, wP)
+    a_out[0] = a_cur
+    ai_out[0] = crossing_radius(h, dr, h0)
+    n = 1
+    P_min = P_out[0]
+    i_min = 0
+    dd = step_max * h0
+    dd_min = step_min * h0
+    dt_prev = 0.0
+    dt_prev2 = 0.0
+    easy = 0
+    while True:
+        if n > max_steps:
+            return STATUS_STEP_LIMIT, n
+        dt = dd / (rate * h0)
+        ceff = step_coefficients(weights, times, dt, e, b)
+        history_vector(weights, e, b, q, sigma, H)
+        for i in range(N):
+            g[i] = -(delta - dd) + h0 + r2half[i]
+        if dt_prev2 > 0.0:
+            # quadratic (Lagrange) extrapolation through the last three accepted states
+            t1 = -dt_prev
+            t2 = -dt_prev - dt_prev2
+            l0 = (dt - t1) * (dt - t2) / (t1 * t2)
+            l1 = dt * (dt - t2) / (t1 * (t1 - t2))
+            l2 = dt * (dt - t1) / (t2 * (t2 - t1))
+            for i in range(N):
+                hp[i] = l0 * h[i] + l1 * h_prev[i] + l2 * h_prev2[i]
+                if hp[i] < 0.5 * h[i]:
+                    hp[i] = 0.5 * h[i]
+        elif dt_prev > 0.0:
+            s = dt / dt_prev
+            for i in range(N):
+                hp[i] = h[i] + s * (h[i] - h_prev[i])
+                if hp[i] < 0.5 * h[i]:
+                    hp[i] = 0.5 * h[i]
+        else:
+            for i in range(N):
+                hp[i] = h[i]
+        ok = newton(hp, g, A, ceff, H, h0, c, tol * h0, max_iter, Jinv, d_base, W, slot_of,
+                    node_of, state, c_base, stats)
+        if not ok:
+            stats[STAT_FAILED_SOLVES] += 1
+            state[0] = 0
+            easy = 0
+            if dd <= dd_min * 1.0001:
+                return STATUS_NEWTON_FAILED, n
+            dd = max(0.5 * dd, dd_min)
+            continue
+        a_new = crossing_radius(hp, dr, hm)
+        if abs(a_new - a_cur) > da_max and dd > dd_min * 1.0001:
+            stats[STAT_REJECTED] += 1
+            easy = 0
+            # halve until the change, assumed proportional to the step, fits
+            da_est = abs(a_new - a_cur)
+            while da_est > 0.8 * da_max and dd > dd_min:
+                dd = max(0.5 * dd, dd_min)
+                da_est *= 0.5
+            continue
+        # accept the step
+        lj_traction(hp, h0, c, sig_new)
+        update_modes(e, b, q, sig_new, sigma)
+        for i in range(N):
+            h_prev2[i] = h_prev[i]
+            h_prev[i] = h[i]
+            h[i] = hp[i]
+            sigma[i] = sig_new[i]
+        dt_prev2 = dt_prev
+        dt_prev = dt
+        t += dt
+        delta -= dd
+        P = load(sigma, wP)
+        t_out[n] = t
+        d_out[n] = delta
+        P_out[n] = P
+        a_out[n] = a_new
+        ai_out[n] = crossing_radius(h, dr, h0)
+        if P < P_min:
+            P_min = P
+            i_min = n
+        n += 1
+        if a_new >= (N - 1) * dr:
+            return STATUS_DOMAIN, n
+        if stop_mode == 0:
+            if P_min < 0.0 and n - 1 - i_min >= 5 and P - P_min > 0.05 * abs(P_min):
+                return STATUS_DONE, n
+            if a_new == 0.0 and n - 1 - i_min >= 1:
+                return STATUS_DONE, n
+        else:
+            if a_new == 0.0 and P > P_min and abs(P) < 1e-3 * abs(P_min):
+                return STATUS_DONE, n
+        da = abs(a_new - a_cur)
+        a_cur = a_new
+        # steps change by factors of 2 only, and grow after 8 easy steps in a row: C_eff
+        # (hence the factorized Jacobian) changes only when the step does
+        if da < 0.3 * da_max:
+            easy += 1
+            if easy >= 8 and dd < step_max * h0:
+                dd = min(2.0 * dd, step_max * h0)
+                easy = 0
+        else:
+            easy = 0

@@ -1,0 +1,319 @@
+"""Plain, serializable values that describe one simulation: ``Scene``, ``Numerics``, ``Result``.
+
+Units are those of DESIGN.md section 2 (see :mod:`sweep.units`):
+
+* radii ``a0`` in ``a_ref = (pi R^2 dg / E0*)^(1/3)``;
+* indentation ``delta0`` in ``d_ref = a_ref^2 / R`` (the paper's delta-hat);
+* ``rate`` is the paper's r-hat = r tau0 / h0 (indenter speed in units of h0 per tau0);
+* time in tau0; loads in pi dg R; crack speed in a_ref / tau0.
+
+A ``Scene`` is the physics (what a user varies in a sweep), ``Numerics`` is how it is
+discretized (what a user trades for speed). Both are frozen dataclasses of plain numbers
+and strings, so they hash, pickle to workers and serialize to JSON/HDF5 unchanged.
+All tunable numerical defaults live here, in :data:`PRESETS`, documented once.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InputError, check_choice, check_int, check_range
+
+MATERIALS = ("mpl", "sls")
+STOPS = ("pulloff", "separation")
+
+#: Physical ranges accepted by :class:`Scene` (wider than the tested extremes).
+SCENE_LIMITS = {
+    "n": (0.0, 5.0),        # MPL exponent, open at 0
+    "k": (0.0, 1.0),        # E0/Einf, open at 0, closed at 1 (k = 1 is elastic)
+    "mu": (0.5, 20.0),      # Tabor parameter
+    "rate": (0.0, 1e12),    # r-hat, open at 0
+    "a0": (0.3, 50.0),      # initial (max-tension) contact radius, a_ref units
+    "delta0": (-5.0, 2500.0),  # initial indentation, d_ref units
+}
+
+
+@dataclass(frozen=True, kw_only=True)
+class Scene:
+    """One unloading experiment of a rigid sphere from a fully relaxed half-space.
+
+    Parameters
+    ----------
+    n : float
+        MPL exponent (spectrum broadness), in (0, 5]. Ignored for ``material="sls"``
+        (kept for bookkeeping).
+    k : float
+        Ratio of relaxed to glassy modulus E0/Einf, in (0, 1]; ``k = 1`` is elastic.
+    mu : float
+        Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.5, 20].
+    rate : float
+        Dimensionless unloading rate r-hat = r tau0 / h0, in (0, 1e12].
+    a0 : float, optional
+        Initial contact radius (max-tension radius, gap = 3^(1/6) h0) of the relaxed
+        state, in a_ref units. Give exactly one of ``a0`` and ``delta0``.
+    delta0 : float, optional
+        Initial indentation in d_ref units (delta-hat). In units of h0 it is
+        ``delta0 / h0_hat(mu)`` (see :func:`sweep.units.delta0_from_h0_units`).
+    material : {"mpl", "sls"}
+        "mpl": MPL retardation spectrum, Chat = 1 - (1-k) 2 t^(n/2) K_n(2 sqrt t)/Gamma(n);
+        "sls": standard linear solid, Chat = 1 - (1-k) exp(-t).
+    stop : {"pulloff", "separation"}
+        Stop right after the load minimum has passed and recovered ("pulloff"), or follow
+        the whole curve until the contact is lost ("separation").
+    """
+
+    n: float
+    k: float = 0.1
+    mu: float = 3.24
+    rate: float
+    a0: float | None = None
+    delta0: float | None = None
+    material: str = "mpl"
+    stop: str = "pulloff"
+
+    def __post_init__(self):
+        lim = SCENE_LIMITS
+        set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
+        set_("n", check_range("n", self.n, lim["n"][0], lim["n"][1], lo_open=True))
+        set_("k", check_range("k", self.k, lim["k"][0], lim["k"][1], lo_open=True))
+        set_("mu", check_range("mu", self.mu, *lim["mu"]))
+        set_("rate", check_range("rate", self.rate, lim["rate"][0], lim["rate"][1], lo_open=True))
+        if (self.a0 is None) == (self.delta0 is None):
+            raise InputError("a0/delta0: give exactly one of a0 (initial contact radius) "
+                             "and delta0 (initial indentation)")
+        if self.a0 is not None:
+            set_("a0", check_range("a0", self.a0, *lim["a0"]))
+        if self.delta0 is not None:
+            set_("delta0", check_range("delta0", self.delta0, *lim["delta0"]))
+        check_choice("material", self.material, MATERIALS)
+        check_choice("stop", self.stop, STOPS)
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Scene":
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = set(d) - names
+        if unknown:
+            raise InputError(f"scene: unknown key(s) {', '.join(sorted(unknown))} "
+                             f"(allowed: {', '.join(sorted(names))})")
+        return cls(**d)
+
+
+#: Named numerical presets. Each is a complete set of :class:`Numerics` fields.
+#: Their measured error and cost are in the README ("Speed and accuracy").
+PRESETS = {
+    "fast": dict(nodes=200, step=0.25, da_max=1.0, prony_rtol=1e-3, tol=1e-8),
+    "balanced": dict(nodes=500, step=0.1, da_max=0.5, prony_rtol=1e-4, tol=1e-9),
+    "accurate": dict(nodes=1000, step=0.05, da_max=0.25, prony_rtol=1e-6, tol=1e-10),
+}
+
+
+@dataclass(frozen=True, kw_only=True)
+class Numerics:
+    """Discretization and solver settings of one scene.
+
+    Parameters
+    ----------
+    nodes : int
+        Number of mesh nodes N (uniform radial mesh, node 0 at r = 0), in [20, 5000].
+    domain : float or None
+        Mesh radius in a_ref units. ``None`` (default) chooses it from the scene: large
+        enough that the gap at the mesh edge is ``tail_gap`` h0 at the start of unloading,
+        so the truncated Lennard-Jones tail is negligible (see ``tail_gap``).
+    tail_gap : float
+        Gap at the mesh edge, in units of h0, used by the automatic domain (>= 10).
+    step : float
+        Largest indentation step, in units of h0 (the adaptive step never exceeds it).
+    min_step : float
+        Smallest indentation step in units of h0 before a run is declared failed.
+    da_max : float
+        Largest change of the contact radius per step, in node spacings.
+    prony_rtol : float
+        Maximum relative error of the Prony approximation of Chat over the scene's time
+        window (ignored with ``exact=True``).
+    tol : float
+        Newton tolerance on the gap, in units of h0 (max norm of the residual).
+    max_steps : int
+        Hard cap on the number of time steps (a run that hits it is ``failed``).
+    exact : bool
+        Use the exact hereditary integral (integrated compliance, O(steps^2 N)) instead
+        of the Prony recursion. For validation on small problems.
+    """
+
+    nodes: int = 500
+    domain: float | None = None
+    tail_gap: float = 60.0
+    step: float = 0.1
+    min_step: float = 1e-4
+    da_max: float = 0.5
+    prony_rtol: float = 1e-4
+    tol: float = 1e-9
+    max_steps: int = 200_000
+    exact: bool = False
+
+    def __post_init__(self):
+        set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
+        set_("nodes", check_int("nodes", self.nodes, 20, 5000))
+        if self.domain is not None:
+            set_("domain", check_range("domain", self.domain, 0.5, 500.0))
+        set_("tail_gap", check_range("tail_gap", self.tail_gap, 10.0, 1e5))
+        set_("step", check_range("step", self.step, 1e-4, 10.0))
+        set_("min_step", check_range("min_step", self.min_step, 1e-9, self.step))
+        set_("da_max", check_range("da_max", self.da_max, 0.01, 10.0))
+        set_("prony_rtol", check_range("prony_rtol", self.prony_rtol, 1e-9, 0.1))
+        set_("tol", check_range("tol", self.tol, 1e-14, 1e-3))
+        set_("max_steps", check_int("max_steps", self.max_steps, 10, 10_000_000))
+        if not isinstance(self.exact, (bool, np.bool_)):
+            raise InputError(f"exact must be true or false (got {self.exact!r})")
+        set_("exact", bool(self.exact))
+
+    @classmethod
+    def preset(cls, name: str = "balanced", **overrides) -> "Numerics":
+        """Numerics of a named preset ("fast", "balanced", "accurate"), with overrides."""
+        check_choice("preset", name, PRESETS)
+        return cls(**{**PRESETS[name], **overrides})
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Numerics":
+        d = dict(d)
+        names = {f.name for f in dataclasses.fields(cls)}
+        preset = d.pop("preset", None)
+        unknown = set(d) - names
+        if unknown:
+            raise InputError(f"numerics: unknown key(s) {', '.join(sorted(unknown))} "
+                             f"(allowed: preset, {', '.join(sorted(names))})")
+        if preset is not None:
+            return cls.preset(preset, **d)
+        return cls(**d)
+
+
+def _canonical(obj) -> str:
+    def norm(v):
+        if isinstance(v, float):
+            return float(repr(v)) if math.isfinite(v) else str(v)
+        if isinstance(v, dict):
+            return {k: norm(x) for k, x in v.items()}
+        return v
+    return json.dumps(norm(obj), sort_keys=True, separators=(",", ":"))
+
+
+def scene_id(scene: Scene, numerics: Numerics) -> str:
+    """Stable id of a (scene, numerics) pair: 16 hex digits of the SHA-1 of canonical JSON.
+
+    The same parameters always map to the same id (sorted keys, repr'd floats), which
+    makes resume and de-duplication of sweeps trivial.
+    """
+    text = _canonical({"scene": scene.to_dict(), "numerics": numerics.to_dict()})
+    return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+
+#: Scalar result fields, in the order they are stored (HDF5 ``runs`` table columns).
+RESULT_SCALARS = (
+    "status", "reason",
+    "pull_off", "a_pulloff", "a_inner_pulloff", "delta_pulloff", "t_pulloff",
+    "crack_speed", "vhat", "rhat_pb",
+    "a0_result", "a0_inner", "delta0_result",
+    "steps", "newton_iterations", "factorizations", "prony_terms", "prony_error",
+    "spacing", "domain_used", "wall_s",
+)
+
+TRAJECTORY_KEYS = ("t", "delta", "P", "a", "a_inner")
+
+
+@dataclass
+class Result:
+    """Outcome of one scene. Scalars are NaN when a run failed before reaching them.
+
+    Attributes
+    ----------
+    status : {"ok", "failed"}
+    reason : str
+        Empty when ``ok``; otherwise why the run failed (Newton failure, step limit, ...).
+    pull_off : float
+        |min P| over the unloading, in units of pi dg R.
+    a_pulloff, a_inner_pulloff : float
+        Max-tension radius (gap = 3^(1/6) h0) and inner radius (gap = h0) at pull-off, a_ref.
+    delta_pulloff, t_pulloff : float
+        Indentation (d_ref) and time since the start of unloading (tau0) at pull-off.
+    crack_speed : float
+        v_a = -da/dt at pull-off, in a_ref / tau0 (local fit of a(t)).
+    vhat : float
+        Crack speed in Persson-Brener units v tau0 / l0 (alpha = pi/9).
+    rhat_pb : float
+        Unloading rate in the units of the paper's v-r fit: rate * h0_hat = r tau0 / d_ref.
+    a0_result, a0_inner, delta0_result : float
+        Initial state actually simulated: contact radius, inner radius, indentation.
+    steps, newton_iterations, factorizations : int
+        Accepted time steps, total Newton iterations, Jacobian factorizations.
+    prony_terms : int
+        Number of Prony modes used (0 in exact mode).
+    prony_error : float
+        Max relative error of the Prony Chat over the scene's window (0 in exact mode).
+    spacing, domain_used : float
+        Node spacing and mesh radius (a_ref units).
+    wall_s : float
+        Wall-clock time of the run in seconds.
+    trajectory : dict of arrays
+        ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
+    """
+
+    scene: Scene
+    numerics: Numerics
+    status: str = "failed"
+    reason: str = ""
+    pull_off: float = math.nan
+    a_pulloff: float = math.nan
+    a_inner_pulloff: float = math.nan
+    delta_pulloff: float = math.nan
+    t_pulloff: float = math.nan
+    crack_speed: float = math.nan
+    vhat: float = math.nan
+    rhat_pb: float = math.nan
+    a0_result: float = math.nan
+    a0_inner: float = math.nan
+    delta0_result: float = math.nan
+    steps: int = 0
+    newton_iterations: int = 0
+    factorizations: int = 0
+    prony_terms: int = 0
+    prony_error: float = math.nan
+    spacing: float = math.nan
+    domain_used: float = math.nan
+    wall_s: float = 0.0
+    trajectory: dict = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def scene_id(self) -> str:
+        return scene_id(self.scene, self.numerics)
+
+    def scalars(self) -> dict:
+        """The scalar results (no scene parameters), keyed as in :data:`RESULT_SCALARS`."""
+        return {name: getattr(self, name) for name in RESULT_SCALARS}
+
+    def to_row(self) -> dict:
+        """One flat row: scene id, scene parameters, numerics (prefixed ``num_``), results."""
+        row = {"scene_id": self.scene_id}
+        row.update(self.scene.to_dict())
+        row.update({f"num_{k}": v for k, v in self.numerics.to_dict().items()})
+        row.update(self.scalars())
+        return row
+
+    def to_dict(self, trajectory: bool = False) -> dict:
+        d = self.to_row()
+        if trajectory:
+            d["trajectory"] = {k: np.asarray(v).tolist() for k, v in self.trajectory.items()}
+        return d
