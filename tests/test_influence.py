@@ -1,0 +1,85 @@
+"""Influence matrix of overlapping triangles: second method (quad), closed forms, scaling."""
+import numpy as np
+import pytest
+from scipy.special import ellipe, ellipkm1
+
+from kernels.influence import assemble_unit, ellipk_complement, load_weights
+from tests.naive import influence_matrix_quad
+
+
+def test_ellipk_by_agm_matches_scipy():
+    k = np.array([0.0, 0.1, 0.5, 0.9, 0.999, 1 - 1e-9])
+    kc = np.sqrt((1 - k) * (1 + k))
+    ours = np.array([ellipk_complement(x) for x in kc])
+    # ellipkm1(1 - m) with 1 - m = kc^2 keeps the digits that ellipk(k^2) loses near k = 1
+    np.testing.assert_allclose(ours, ellipkm1(kc**2), rtol=1e-13)
+
+
+def test_matrix_matches_quadrature_of_the_elliptic_kernel():
+    # independent assembly by scipy.integrate.quad (tests/naive.py); interior columns
+    N = 40
+    ours = assemble_unit(N)
+    ref = influence_matrix_quad(N, 1.0, tail="full")
+    np.testing.assert_allclose(ours, ref, rtol=1e-9, atol=1e-12)
+
+
+def test_matrix_scales_with_spacing():
+    # u = A(dr) p with A(dr) = dr * A(1): a disc of radius 1 meshed two ways
+    A = assemble_unit(200)
+    for dr in (0.01, 0.02):
+        r = np.arange(200) * dr
+        p = np.where(r < 1 - 1e-12, 1.0, 0.0)
+        p[int(round(1 / dr))] = 0.5
+        u0 = (A @ p * dr)[0]
+        assert u0 == pytest.approx(2.0, rel=1e-12)     # u(0) = 2 p a exactly
+
+
+def _disc_error(a_nodes):
+    N = a_nodes + 12
+    dr = 1.0 / a_nodes
+    r = np.arange(N) * dr
+    p = np.where(r < 1 - 1e-12, 1.0, 0.0)
+    p[a_nodes] = 0.5                   # the step sampled at its midpoint value
+    u = assemble_unit(N) @ p * dr
+    exact = 4 / np.pi * ellipe(np.minimum(r, 1.0) ** 2)
+    inner = r <= 0.8
+    return np.max(np.abs(u[inner] / exact[inner] - 1))
+
+
+def test_uniform_pressure_on_a_disc_converges_to_closed_form():
+    # u(r) = (4 p a / pi) E(r/a) inside the disc; second-order convergence, 1e-6 at a/dr = 800
+    e1, e2 = _disc_error(200), _disc_error(400)
+    assert 3.5 < e1 / e2 < 4.5
+    assert _disc_error(800) < 1.5e-6
+
+
+def test_hertz_pressure_gives_parabolic_deflection():
+    # p = p0 sqrt(1 - r^2/a^2) -> u = pi p0 (2 a^2 - r^2)/(4 a) inside; the sqrt edge makes the
+    # nodal interpolation converge as dr^1.5; Richardson extrapolation with that order
+    # reaches the closed form to 1e-6 away from the edge
+    def deflection(a_nodes):
+        N = a_nodes + 5
+        dr = 1.0 / a_nodes
+        r = np.arange(N) * dr
+        p = np.sqrt(np.clip(1 - r**2, 0, None))
+        u = assemble_unit(N) @ p * dr
+        return r, u
+
+    r1, u1 = deflection(200)
+    r2, u2 = deflection(400)
+    idx1 = np.flatnonzero(r1 <= 0.8)
+    u2_on_1 = u2[2 * idx1]
+    exact = np.pi * (2 - r1[idx1] ** 2) / 4
+    err1 = np.max(np.abs(u1[idx1] / exact - 1))
+    err2 = np.max(np.abs(u2_on_1 / exact - 1))
+    assert 2.4 < err1 / err2 < 3.3                       # order 1.5: ratio 2^1.5 = 2.83
+    extrapolated = (2**1.5 * u2_on_1 - u1[idx1]) / (2**1.5 - 1)
+    assert np.max(np.abs(extrapolated / exact - 1)) < 1e-6
+
+
+def test_load_weights_integrate_piecewise_linear_traction_exactly():
+    # P = 2 pi int sigma r dr for sigma = 1 - r on [0, 1] (piecewise linear, exact): pi/3
+    N, dr = 101, 0.01
+    r = np.arange(N) * dr
+    sigma = np.clip(1 - r, 0, None)
+    assert 2 * np.pi * load_weights(N, dr) @ sigma == pytest.approx(np.pi / 3, rel=1e-12)

@@ -1,0 +1,360 @@
+"""Analytic theory (sweep.theory): Persson-Brener, JKR/Hertz, Gent-Schultz.
+
+Every PB check compares with an independent route: scipy.integrate.quad of the paper's
+integrand in the original variable, the paper's Appendix-B closed form, asymptotic
+expansions derived by hand (docstrings of the tests), or a scalar brentq solve.
+"""
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from scipy.integrate import quad
+from scipy.optimize import brentq
+from scipy.special import gamma as gamma_fn
+from scipy.special import roots_genlaguerre
+
+from sweep import theory
+from sweep.errors import InputError
+from sweep.theory import (
+    gent_schultz,
+    jkr_contact_radius,
+    jkr_indentation,
+    jkr_load,
+    jkr_pull_off,
+    jkr_pull_off_point,
+    paper_v_vs_r_fit,
+    pb_gamma_eff,
+    pb_gamma_eff_spectrum,
+    pb_integral,
+    pb_integral_closed_form,
+)
+
+PAPER = Path(__file__).resolve().parents[2] / "shared" / "reference" / "paper_values.yaml"
+
+
+# --------------------------------------------------------------------------------------------
+# independent reference: quad of the paper's integrand (eq. PBmodel) in the variable x
+# --------------------------------------------------------------------------------------------
+def quad_integral(n, c):
+    """I = int x^(n-1) e^-x / Gamma(n) [sqrt(1+z^2) - z] dx, z = c / x, by adaptive quad.
+
+    The bracket is written x / (c + sqrt(x^2 + c^2)) (no cancellation). Pieces split at c,
+    at every decade between c and 1, and at 1, 10, 60 (none beyond); below 1 the variable
+    t = x^n removes the x^(n-1) singularity and spreads the decades evenly for small n.
+    """
+
+    def bracket(x):
+        return x / (c + math.sqrt(x * x + c * c))
+
+    lo = 0.1 * min(c, 1.0)
+    cuts = {lo, c, 1.0, 10.0, 60.0}
+    cuts.update(10.0 ** np.arange(math.ceil(math.log10(lo)), 0))
+    edges = [0.0] + sorted(b for b in cuts if b <= 60.0) + [np.inf]
+    total = 0.0
+    for a, b in zip(edges[:-1], edges[1:]):
+        if b <= 1.0:  # int_a^b x^(n-1) e^-x g dx = (1/n) int_{a^n}^{b^n} e^-x g dt, x = t^(1/n)
+            val, _ = quad(
+                lambda t: math.exp(-(t ** (1 / n))) * bracket(t ** (1 / n)) / n,
+                a**n,
+                b**n,
+                epsabs=0,
+                epsrel=1e-13,
+                limit=200,
+            )
+        else:
+            val, _ = quad(
+                lambda x: x ** (n - 1) * math.exp(-x) * bracket(x),
+                a,
+                b,
+                epsabs=0,
+                epsrel=1e-13,
+                limit=200,
+            )
+        total += val
+    return total / gamma_fn(n)
+
+
+def brentq_gamma(n, k, v):
+    """Scalar root of G (1 - (1-k) I(G)) - 1 on [1, 1/k] with the quad integral."""
+    f = lambda g: g * (1.0 - (1.0 - k) * quad_integral(n, g / (2 * math.pi * v))) - 1.0  # noqa
+    return brentq(f, 1.0, 1.0 / k, xtol=1e-14, rtol=1e-14)
+
+
+# --------------------------------------------------------------------------------------------
+# the integral
+# --------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("n", [0.05, 0.4, 1.0, 1.6, 3.0])
+def test_integral_matches_quad(n):
+    c = np.array([1e-6, 1e-2, 1.0, 30.0, 1e4])
+    gamma = 2.0
+    vhat = gamma / (2 * np.pi * c)
+    ours = pb_integral(n, vhat, gamma)
+    ref = np.array([quad_integral(n, ci) for ci in c])
+    np.testing.assert_allclose(ours, ref, rtol=1e-10)
+
+
+@pytest.mark.parametrize("n", [0.05, 0.4, 0.8, 1.6, 2.5])
+def test_integral_matches_appendix_b_closed_form(n):
+    """Quadrature vs the paper's hypergeometric closed form where the series is usable."""
+    c = np.array([1e-8, 1e-3, 0.1, 1.0, 3.0, 10.0])  # c = Gamma / (2 pi vhat) <= 10
+    gamma = np.array([1.0, 7.5])[:, None]
+    vhat = gamma / (2 * np.pi * c[None, :])
+    closed = pb_integral_closed_form(n, vhat, gamma)
+    assert np.all(np.isfinite(closed))
+    np.testing.assert_allclose(pb_integral(n, vhat, gamma), closed, rtol=1e-8)
+
+
+def test_closed_form_limits_are_reported():
+    # beyond c ~ 15 the alternating series loses the digits: nan instead of a wrong number
+    assert math.isnan(pb_integral_closed_form(0.4, 1.0 / (2 * np.pi * 40.0), 1.0))
+    # near an integer n the removable poles cancel catastrophically: flagged too
+    assert math.isnan(pb_integral_closed_form(1.0 + 1e-9, 0.1, 1.0))
+    with pytest.raises(InputError, match=r"^n must not be an integer"):
+        pb_integral_closed_form(2.0, 1.0, 1.0)
+
+
+# --------------------------------------------------------------------------------------------
+# the self-consistent effective surface energy
+# --------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("n", [0.05, 0.2, 0.5, 1.0, 2.0, 3.0])
+@pytest.mark.parametrize("k", [1e-5, 1e-2, 0.5])
+def test_gamma_eff_matches_independent_scalar_solve(n, k):
+    """The whole advertised range, vhat = 1e-6 .. 1e12, against brentq + quad.
+
+    Measured worst difference 1.3e-11 (n = 2, k = 1e-5, vhat = 1e12), where the reference
+    itself loses digits forming 1 - (1-k) I with I -> 1.
+    """
+    v = np.array([1e-6, 1e-3, 1.0, 1e3, 1e6, 1e9, 1e12])
+    ref = np.array([brentq_gamma(n, k, vi) for vi in v])
+    np.testing.assert_allclose(pb_gamma_eff(n, k, v), ref, rtol=1e-10)
+
+
+def test_quadrature_step_is_converged(monkeypatch):
+    v = np.logspace(-6, 12, 19)
+    for n in (0.05, 1.0, 3.0, 10.0):
+        coarse = pb_gamma_eff(n, 1e-4, v)
+        monkeypatch.setattr(theory, "_STEP", theory._STEP / 2)
+        fine = pb_gamma_eff(n, 1e-4, v)
+        monkeypatch.undo()
+        np.testing.assert_allclose(coarse, fine, rtol=1e-13)
+
+
+def test_gamma_eff_limits_and_shape():
+    v = np.logspace(-6, 12, 55)
+    for n in (0.05, 0.4, 1.6, 3.0):
+        for k in (1e-5, 0.1, 0.9):
+            g = pb_gamma_eff(n, k, v)
+            assert g.shape == v.shape
+            assert np.all(np.diff(g) > 0)  # strictly increasing with crack speed
+            assert np.all((g > 1.0) & (g < 1.0 / k))
+    # vhat = 0 is exactly 1; k = 1 (elastic) is 1 at any speed; the glassy limit 1/k
+    assert pb_gamma_eff(0.4, 0.1, 0.0) == 1.0
+    np.testing.assert_array_equal(pb_gamma_eff(0.4, 1.0, [1e-3, 1e9]), [1.0, 1.0])
+    assert pb_gamma_eff(1.6, 0.1, 1e12) == pytest.approx(10.0, rel=1e-10)
+    assert isinstance(pb_gamma_eff(0.4, 0.1, 2.0), float)
+    assert pb_gamma_eff(0.4, 0.1, [[1.0, 2.0]]).shape == (1, 2)
+
+
+@pytest.mark.parametrize("n", [0.05, 0.4, 1.6, 3.0])
+def test_small_speed_asymptote(n):
+    """Gamma_eff - 1 = (1-k) pi n v [1 - (n+1)(n+2) pi^2 v^2 / Gamma^2 + ...].
+
+    For large z = c/x, sqrt(1+z^2) - z = 1/(2z) - 1/(8z^3) + ..., so with c = G/(2 pi v)
+    I = n/(2c) - n(n+1)(n+2)/(8c^3) + ... (Gamma-distribution moments), and
+    G - 1 = (1-k) I G: the O(v^2) terms cancel, the first correction is O(v^3).
+    """
+    k = 0.1
+    slope = (1 - k) * np.pi * n
+    assert (pb_gamma_eff(n, k, 1e-6) - 1.0) / 1e-6 == pytest.approx(slope, rel=1e-8)
+    # the O(v^2) relative correction, itself exact up to O(v^2) (measured 3e-4..8e-4 at 1e-3)
+    for v, rel in ((1e-3, 2e-3), (1e-2, 0.1)):
+        g = pb_gamma_eff(n, k, v)
+        dev = (g - 1.0) / (slope * v) - 1.0
+        expected = -(n + 1) * (n + 2) * np.pi**2 * v**2 / g**2
+        assert dev == pytest.approx(expected, rel=rel)
+
+
+@pytest.mark.parametrize("n", [1.6, 2.5, 3.0])
+def test_large_speed_asymptote_n_above_1(n):
+    """J = 1 - I = c E[1/x] + ... = c/(n-1) for c -> 0 (n > 1), and 1/G = k + (1-k) J."""
+    k, v = 0.1, 1e8
+    g = pb_gamma_eff(n, k, v)
+    c = g / (2 * np.pi * v)
+    assert (1 / g - k) / (1 - k) == pytest.approx(c / (n - 1), rel=1e-4)
+
+
+@pytest.mark.parametrize("n", [0.05, 0.4])
+def test_large_speed_asymptote_n_below_1(n):
+    """For n < 1, J = c^n M / Gamma(n) + O(c), M = int_0^inf y^(n-1) [1 - phi(y)] dy.
+
+    With the Mellin transform of sqrt(1+y^2) - 1 - y on (-1, 0),
+    M = Gamma((n-1)/2) Gamma(-n/2) / (4 sqrt(pi)).
+    """
+    k, v = 1e-3, 1e10
+    g = pb_gamma_eff(n, k, v)
+    c = g / (2 * np.pi * v)
+    m = gamma_fn((n - 1) / 2) * gamma_fn(-n / 2) / (4 * np.sqrt(np.pi))
+    assert (1 / g - k) / (1 - k) == pytest.approx(c**n * m / gamma_fn(n), rel=1e-3)
+
+
+def test_paper_linear_regime_coefficient():
+    """Paper, appendix B: Gamma_eff - 1 ~ q1 v with q1 = -0.0125 + 3.136 n (k = 0.1).
+
+    The exact small-speed slope is (1-k) pi n = 2.827 n for k = 0.1. The paper's 3.136 is pi
+    (0.2 %), i.e. the slope without the factor (1-k): our slope divided by (1-k) matches the
+    paper's q1 to within its fitted offset -0.0125 (3 % at n = 0.4). So the paper's q1
+    overstates the k = 0.1 slope by the factor 1/(1-k) = 1.11; this test records that.
+    """
+    k, v = 0.1, 1e-6
+    for n in (0.4, 0.6, 0.8, 1.6):
+        slope = (pb_gamma_eff(n, k, v) - 1.0) / v
+        assert slope == pytest.approx((1 - k) * np.pi * n, rel=1e-5)
+        q1_paper = -0.0125 + 3.136 * n
+        assert q1_paper == pytest.approx(slope / (1 - k), rel=0.03)
+        assert 1.07 < q1_paper / slope < 1.12
+
+
+# --------------------------------------------------------------------------------------------
+# discrete spectra
+# --------------------------------------------------------------------------------------------
+def test_sls_against_scalar_root():
+    k = 0.1
+    for v in (1e-4, 0.03, 1.0, 30.0, 1e5):
+        def f(g):
+            c = g / (2 * np.pi * v)
+            return g * (1 - (1 - k) * (math.sqrt(1 + c * c) - c)) - 1
+
+        ref = brentq(f, 1.0, 1 / k, xtol=1e-15, rtol=1e-15)
+        assert pb_gamma_eff_spectrum([1.0], [1.0], k, v) == pytest.approx(ref, rel=1e-12)
+
+
+def test_spectrum_gauss_laguerre_discretization_of_mpl():
+    """Generalized Gauss-Laguerre nodes of the Gamma(n) density give the MPL result for slow
+    cracks (the bracket is then smooth on the scale of the nodes)."""
+    n, k = 0.6, 0.1
+    x, w = roots_genlaguerre(60, n - 1)
+    v = np.array([1e-4, 1e-3, 1e-2])
+    np.testing.assert_allclose(
+        pb_gamma_eff_spectrum(w, x, k, v), pb_gamma_eff(n, k, v), rtol=1e-9
+    )
+
+
+def test_spectrum_weights_normalized_and_glassy_mode():
+    k = 0.2
+    a = pb_gamma_eff_spectrum([2.0, 2.0], [1.0, 1.0], k, 0.5)
+    assert a == pytest.approx(pb_gamma_eff_spectrum([1.0], [1.0], k, 0.5), rel=1e-14)
+    # a mode with tau = inf never relaxes: at vhat -> 0 it keeps its share of the glassy jump
+    g0 = pb_gamma_eff_spectrum([0.5, 0.5], [1.0, np.inf], k, 1e-9)
+    assert g0 == pytest.approx(1.0 / (1.0 - 0.5 * (1 - k)), rel=1e-8)
+    # tau = 0 relaxes instantly: no dissipation
+    assert pb_gamma_eff_spectrum([1.0], [0.0], k, 1e3) == 1.0
+
+
+# --------------------------------------------------------------------------------------------
+# validation
+# --------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "args,match",
+    [
+        ((0.0, 0.1, 1.0), r"^n must be in \(0, 10\]"),
+        ((-1.0, 0.1, 1.0), r"^n must be in \(0, 10\]"),
+        ((0.4, 0.0, 1.0), r"^k must be in \(0, 1\]"),
+        ((0.4, 1.5, 1.0), r"^k must be in \(0, 1\]"),
+        ((0.4, 0.1, [1.0, -1.0]), r"^vhat must be >= 0"),
+        ((0.4, 0.1, float("nan")), r"^vhat must be a finite number"),
+        ((0.4, 0.1, "abc"), r"^vhat must be numbers"),
+    ],
+)
+def test_pb_validation(args, match):
+    with pytest.raises(InputError, match=match):
+        pb_gamma_eff(*args)
+
+
+def test_spectrum_validation():
+    with pytest.raises(InputError, match="equal length"):
+        pb_gamma_eff_spectrum([1.0, 2.0], [1.0], 0.1, 1.0)
+    with pytest.raises(InputError, match=r"^weights must be >= 0"):
+        pb_gamma_eff_spectrum([-1.0], [1.0], 0.1, 1.0)
+    with pytest.raises(InputError, match=r"^times must be in \[0, inf\]"):
+        pb_gamma_eff_spectrum([1.0], [-1.0], 0.1, 1.0)
+    with pytest.raises(InputError, match="positive sum"):
+        pb_gamma_eff_spectrum([0.0], [1.0], 0.1, 1.0)
+
+
+# --------------------------------------------------------------------------------------------
+# JKR / Hertz
+# --------------------------------------------------------------------------------------------
+def test_jkr_pull_off_force_control():
+    a, p, d = jkr_pull_off_point("force")
+    h = 1e-6
+    assert (jkr_load(a + h) - jkr_load(a - h)) / (2 * h) == pytest.approx(0.0, abs=1e-8)
+    assert p == pytest.approx(-1.5, rel=1e-14)
+    assert -p == jkr_pull_off()
+    # it is the minimum of P(a)
+    aa = np.linspace(0.01, 5, 100001)
+    assert jkr_load(aa).min() >= p - 1e-12
+    assert d == pytest.approx(a**2 - math.sqrt(2 * a), rel=1e-14)
+
+
+def test_jkr_pull_off_fixed_grips():
+    a, p, d = jkr_pull_off_point("displacement")
+    h = 1e-6
+    assert (jkr_indentation(a + h) - jkr_indentation(a - h)) / (2 * h) == pytest.approx(
+        0.0, abs=1e-8
+    )
+    assert (a, d) == pytest.approx((0.5, -0.75), rel=1e-14)
+    assert p == pytest.approx(-5.0 / 6.0, rel=1e-14)  # 5/9 of the force-control pull-off
+    with pytest.raises(InputError, match="control must be one of"):
+        jkr_pull_off_point("grips")
+
+
+def test_jkr_contact_radius_inverts_on_the_stable_branches():
+    a_f = jkr_pull_off_point("force")[0]
+    a = np.concatenate([[a_f], np.linspace(a_f + 1e-3, 20, 50)])
+    np.testing.assert_allclose(jkr_contact_radius(load=jkr_load(a)), a, rtol=1e-12)
+    a = np.linspace(0.5001, 20, 50)
+    np.testing.assert_allclose(jkr_contact_radius(indentation=jkr_indentation(a)), a, rtol=1e-12)
+    # at the fold d delta/da = 0 the inverse is ill-conditioned (da ~ sqrt(d delta)): ~sqrt(eps)
+    assert jkr_contact_radius(indentation=-0.75) == pytest.approx(0.5, abs=1e-7)
+    assert isinstance(jkr_contact_radius(load=0.0), float)
+    # zero load: u = a^(3/2) = 3 sqrt2 / 2
+    assert jkr_contact_radius(load=0.0) == pytest.approx((1.5 * math.sqrt(2)) ** (2 / 3))
+    with pytest.raises(InputError, match=r"^load must be >= -1.5"):
+        jkr_contact_radius(load=-2.0)
+    with pytest.raises(InputError, match=r"^indentation must be >= -0.75"):
+        jkr_contact_radius(indentation=-1.0)
+    with pytest.raises(InputError, match="exactly one"):
+        jkr_contact_radius()
+
+
+def test_jkr_tends_to_hertz_for_large_contacts():
+    a = 1e4
+    assert jkr_load(a) == pytest.approx(theory.hertz_load(a), rel=1e-5)
+    assert jkr_indentation(a) == pytest.approx(theory.hertz_indentation(a), rel=1e-5)
+
+
+# --------------------------------------------------------------------------------------------
+# rate laws
+# --------------------------------------------------------------------------------------------
+def test_gent_schultz():
+    assert gent_schultz(0.0, 213.5, 0.4154) == 1.0
+    assert gent_schultz(213.5, 213.5, 0.4154) == pytest.approx(2.0)
+    v = np.array([1.0, 10.0, 100.0])
+    g = gent_schultz(v, 213.5, 0.4154)
+    np.testing.assert_allclose(np.diff(np.log(g - 1)) / np.diff(np.log(v)), 0.4154, rtol=1e-12)
+    with pytest.raises(InputError, match=r"^v0 must be > 0"):
+        gent_schultz(1.0, 0.0, 0.5)
+
+
+def test_paper_v_vs_r_fit():
+    if PAPER.exists():
+        fit = yaml.safe_load(PAPER.read_text())["pb_theory"]["v_vs_r_fit"]
+        assert paper_v_vs_r_fit(1.0) == pytest.approx(fit["prefactor"])
+        assert paper_v_vs_r_fit(10.0) / paper_v_vs_r_fit(1.0) == pytest.approx(
+            10 ** fit["exponent"]
+        )
+    assert paper_v_vs_r_fit(2.0, prefactor=1.0, exponent=1.0) == 2.0
+    with pytest.raises(InputError, match=r"^rhat_pb must be >= 0"):
+        paper_v_vs_r_fit(-1.0)
