@@ -9,11 +9,12 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow clean
+.PHONY: help venv demo test test-slow bench clean
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
 	@echo "make test   - create/update .venv and run the test suite"
+	@echo "make bench  - speed benchmarks (JSON in results/bench/)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -25,11 +26,24 @@ $(STAMP): pyproject.toml constraints.txt | $(BIN)/python
 
 venv: $(STAMP)
 
+demo: $(STAMP)
+	$(BIN)/sweep run configs/demo.yaml
+	$(BIN)/sweep info results/demo.h5
+	$(BIN)/sweep plot results/demo.h5 --out results/demo.png
+	@echo "results: results/demo.h5 (read with: python -c 'import sweep; print(sweep.load(\"results/demo.h5\"))')"
+	@echo "figure:  results/demo.png"
+
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not slow" tests
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow tests
+
+bench: $(STAMP)
+	$(BIN)/python -m sweep.benchmarks scene --out results/bench/scene.json
+	$(BIN)/python -m sweep.benchmarks presets --out results/bench/presets.json
+	$(BIN)/python -m sweep.benchmarks scheduler --out results/bench/scheduler.json
+	$(BIN)/python -m sweep.benchmarks store --out results/bench/store.json
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

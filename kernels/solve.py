@@ -37,7 +37,20 @@ STAT_FAILED_SOLVES = 3
 STAT_COLUMNS = 4
 STAT_REFACTOR_OVERFLOW = 5
 STAT_REFACTOR_LINESEARCH = 6
-N_STATS = 7
+STAT_JUMPS = 7
+N_STATS = 8
+
+#: the pull-off is past once the load has recovered by this fraction of |P_min| ...
+RECOVERY = 0.05
+#: ... and by at least this much (units of pi dg R; the elastic pull-off is about 1.5)
+RECOVERY_FLOOR = 0.05
+
+#: a failed step is halved down to this fraction of the largest step before it is taken
+#: for a fold of the discrete path (and the snapped state is looked for)
+SNAP_STEP_FRACTION = 1.0 / 64.0
+
+#: pseudo-time iterations allowed for one snap of the crack tip at a fold
+RELAX_MAX_ITER = 300
 
 #: a node joins the low-rank correction when its Jacobian diagonal moved by more than this
 #: fraction, C A_ii |d_i - d_base_i| / max(|J_b,ii|, 1); smaller changes are left out, which
@@ -81,6 +94,26 @@ def residual(h, g, A, ceff, H, h0, c, sig, w, F):
         if abs(F[i]) > norm:
             norm = abs(F[i])
     return norm
+
+
+@njit(cache=True)
+def positive_step(h, dh):
+    """Largest step length <= 1 along ``dh`` that keeps every gap above 30 % of its value."""
+    lam = 1.0
+    for i in range(h.size):
+        if dh[i] < 0.0:
+            lim = -0.7 * h[i] / dh[i]
+            if lim < lam:
+                lam = lim
+    return lam
+
+
+@njit(cache=True)
+def _norm2(F):
+    s = 0.0
+    for i in range(F.size):
+        s += F[i] * F[i]
+    return np.sqrt(s)
 
 
 @njit(cache=True)
@@ -193,19 +226,16 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, nod
             stats[STAT_REFACTOR_OVERFLOW] += 1
             dh, ok = newton_direction(F, d, A, ceff, c_base[1], Jinv, d_base, W, slot_of,
                                       node_of, state, stats)
-        # largest step keeping every gap above 30% of its current value
-        lam = 1.0
-        for i in range(N):
-            if dh[i] < 0.0:
-                lim = -0.7 * h[i] / dh[i]
-                if lim < lam:
-                    lam = lim
+        lam = positive_step(h, dh)
+        # backtracking on the merit |F|_2 (Newton directions descend it); the max norm
+        # decides convergence
         accepted = False
-        for _ls in range(12):
+        n2 = _norm2(F)
+        for _ls in range(16):
             for i in range(N):
                 ht[i] = h[i] + lam * dh[i]
             nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
-            if nt < norm:
+            if _norm2(Ft) < (1.0 - 1e-4 * lam) * n2:
                 accepted = True
                 break
             lam *= 0.5
@@ -228,6 +258,87 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, nod
 
 
 @njit(cache=True)
+def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
+    """Pseudo-transient continuation to a *stable* equilibrium, in place; True on success.
+
+    Integrates the relaxation dh/dtau = -F(h) with linearly implicit Euler steps,
+    (I/dtau + J) dh = -F, and the switched-evolution-relaxation rule
+    dtau <- dtau |F_old| / |F_new|: small dtau follows the flow, large dtau is Newton.
+    J = A K (compliance times the energy Hessian), so the flow is attracted to stable
+    equilibria. Used where the discrete equilibrium path folds (the crack tip snapping
+    from one node to the next), as the physical system would. One dense factorization per
+    iteration: a fallback, not the main path.
+    """
+    N = h.size
+    sig = np.empty(N)
+    d = np.empty(N)
+    w = np.empty(N)
+    F = np.empty(N)
+    Ft = np.empty(N)
+    ht = np.empty(N)
+    norm = residual(h, g, A, ceff, H, h0, c, sig, w, F)
+    n2 = _norm2(F)
+    dtau = 0.1
+    J = np.empty((N, N))
+    for it in range(max_iter):
+        if norm <= tol:
+            return True
+        stats[STAT_ITER] += 1
+        stats[STAT_FACTOR] += 1
+        lj_traction_and_stiffness(h, h0, c, sig, d)
+        for i in range(N):
+            for j in range(N):
+                J[i, j] = -ceff * A[i, j] * d[j]
+            J[i, i] += 1.0 + 1.0 / dtau
+        dh = -np.linalg.solve(J, F)
+        lam = positive_step(h, dh)
+        for i in range(N):
+            ht[i] = h[i] + lam * dh[i]
+        nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
+        nt2 = _norm2(Ft)
+        if not np.isfinite(nt2) or nt2 > 1e3 * n2:
+            dtau *= 0.1
+            if dtau < 1e-10:
+                return False
+            continue
+        for i in range(N):
+            h[i] = ht[i]
+            F[i] = Ft[i]
+        dtau = min(dtau * min(n2 / nt2, 10.0), 1e12)
+        norm, n2 = nt, nt2
+    return norm <= tol
+
+
+@njit(cache=True)
+def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, dr, hm, Jinv, d_base, W, slot_of, node_of,
+         state, c_base, stats):
+    """Newton from the gap profile outside the crack tip shifted inward by 1 to 6 nodes.
+
+    Near a fold of the discrete path the stable state the tip snaps to is, locally, the
+    same profile one node further in; starting Newton there finds it in a few iterations.
+    Accepts only a solution whose contact radius moved inward. Solution in ``hp``.
+    """
+    N = h.size
+    a_old = crossing_radius(h, dr, hm)
+    i_tip = int(a_old / dr)
+    for shift in range(1, 7):
+        i0 = max(i_tip - 20, 1)
+        for i in range(N):
+            if i < i0:
+                hp[i] = h[i]
+            elif i + shift < N:
+                hp[i] = h[i + shift]
+            else:
+                hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
+        state[0] = 0
+        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, node_of,
+                  state, c_base, stats):
+            if crossing_radius(hp, dr, hm) < a_old:
+                return True
+    return False
+
+
+@njit(cache=True)
 def load(sigma, wP):
     """P = 2 pi sum_j w_j sigma_j (positive = compressive)."""
     return 2.0 * np.pi * np.dot(wP, sigma)
@@ -237,7 +348,7 @@ def load(sigma, wP):
 def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
            step_max, step_min, da_max, tol, max_iter, max_steps, stop_mode,
            Jinv, d_base, W, slot_of, node_of, state, c_base,
-           t_out, d_out, P_out, a_out, ai_out, stats):
+           t_out, d_out, P_out, a_out, ai_out, h_out, stats):
     """Unload at constant rate from the relaxed state ``h_init`` with the Prony recursion.
 
     Parameters (dimensionless, DESIGN.md section 2)
@@ -253,6 +364,7 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
     Jinv, d_base, W, slot_of, node_of, state, c_base : Jacobian cache arrays
         (:func:`new_jacobian_cache`); may carry the factorization of the initial solve.
     t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
+    h_out : (N,) receives the gap of the last accepted step.
     stats : int64 array of length N_STATS (incremented).
 
     Returns
@@ -296,6 +408,7 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
     easy = 0
     while True:
         if n > max_steps:
+            h_out[:] = h
             return STATUS_STEP_LIMIT, n
         dt = dd / (rate * h0)
         ceff = step_coefficients(weights, times, dt, e, b)
@@ -328,12 +441,24 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
             stats[STAT_FAILED_SOLVES] += 1
             state[0] = 0
             easy = 0
-            if dd <= dd_min * 1.0001:
+            if dd > max(dd_min, SNAP_STEP_FRACTION * step_max * h0) * 1.0001:
+                dd = max(0.5 * dd, dd_min)
+                continue
+            # the equilibrium path folds here (the crack tip snaps to the next node): look
+            # for the snapped state by Newton from the profile shifted inward by 1..3 nodes,
+            # else by pseudo-transient relaxation from the last state
+            stats[STAT_JUMPS] += 1
+            ok = snap(h, hp, g, A, ceff, H, h0, c, tol * h0, max_iter, dr, hm, Jinv, d_base, W,
+                      slot_of, node_of, state, c_base, stats)
+            if not ok:
+                for i in range(N):
+                    hp[i] = h[i]
+                ok = relax(hp, g, A, ceff, H, h0, c, tol * h0, RELAX_MAX_ITER, stats)
+            if not ok:
+                h_out[:] = h
                 return STATUS_NEWTON_FAILED, n
-            dd = max(0.5 * dd, dd_min)
-            continue
         a_new = crossing_radius(hp, dr, hm)
-        if abs(a_new - a_cur) > da_max and dd > dd_min * 1.0001:
+        if ok and abs(a_new - a_cur) > da_max and dd > dd_min * 1.0001:
             stats[STAT_REJECTED] += 1
             easy = 0
             # halve until the change, assumed proportional to the step, fits
@@ -365,14 +490,19 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
             i_min = n
         n += 1
         if a_new >= (N - 1) * dr:
+            h_out[:] = h
             return STATUS_DOMAIN, n
         if stop_mode == 0:
-            if P_min < 0.0 and n - 1 - i_min >= 5 and P - P_min > 0.05 * abs(P_min):
+            if P_min < 0.0 and n - 1 - i_min >= 5 and P - P_min > max(RECOVERY * abs(P_min),
+                                                                      RECOVERY_FLOOR):
+                h_out[:] = h
                 return STATUS_DONE, n
             if a_new == 0.0 and n - 1 - i_min >= 1:
+                h_out[:] = h
                 return STATUS_DONE, n
         else:
             if a_new == 0.0 and P > P_min and abs(P) < 1e-3 * abs(P_min):
+                h_out[:] = h
                 return STATUS_DONE, n
         da = abs(a_new - a_cur)
         a_cur = a_new

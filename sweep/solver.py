@@ -27,14 +27,19 @@ import numpy as np
 
 from kernels.influence import assemble_unit, load_weights
 from kernels.interface import crossing_radius, lj_traction
-from kernels.solve import (N_STATS, STAT_FACTOR, STAT_ITER, STATUS_DOMAIN, STATUS_DONE,
+from kernels.solve import (N_STATS, RECOVERY, RECOVERY_FLOOR, STAT_FACTOR, STAT_ITER,
+                           STATUS_DOMAIN, STATUS_DONE,
                            STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT, new_jacobian_cache, newton,
                            unload)
 
 from . import units
 from .scene import Numerics, Result, Scene
 
-MAX_NEWTON_ITER = 40
+#: Newton iterations per solve: a good step converges in 2-5 (quadratic predictor); a solve
+#: that needs more is better retried with a smaller step or taken for a fold
+MAX_NEWTON_ITER = 12
+#: iterations of the elastic solves of the initial state (poorer starting guesses)
+MAX_NEWTON_ITER_INITIAL = 40
 #: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time]
 WINDOW_SAFETY = 10.0
 
@@ -105,7 +110,7 @@ class _Elastic:
         h = np.array(guess, dtype=float)
         g = -delta + self.h0 + 0.5 * self.r**2
         ok = newton(h, g, self.A, 1.0, self.zero, self.h0, self.c, self.tol * self.h0,
-                    MAX_NEWTON_ITER, *self.cache, self.stats)
+                    MAX_NEWTON_ITER_INITIAL, *self.cache, self.stats)
         if not ok:
             self.cache[5][0] = 0     # state[valid] = 0: refactorize next time
         return ok, h
@@ -114,33 +119,57 @@ class _Elastic:
         return crossing_radius(h, self.dr, level_factor * self.h0)
 
 
+def _walk(el: _Elastic, d_from: float, h_from: np.ndarray, d_to: float):
+    """Elastic continuation from a converged state at ``d_from`` to ``d_to``.
+
+    Adaptive steps in delta (halved on a failed solve, grown after successes), each solve
+    warm-started from the previous gap shifted by the change of indentation.
+    Returns the gap at ``d_to`` or None.
+    """
+    d, h = d_from, h_from
+    step = min(0.25, abs(d_to - d_from)) if d_to != d_from else 0.0
+    while d != d_to:
+        if step < 1e-6:
+            return None
+        d_next = d_to if abs(d_to - d) <= step else d + math.copysign(step, d_to - d)
+        guess = np.maximum(h - (d_next - d), 0.3 * h)
+        ok, h_new = el.solve(d_next, guess)
+        if ok:
+            d, h = d_next, h_new
+            step *= 1.5
+        else:
+            step *= 0.5
+    return h
+
+
+def _solve_at(el: _Elastic, delta: float) -> np.ndarray:
+    """Elastic LJ solution at ``delta``: from the JKR guess, else by continuation from the
+    nearest indentation that converges directly (a coarse mesh can trap Newton in a
+    non-solution minimum of |F| where the contact edge sits between nodes)."""
+    ok, h = el.solve(delta, jkr_gap_guess(el.r, delta, el.h0))
+    if ok:
+        return h
+    for offset in (0.5, -0.5, 1.0, -1.0, 2.0, -2.0, 4.0, 8.0):
+        d = delta + offset
+        ok, h = el.solve(d, jkr_gap_guess(el.r, d, el.h0))
+        if ok:
+            h = _walk(el, d, h, delta)
+            if h is not None:
+                return h
+    raise RuntimeError(f"no converged relaxed state at delta0={delta:.6g}")
+
+
 def relaxed_state(el: _Elastic, delta0=None, a0=None):
     """Relaxed elastic state at ``delta0`` or at the indentation giving contact radius ``a0``.
 
     Returns (h, delta0) or raises RuntimeError with a reason.
     """
-    h0 = el.h0
     if delta0 is not None:
-        ok, h = el.solve(delta0, jkr_gap_guess(el.r, delta0, h0))
-        if not ok:
-            # continuation from a deeper, more Hertzian indentation
-            d = delta0 + 2.0
-            ok, h = el.solve(d, jkr_gap_guess(el.r, d, h0))
-            steps = 0
-            while ok and d > delta0 and steps < 400:
-                d_next = max(d - 0.05, delta0)
-                ok, h = el.solve(d_next, h + (d - d_next))
-                d = d_next
-                steps += 1
-            if not ok or d != delta0:
-                raise RuntimeError(f"no converged relaxed state at delta0={delta0:.6g}")
-        return h, float(delta0)
+        return _solve_at(el, float(delta0)), float(delta0)
 
     # find delta with a(delta) = a0: secant on delta, warm-started solves
     d1 = a0 * a0 - math.sqrt(2.0 * a0)
-    ok, h1 = el.solve(d1, jkr_gap_guess(el.r, d1, h0))
-    if not ok:
-        h1, d1 = relaxed_state(el, delta0=d1)
+    h1 = _solve_at(el, d1)
     f1 = el.radius(h1) - a0
     slope = 1.0 / (2 * a0 - 0.5 ** 0.5 * a0 ** -0.5)     # JKR da/d delta
     d2 = d1 - f1 / slope
@@ -148,7 +177,9 @@ def relaxed_state(el: _Elastic, delta0=None, a0=None):
     for _ in range(60):
         ok, h2 = el.solve(d2, np.maximum(h1 + (d1 - d2), 0.3 * h1))
         if not ok:
-            h2, _ = relaxed_state(el, delta0=d2)
+            h2 = _walk(el, d1, h1, d2)
+            if h2 is None:
+                h2 = _solve_at(el, d2)
         f2 = el.radius(h2) - a0
         if f2 < 0:
             lo = d2 if lo is None else max(lo, d2)
@@ -277,6 +308,13 @@ def _simulate(scene: Scene, numerics: Numerics, res: Result) -> None:
     domain = numerics.domain if numerics.domain is not None else auto_domain(scene, numerics, d_est)
     dr = domain / (N - 1)
     res.spacing, res.domain_used = dr, domain
+    zone = units.l0_hat(scene.mu) / dr
+    if zone < numerics.zone_nodes:
+        need = int(math.ceil(numerics.zone_nodes * domain / units.l0_hat(scene.mu))) + 1
+        res.reason = (f"mesh too coarse: the process zone l0 = {units.l0_hat(scene.mu):.3g} a_ref "
+                      f"spans {zone:.2g} node spacings (< zone_nodes = {numerics.zone_nodes:g}); "
+                      f"use nodes >= {need} for domain {domain:.3g}")
+        return
     A = influence_matrix(N, dr)
     wP = load_weights(N, dr)
 
@@ -317,9 +355,11 @@ def _simulate(scene: Scene, numerics: Numerics, res: Result) -> None:
             weights = np.ascontiguousarray(prony.weights, dtype=float)
             times = np.ascontiguousarray(prony.times, dtype=float)
             res.prony_terms, res.prony_error = int(weights.size), float(prony.max_rel_error)
+        h_final = np.empty(N)
         status, n = unload(A, dr, wP, h_init, delta0, scene.rate, h0, c, weights, times,
                            numerics.step, numerics.min_step, numerics.da_max * dr, numerics.tol,
-                           MAX_NEWTON_ITER, max_steps, stop_mode, *el.cache, *out, stats)
+                           MAX_NEWTON_ITER, max_steps, stop_mode, *el.cache, *out, h_final, stats)
+        res.final_gap = h_final
     t, delta, P, a, a_inner = (x[:n].copy() for x in out)
     res.trajectory = {"t": t, "delta": delta, "P": P, "a": a, "a_inner": a_inner}
     res.steps = n - 1
@@ -328,9 +368,17 @@ def _simulate(scene: Scene, numerics: Numerics, res: Result) -> None:
     _finish(res, scene, status, t, delta, P, a, a_inner, dr, h0)
 
 
+def _past_pull_off(P) -> bool:
+    """The stop criterion of the kernels: a tensile minimum, >= 5 steps before the end,
+    after which the load has recovered by RECOVERY |P_min| and at least RECOVERY_FLOOR."""
+    i = int(np.argmin(P))
+    return (P[i] < 0 and len(P) - 1 - i >= 5
+            and P[-1] - P[i] > max(RECOVERY * abs(P[i]), RECOVERY_FLOOR))
+
+
 def _finish(res, scene, status, t, delta, P, a, a_inner, dr, h0):
     i, t_star, P_star = refine_minimum(t, P)
-    passed = P_star < 0 and i < len(P) - 1 and P[-1] > P_star
+    passed = _past_pull_off(P)
     if status == STATUS_DOMAIN:
         res.reason = "contact reached the mesh edge: increase numerics.domain"
         return
@@ -338,8 +386,9 @@ def _finish(res, scene, status, t, delta, P, a, a_inner, dr, h0):
         res.reason = f"step limit ({res.numerics.max_steps}) reached before pull-off"
         return
     if status == STATUS_NEWTON_FAILED and not passed:
-        res.reason = (f"Newton failed at the minimum step (delta={delta[-1]:.6g}, "
-                      f"a={a[-1]:.4g}) before pull-off")
+        res.reason = (f"no equilibrium found at the minimum step before pull-off (delta="
+                      f"{delta[-1]:.6g}, a={a[-1]:.4g}): the discrete path folds where the "
+                      f"crack tip is under-resolved; increase nodes or reduce domain")
         return
     if P_star >= 0:
         res.reason = "no tensile load reached"
@@ -425,7 +474,8 @@ def _unload_exact(A, dr, wP, h_init, delta0, scene, numerics, h0, c, material, s
         if a_new >= (N - 1) * dr:
             return STATUS_DOMAIN, n
         if stop_mode == 0:
-            if P_min < 0 and n - 1 - i_min >= 5 and P - P_min > 0.05 * abs(P_min):
+            if (P_min < 0 and n - 1 - i_min >= 5
+                    and P - P_min > max(RECOVERY * abs(P_min), RECOVERY_FLOOR)):
                 return STATUS_DONE, n
             if a_new == 0.0 and n - 1 - i_min >= 1:
                 return STATUS_DONE, n
@@ -434,8 +484,14 @@ def _unload_exact(A, dr, wP, h_init, delta0, scene, numerics, h0, c, material, s
 
 
 def warm_up() -> float:
-    """Compile (or load from the Numba cache) every kernel on a tiny scene; returns seconds."""
+    """Compile (or load from the Numba cache) the kernels on a tiny scene; returns seconds.
+
+    Raises RuntimeError if the warm-up scene itself fails (a broken installation).
+    """
     t0 = time.perf_counter()
     scene = Scene(n=0.8, k=0.5, mu=3.24, a0=1.5, rate=10.0)
-    simulate(scene, Numerics(nodes=40, step=0.5, da_max=2.0, prony_rtol=1e-2, tol=1e-8))
+    res = simulate(scene, Numerics(nodes=80, domain=3.0, step=0.5, da_max=2.0,
+                                   prony_rtol=1e-2, tol=1e-8))
+    if not res.ok:
+        raise RuntimeError(f"warm-up scene failed: {res.reason}")
     return time.perf_counter() - t0

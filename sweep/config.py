@@ -1,0 +1,453 @@
+"""Sweep configurations: YAML files under ``configs/`` that describe a grid of scenes.
+
+Format (all keys; unknown keys are errors)::
+
+    name: threshold                 # required; letters, digits, "-", "_", "."
+    description: free text          # optional
+    grid:                           # required: one grid, or a list of grids (see below)
+      n: [0.4, 0.6, 0.8, 1.6]       # a list of values ...
+      k: 0.1                        # ... or a single value ...
+      a0: {linspace: [1, 8, 15]}    # ... or a range {linspace: [start, stop, num]}
+      rate: {log10: [0, 6, 7]}      # ... or {log10: [start, stop, num]} = 10**linspace
+    numerics: {preset: balanced}    # optional: a preset and/or explicit Numerics fields
+    store: {trajectories: false}    # optional: also keep t, delta, P, a, a_inner per scene
+    output: results/threshold.h5    # optional: HDF5 file; relative to the working directory
+
+Grid axes (the fields of :class:`sweep.scene.Scene`; units as there):
+
+========  ========  =========================================================
+axis      default   meaning
+========  ========  =========================================================
+n         required  MPL exponent, (0, 5]
+rate      required  unloading rate r-hat = r tau0 / h0, (0, 1e12]
+a0        --        initial contact radius (a_ref); give exactly one of a0, delta0
+delta0    --        initial indentation (d_ref)
+k         0.1       E0/Einf, (0, 1]
+mu        3.24      Tabor parameter, [0.5, 20]
+material  mpl       "mpl" or "sls"
+stop      pulloff   "pulloff" or "separation"
+========  ========  =========================================================
+
+The scenes are the Cartesian product of the axes. ``grid`` may also be a *list* of such
+mappings (e.g. the three panels of the paper's Fig. 3): the sweep is then the union of the
+sub-grids, de-duplicated by scene id (first occurrence kept, order preserved). Every scene
+of a sweep uses the same ``numerics`` (default: the "balanced" preset); ``numerics`` may
+combine a ``preset`` with explicit overrides (``{preset: fast, nodes: 120}``).
+``output`` defaults to ``results/<name>.h5``.
+
+YAML 1.1 reads ``1e6`` as a string; numeric strings such as ``"1e6"`` are accepted as
+numbers wherever a number is expected. Configs are read with a safe loader (no Python
+objects, no code) that also rejects duplicate keys. Validation collects every problem
+and raises one :class:`~sweep.errors.InputError` that lists them all, each naming its key.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import itertools
+import json
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from .errors import InputError, as_float, check_choice, check_int, check_range
+from .scene import MATERIALS, SCENE_LIMITS, STOPS, Numerics, Scene, scene_id
+
+#: Top-level keys of a config file.
+TOP_KEYS = ("name", "description", "grid", "numerics", "store", "output")
+#: Grid axes, in the order the Cartesian product iterates them (last varies fastest).
+AXES = ("material", "stop", "n", "k", "mu", "a0", "delta0", "rate")
+NUMERIC_AXES = ("n", "k", "mu", "a0", "delta0", "rate")
+#: Defaults of axes left out of a grid.
+AXIS_DEFAULTS = {"k": 0.1, "mu": 3.24, "material": "mpl", "stop": "pulloff"}
+STORE_KEYS = ("trajectories",)
+RANGE_KINDS = ("log10", "linspace")
+MAX_SCENES = 200_000
+MAX_RANGE_NUM = 10_000
+_NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
+_OPEN_LOW = {"n", "k", "rate"}  # axes whose lower limit is excluded
+
+
+@dataclass(frozen=True)
+class SweepConfig:
+    """A validated sweep: name, grids of axis values, numerics, storage options, output.
+
+    Build it with :func:`load_config` (file), :func:`parse_config` (YAML text) or
+    :func:`config_from_dict` (mapping). ``grids`` is a tuple of ``{axis: tuple(values)}``
+    with every axis filled in (defaults applied; the unused one of a0/delta0 absent).
+    """
+
+    name: str
+    grids: tuple
+    numerics: Numerics
+    trajectories: bool = False
+    output: str = ""
+    description: str = ""
+    text: str = field(default="", repr=False, compare=False)
+    source: str = field(default="<dict>", compare=False)
+
+    def scenes(self) -> list[Scene]:
+        """The scenes of the sweep, de-duplicated by scene id, in grid order."""
+        return [s for _, s in self.tasks()]
+
+    def tasks(self) -> list[tuple[str, Scene]]:
+        """``(scene_id, scene)`` pairs of the sweep, de-duplicated, in grid order."""
+        seen: dict[str, Scene] = {}
+        for grid in self.grids:
+            names = [a for a in AXES if a in grid]
+            for values in itertools.product(*(grid[a] for a in names)):
+                scene = Scene(**dict(zip(names, values)))
+                sid = scene_id(scene, self.numerics)
+                if sid not in seen:
+                    seen[sid] = scene
+        return list(seen.items())
+
+    @property
+    def config_hash(self) -> str:
+        """Hash of what the results depend on: the scene ids and the trajectory flag.
+
+        Renaming the sweep, reformatting the file or moving the output does not change it;
+        any change of a scene, of the numerics or of ``store.trajectories`` does.
+        """
+        ids = sorted(sid for sid, _ in self.tasks())
+        text = json.dumps({"scenes": ids, "trajectories": bool(self.trajectories)},
+                          sort_keys=True, separators=(",", ":"))
+        return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+    def output_path(self, out: str | os.PathLike | None = None) -> Path:
+        """Absolute output path (``out`` overrides ``output``; relative to the cwd)."""
+        p = Path(out if out is not None else self.output).expanduser()
+        return p if p.is_absolute() else Path.cwd() / p
+
+    def to_dict(self) -> dict:
+        """A plain mapping that :func:`config_from_dict` turns back into this config."""
+        grids = []
+        for g in self.grids:
+            grids.append({a: list(v) for a, v in g.items()})
+        return {
+            "name": self.name,
+            "description": self.description,
+            "grid": grids[0] if len(grids) == 1 else grids,
+            "numerics": self.numerics.to_dict(),
+            "store": {"trajectories": self.trajectories},
+            "output": self.output,
+        }
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """Safe loader (plain data only) that rejects duplicate mapping keys."""
+
+
+def _construct_mapping(loader, node, deep=False):
+    seen = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        try:
+            dup = key in seen
+        except TypeError:
+            dup = False
+        if dup:
+            mark = key_node.start_mark
+            raise yaml.constructor.ConstructorError(
+                None, None, f"duplicate key {key!r}", mark)
+        try:
+            seen.add(key)
+        except TypeError:
+            pass
+    return yaml.SafeLoader.construct_mapping(loader, node, deep=deep)
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
+                                 _construct_mapping)
+
+
+def load_config(path: str | os.PathLike) -> SweepConfig:
+    """Read and validate a YAML config file."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(f"config: no such file {str(p)!r}") from None
+    except IsADirectoryError:
+        raise InputError(f"config: {str(p)!r} is a directory, not a YAML file") from None
+    except UnicodeDecodeError:
+        raise InputError(f"config: {str(p)!r} is not UTF-8 text") from None
+    except OSError as exc:
+        raise InputError(f"config: cannot read {str(p)!r} ({exc.strerror or exc})") from None
+    return parse_config(text, source=str(p))
+
+
+def parse_config(text: str, source: str = "<string>") -> SweepConfig:
+    """Parse YAML ``text`` (safe loader) and validate it."""
+    try:
+        data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 -- a SafeLoader subclass
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise InputError(f"{source}: not valid YAML{where}: {problem}") from None
+    return config_from_dict(data, text=text, source=source)
+
+
+def _fmt_choices(items) -> str:
+    return ", ".join(items)
+
+
+def _axis_values(where: str, axis: str, spec, problems: list[str]) -> tuple | None:
+    """Expand one axis spec into a tuple of validated values (None on error)."""
+    if axis in ("material", "stop"):
+        allowed = MATERIALS if axis == "material" else STOPS
+        vals = spec if isinstance(spec, list) else [spec]
+        if not vals:
+            problems.append(f"{where}: must not be an empty list")
+            return None
+        out = []
+        for i, v in enumerate(vals):
+            w = f"{where}[{i}]" if isinstance(spec, list) else where
+            try:
+                out.append(check_choice(w, v, allowed))
+            except InputError as exc:
+                problems.append(str(exc))
+        return tuple(out) if len(out) == len(vals) else None
+
+    lo, hi = SCENE_LIMITS[axis]
+    lo_open = axis in _OPEN_LOW
+    if isinstance(spec, dict):
+        kinds = [k for k in spec if k in RANGE_KINDS]
+        unknown = [str(k) for k in spec if k not in RANGE_KINDS]
+        if unknown or len(kinds) != 1:
+            problems.append(f"{where}: a range must be {{log10: [start, stop, num]}} or "
+                            f"{{linspace: [start, stop, num]}} (got keys "
+                            f"{', '.join(map(str, spec)) or 'none'})")
+            return None
+        kind = kinds[0]
+        args = spec[kind]
+        if not isinstance(args, list) or len(args) != 3:
+            problems.append(f"{where}.{kind}: must be a list [start, stop, num] (got {args!r})")
+            return None
+        try:
+            start = as_float(f"{where}.{kind}[0] (start)", args[0])
+            stop = as_float(f"{where}.{kind}[1] (stop)", args[1])
+            num = check_int(f"{where}.{kind}[2] (num)", args[2], 1, MAX_RANGE_NUM)
+        except InputError as exc:
+            problems.append(str(exc))
+            return None
+        if kind == "log10":
+            if max(abs(start), abs(stop)) > 300:
+                problems.append(f"{where}.log10: start and stop are exponents of 10 and must "
+                                f"be in [-300, 300] (got {start:g}, {stop:g})")
+                return None
+            vals = [float(v) for v in np.logspace(start, stop, num)]
+        else:
+            vals = [float(v) for v in np.linspace(start, stop, num)]
+        label = lambda i: f"{where} ({kind} value {i})"  # noqa: E731
+    elif isinstance(spec, list):
+        if not spec:
+            problems.append(f"{where}: must not be an empty list")
+            return None
+        vals = spec
+        label = lambda i: f"{where}[{i}]"  # noqa: E731
+    elif isinstance(spec, (int, float, str)) and not isinstance(spec, bool):
+        vals = [spec]
+        label = lambda i: where  # noqa: E731
+    else:
+        problems.append(f"{where}: must be a number, a list of numbers, {{log10: [start, "
+                        f"stop, num]}} or {{linspace: [start, stop, num]}} (got {spec!r})")
+        return None
+    out = []
+    for i, v in enumerate(vals):
+        if isinstance(v, (list, dict)):
+            problems.append(f"{label(i)} must be a number (got {v!r})")
+            continue
+        try:
+            out.append(check_range(label(i), v, lo, hi, lo_open=lo_open))
+        except InputError as exc:
+            problems.append(str(exc))
+    return tuple(out) if len(out) == len(vals) else None
+
+
+def _check_grid(where: str, grid, problems: list[str]) -> dict | None:
+    if not isinstance(grid, dict):
+        problems.append(f"{where}: must be a mapping of axes ({_fmt_choices(AXES)}) "
+                        f"(got {type(grid).__name__})")
+        return None
+    n_before = len(problems)
+    out = {}
+    for key in grid:
+        if key not in AXES:
+            problems.append(f"{where}.{key}: unknown axis (allowed: {_fmt_choices(AXES)})")
+    for axis in ("n", "rate"):
+        if axis not in grid:
+            problems.append(f"{where}.{axis}: required axis is missing")
+    if ("a0" in grid) == ("delta0" in grid):
+        problems.append(f"{where}: give exactly one of the axes a0 (initial contact radius) "
+                        f"and delta0 (initial indentation)")
+    for axis in AXES:
+        if axis in grid:
+            vals = _axis_values(f"{where}.{axis}", axis, grid[axis], problems)
+            if vals is not None:
+                out[axis] = vals
+        elif axis in AXIS_DEFAULTS:
+            out[axis] = (AXIS_DEFAULTS[axis],)
+    return out if len(problems) == n_before else None
+
+
+def _check_numerics(spec, problems: list[str]) -> Numerics | None:
+    if spec is None:
+        return Numerics.preset("balanced")
+    if not isinstance(spec, dict):
+        problems.append(f"numerics: must be a mapping such as {{preset: fast}} "
+                        f"(got {spec!r})")
+        return None
+    n_before = len(problems)
+    base = {"preset": spec["preset"]} if "preset" in spec else {}
+    if "preset" in spec:
+        try:
+            Numerics.from_dict(base)
+        except InputError as exc:
+            problems.append(f"numerics.{exc}")
+            base = {}
+    # check each field on its own so that every problem is reported
+    for key, value in spec.items():
+        if key == "preset":
+            continue
+        try:
+            Numerics.from_dict({**base, key: value})
+        except InputError as exc:
+            msg = str(exc)
+            problems.append(msg if msg.startswith("numerics") else f"numerics.{msg}")
+        except TypeError as exc:  # pragma: no cover - defensive
+            problems.append(f"numerics.{key}: {exc}")
+    if len(problems) != n_before:
+        return None
+    try:
+        return Numerics.from_dict(spec)
+    except InputError as exc:  # combination of individually valid fields
+        problems.append(f"numerics: {exc}")
+        return None
+
+
+def config_from_dict(data, text: str | None = None, source: str = "<dict>") -> SweepConfig:
+    """Validate a parsed config mapping; raise one InputError listing every problem."""
+    problems: list[str] = []
+    if data is None:
+        raise InputError(f"{source}: config is empty (expected a mapping with keys "
+                         f"{_fmt_choices(TOP_KEYS)})")
+    if not isinstance(data, dict):
+        raise InputError(f"{source}: config must be a mapping with keys "
+                         f"{_fmt_choices(TOP_KEYS)} (got {type(data).__name__})")
+    for key in data:
+        if key not in TOP_KEYS:
+            problems.append(f"{key}: unknown key (allowed: {_fmt_choices(TOP_KEYS)})")
+
+    name = data.get("name")
+    if name is None:
+        problems.append("name: required key is missing (a short name such as 'smoke')")
+        name = ""
+    elif not isinstance(name, str) or not _NAME_RE.match(name):
+        problems.append(f"name: must be a string of letters, digits, '-', '_', '.' "
+                        f"(got {name!r})")
+    description = data.get("description", "") or ""
+    if not isinstance(description, str):
+        problems.append(f"description: must be a string (got {description!r})")
+
+    grids: list[dict] = []
+    if "grid" not in data:
+        problems.append("grid: required key is missing (a mapping of axes, or a list of them)")
+    else:
+        g = data["grid"]
+        if isinstance(g, list):
+            if not g:
+                problems.append("grid: must not be an empty list")
+            for i, sub in enumerate(g):
+                checked = _check_grid(f"grid[{i}]", sub, problems)
+                if checked is not None:
+                    grids.append(checked)
+        else:
+            checked = _check_grid("grid", g, problems)
+            if checked is not None:
+                grids.append(checked)
+
+    numerics = _check_numerics(data.get("numerics"), problems)
+
+    trajectories = False
+    store = data.get("store")
+    if store is not None:
+        if not isinstance(store, dict):
+            problems.append(f"store: must be a mapping such as {{trajectories: true}} "
+                            f"(got {store!r})")
+        else:
+            for key in store:
+                if key not in STORE_KEYS:
+                    problems.append(f"store.{key}: unknown key (allowed: "
+                                    f"{_fmt_choices(STORE_KEYS)})")
+            if "trajectories" in store:
+                t = store["trajectories"]
+                if not isinstance(t, bool):
+                    problems.append(f"store.trajectories: must be true or false (got {t!r})")
+                else:
+                    trajectories = t
+
+    output = data.get("output")
+    if output is None:
+        output = f"results/{name}.h5" if isinstance(name, str) and name else ""
+    elif not isinstance(output, str) or not output.strip():
+        problems.append(f"output: must be a file path string (got {output!r})")
+        output = ""
+    elif output.endswith(("/", os.sep)):
+        problems.append(f"output: must name a file, not a directory (got {output!r})")
+
+    if not problems and grids:
+        total = 0
+        for g in grids:
+            size = 1
+            for v in g.values():
+                size *= len(v)
+            total += size
+        if total > MAX_SCENES:
+            problems.append(f"grid: {total} scenes is more than the maximum {MAX_SCENES}; "
+                            f"split the campaign into several configs")
+
+    if problems:
+        head = f"{source}: " if source else ""
+        if len(problems) == 1:
+            raise InputError(head + problems[0])
+        raise InputError(f"{head}{len(problems)} problems: " + "; ".join(problems))
+
+    cfg = SweepConfig(name=name, grids=tuple(grids), numerics=numerics,
+                      trajectories=trajectories, output=output, description=description,
+                      text=text or "", source=source)
+    if text is None:
+        cfg = dataclasses.replace(cfg, text=yaml.safe_dump(cfg.to_dict(), sort_keys=False))
+    try:
+        cfg.tasks()  # Scene-level checks (should all have passed above)
+    except InputError as exc:  # pragma: no cover - defensive
+        raise InputError(f"{source}: {exc}") from None
+    return cfg
+
+
+def as_config(config) -> SweepConfig:
+    """A :class:`SweepConfig` from a config, a mapping, or a path to a YAML file."""
+    if isinstance(config, SweepConfig):
+        return config
+    if isinstance(config, dict):
+        return config_from_dict(config)
+    if isinstance(config, (str, os.PathLike)):
+        return load_config(config)
+    raise InputError(f"config must be a SweepConfig, a mapping or a path "
+                     f"(got {type(config).__name__})")
+
+
+def scale_grid(config: SweepConfig, axis: str, values) -> SweepConfig:
+    """A copy of ``config`` whose (first) grid has ``axis`` replaced by ``values``."""
+    grids = list(config.grids)
+    g = dict(grids[0])
+    g[axis] = tuple(values)
+    grids[0] = g
+    return SweepConfig(name=config.name, grids=tuple(grids), numerics=config.numerics,
+                       trajectories=config.trajectories, output=config.output,
+                       description=config.description, text=config.text, source=config.source)

@@ -1,0 +1,84 @@
+"""Figures of a sweep's results (matplotlib, the optional ``plot`` extra).
+
+``plot_sweep(path, out)`` draws what a user checks first after a run: the pull-off force
+against the unloading rate (one line per (n, k, a0) group) and, when the sweep stored
+trajectories, the load against the contact radius P(a) with the JKR curve for reference.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+
+
+def _pyplot():
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:  # pragma: no cover - the extra is installed by make demo/test
+        raise InputError("plot needs matplotlib: pip install 'visco-sweep[plot]'") from None
+    return plt
+
+
+def plot_sweep(path, out=None) -> Path:
+    """Write a PNG summary of the results file ``path``; returns the figure's path.
+
+    Parameters
+    ----------
+    path : str or Path
+        HDF5 results file of ``sweep run``.
+    out : str or Path, optional
+        Output PNG; default: the results file with the suffix ``.png``.
+    """
+    from .store import load, load_trajectory
+    from .theory import jkr_load
+
+    plt = _pyplot()
+    path = Path(path)
+    df = load(path)
+    if df.empty:
+        raise InputError(f"results: {path} holds no finished scene")
+    ok = df[df["status"] == "ok"]
+    out = Path(out) if out is not None else path.with_suffix(".png")
+    has_traj = False
+    try:
+        load_trajectory(path, str(ok["scene_id"].iloc[0])) if len(ok) else None
+        has_traj = len(ok) > 0
+    except (KeyError, InputError, OSError):
+        has_traj = False
+    ncols = 2 if has_traj else 1
+    fig, axes = plt.subplots(1, ncols, figsize=(6.0 * ncols, 4.5), squeeze=False)
+    ax = axes[0, 0]
+    keys = [c for c in ("material", "n", "k", "mu", "a0", "delta0") if c in ok and ok[c].nunique() > 1]
+    groups = ok.groupby(keys, dropna=False) if keys else [((), ok)]
+    for key, g in groups:
+        g = g.sort_values("rate")
+        key = key if isinstance(key, tuple) else (key,)
+        label = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in zip(keys, key))
+        ax.plot(g["rate"], g["pull_off"], "o-", label=label or None)
+    ax.axhline(1.5, color="0.6", ls=":", lw=1, label="JKR elastic, 1.5")
+    ax.set_xscale("log")
+    ax.set_xlabel(r"unloading rate $\hat r = r\tau_0/h_0$")
+    ax.set_ylabel(r"pull-off force $\hat P_{po}$  ($\pi\Delta\gamma_0 R$)")
+    ax.set_title(f"{path.name}: {len(ok)} ok, {len(df) - len(ok)} failed")
+    ax.legend(fontsize=7)
+    if has_traj:
+        ax2 = axes[0, 1]
+        for _, row in ok.iterrows():
+            tr = load_trajectory(path, str(row["scene_id"]))
+            ax2.plot(tr["a"], tr["P"], lw=1,
+                     label=f"n={row['n']:g}, rate={row['rate']:g}")
+        a = np.linspace(0.5, max(3.0, float(ok["a0_result"].max())), 200)
+        ax2.plot(a, jkr_load(a), "k--", lw=1, label="JKR (relaxed)")
+        ax2.set_xlabel(r"contact radius $\hat a$")
+        ax2.set_ylabel(r"load $\hat P$")
+        ax2.set_title("trajectories P(a)")
+        ax2.legend(fontsize=6)
+    fig.tight_layout()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+    return out

@@ -1,0 +1,471 @@
+"""Run a sweep: spread the scenes of a config over the cores (or a dask cluster), store results.
+
+:func:`run_sweep` is the Python entry point behind ``sweep run``::
+
+    from sweep import run_sweep
+    report = run_sweep("configs/smoke.yaml", jobs=2)          # joblib/loky on this machine
+    report = run_sweep(cfg, backend="dask", scheduler="tcp://head:8786")   # a cluster
+
+Scheduling. joblib ``Parallel(return_as="generator_unordered", batch_size=1)`` runs one
+scene per task; results stream back to the parent as each scene finishes and the parent,
+the single writer, appends them to the crash-safe store (:mod:`sweep.store`). Backends:
+
+* ``loky`` (default): ``jobs`` worker processes on this machine (default: all cores), each
+  with one BLAS/OpenMP/Numba thread (``inner_max_num_threads=1``). ``jobs=1`` runs in the
+  parent process.
+* ``dask``: the same tasks through joblib's dask backend on a ``dask.distributed`` cluster at
+  ``scheduler`` (``tcp://host:8786``); without an address a ``LocalCluster`` with ``jobs``
+  single-threaded worker processes is started for the run.
+
+The Numba cache is warmed in the parent (``sweep.solver.warm_up()``, which compiles and
+writes the on-disk cache) before the grid starts, and once more in every worker process on
+its first task (a cache load). Resume: scenes whose id is already in the results file (or
+its journal) are skipped, so running the same command again completes an interrupted sweep.
+"""
+from __future__ import annotations
+
+import math
+import os
+import socket
+import sys
+import tempfile
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import click
+import numpy as np
+
+from .config import SweepConfig, as_config
+from .errors import InputError, check_int, check_range
+from .scene import Result
+from .store import ResultStore, StoreBusyError, plain_row
+
+BACKENDS = ("loky", "dask")
+PROGRESS_MODES = ("auto", "bar", "log", "none")
+THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+               "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
+               "NUMBA_NUM_THREADS")
+
+
+class SweepRuntimeError(RuntimeError):
+    """A sweep could not run or was stopped (cluster unreachable, worker crash, ...).
+
+    The CLI maps it to exit code 1. Results finished before the error are on disk.
+    """
+
+
+@dataclass
+class SweepReport:
+    """What :func:`run_sweep` did."""
+
+    output: Path
+    name: str
+    total: int
+    skipped: int
+    ran: int
+    failed: int
+    wall_s: float
+    backend: str
+    jobs: int
+    backup: Path | None = None
+    failed_ids: list = field(default_factory=list)
+
+    def line(self) -> str:
+        text = (f"{self.name}: {self.total} scenes ({self.ran} ran, {self.skipped} already "
+                f"done, {self.failed} failed) in {self.wall_s:.1f} s -> {self.output}")
+        if self.backup is not None:
+            text += f" (previous results moved to {self.backup})"
+        return text
+
+
+# ----------------------------------------------------------------------------- workers
+_WORKER_READY = False
+
+
+def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
+    """Once per process: one thread for BLAS/OpenMP/Numba, then warm the Numba cache."""
+    global _WORKER_READY
+    if _WORKER_READY:
+        return
+    if limit_threads:
+        for var in THREAD_VARS:
+            os.environ.setdefault(var, "1")
+        try:
+            from threadpoolctl import threadpool_limits
+
+            threadpool_limits(limits=1)
+        except Exception:  # pragma: no cover - threadpoolctl is a joblib dependency
+            pass
+    if warm:
+        from . import solver
+
+        if hasattr(solver, "warm_up"):
+            solver.warm_up()
+    _WORKER_READY = True
+
+
+def _one_line(text: str, limit: int = 300) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | None = None,
+              in_worker: bool = True):
+    """Worker task: simulate one scene; return ``(row, trajectory or None)``, plain data.
+
+    Never raises for a failing scene: an exception becomes ``status="failed"`` with the
+    exception as reason (the solver itself already reports numerical failures that way).
+    ``in_worker=False`` (the sequential path in the parent) leaves the thread limits alone.
+    """
+    if in_worker:
+        _prepare_worker(warm=simulate is None)
+    if simulate is None:
+        from .solver import simulate
+    t0 = time.perf_counter()
+    c0 = time.process_time()
+    try:
+        res = simulate(scene, numerics)
+    except Exception as exc:  # a bug in one scene must not stop the sweep
+        res = Result(scene=scene, numerics=numerics, status="failed",
+                     reason=_one_line(f"exception {type(exc).__name__}: {exc}"))
+    task_wall = time.perf_counter() - t0
+    task_cpu = time.process_time() - c0
+    row = res.to_row()
+    row["reason"] = _one_line(row.get("reason", "") or "")
+    wall = row.get("wall_s")
+    if wall is None or not math.isfinite(float(wall)) or float(wall) <= 0.0:
+        row["wall_s"] = task_wall
+    row["task_wall_s"] = task_wall
+    row["task_cpu_s"] = task_cpu
+    row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
+    row["finished_at"] = time.time()
+    traj = None
+    if trajectories and res.trajectory:
+        traj = {str(k): np.asarray(v, dtype=np.float64) for k, v in res.trajectory.items()}
+    return plain_row(row), traj
+
+
+def template_row(config: SweepConfig) -> dict:
+    """A row with every column of the runs table (used for an empty table's schema)."""
+    _, scene = config.tasks()[0]
+    row = Result(scene=scene, numerics=config.numerics).to_row()
+    row.update(task_wall_s=0.0, task_cpu_s=0.0, worker="", finished_at=0.0)
+    return row
+
+
+# ----------------------------------------------------------------------------- progress
+def _fmt_eta(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "--:--:--"
+    s = int(round(seconds))
+    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
+
+
+class Progress:
+    """Progress display: one updating line on a TTY ("bar"), one line per scene ("log")."""
+
+    def __init__(self, mode, total: int, already: int, stream=None):
+        self.stream = stream if stream is not None else sys.stderr
+        if callable(mode):
+            self.callback, mode = mode, "none"
+        else:
+            self.callback = None
+        if mode == "auto":
+            isatty = getattr(self.stream, "isatty", lambda: False)
+            mode = "bar" if isatty() else "log"
+        self.mode = mode
+        self.total, self.done, self.already = total, already, already
+        self.failed = 0
+        self.t0 = time.monotonic()
+        self.width = len(str(total))
+
+    def _echo(self, text: str, nl: bool = True) -> None:
+        click.echo(text, file=self.stream, nl=nl)
+        with_flush = getattr(self.stream, "flush", None)
+        if with_flush:
+            with_flush()
+
+    def eta(self) -> float:
+        ran = self.done - self.already
+        if ran <= 0:
+            return math.inf
+        return (time.monotonic() - self.t0) / ran * (self.total - self.done)
+
+    def message(self, text: str) -> None:
+        if self.mode != "none":
+            self._echo(text)
+
+    def bar_text(self) -> str:
+        return (f"[{self.done:{self.width}d}/{self.total}] {self.failed} failed  "
+                f"ETA {_fmt_eta(self.eta())}")
+
+    def start(self) -> None:
+        if self.mode == "bar":
+            self._echo("\r" + self.bar_text(), nl=False)
+
+    def update(self, row: dict) -> None:
+        self.done += 1
+        if row.get("status") != "ok":
+            self.failed += 1
+        if self.callback is not None:
+            self.callback({"done": self.done, "total": self.total, "failed": self.failed,
+                           "eta": self.eta(), "row": row})
+        if self.mode == "bar":
+            self._echo("\r" + self.bar_text() + "   ", nl=False)
+        elif self.mode == "log":
+            po = row.get("pull_off")
+            po = f"{po:.5g}" if isinstance(po, float) else str(po)
+            text = (f"[{self.done:{self.width}d}/{self.total}] {row['scene_id']} "
+                    f"{row.get('status')} pull_off={po} wall={row.get('wall_s', 0.0):.3g}s")
+            if row.get("status") != "ok" and row.get("reason"):
+                text += f" reason: {row['reason']}"
+            self._echo(text)
+
+    def close(self) -> None:
+        if self.mode == "bar":
+            self._echo("")
+
+
+# ----------------------------------------------------------------------------- helpers
+def check_output_writable(path: Path) -> None:
+    """Raise InputError unless a results file can be created at ``path``."""
+    if path.is_dir():
+        raise InputError(f"output {path} is a directory; give a file path such as "
+                         f"{path / 'results.h5'}")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"output {path}: cannot create directory {path.parent} "
+                         f"({exc.strerror or exc})") from None
+    try:
+        fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.probe-")
+        os.close(fd)
+        os.unlink(name)
+    except OSError as exc:
+        raise InputError(f"output {path}: cannot write in {path.parent} "
+                         f"({exc.strerror or exc})") from None
+    if path.exists() and not os.access(path, os.R_OK):
+        raise InputError(f"output {path} exists but cannot be read")
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return text[0] if text else type(exc).__name__
+
+
+def _connect_dask(scheduler, jobs, timeout):
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise SweepRuntimeError("backend dask needs dask.distributed: pip install "
+                                "'visco-sweep[cluster]'") from None
+    if scheduler:
+        try:
+            client = Client(scheduler, timeout=f"{timeout}s", set_as_default=False)
+        except Exception as exc:
+            raise SweepRuntimeError(f"cannot connect to the dask scheduler at {scheduler} "
+                                    f"within {timeout:g} s ({_first_line(exc)})") from None
+        return client, None
+    n = jobs or os.cpu_count() or 1
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    return Client(cluster, set_as_default=False), cluster
+
+
+# ----------------------------------------------------------------------------- entry point
+def run_sweep(config, jobs: int | None = None, backend: str = "loky",
+              scheduler: str | None = None, out=None, resume: bool = True,
+              progress="auto", simulate: Callable | None = None,
+              consolidate_every: float = 5.0, connect_timeout: float = 10.0,
+              stream=None) -> SweepReport:
+    """Run (or resume) the sweep of ``config`` and write its results file.
+
+    Parameters
+    ----------
+    config : SweepConfig, mapping, or path of a YAML file
+    jobs : int, optional
+        Worker processes (loky, default: all cores) or tasks in flight (dask, default: all
+        worker threads of the cluster).
+    backend : {"loky", "dask"}
+    scheduler : str, optional
+        Address of a dask.distributed scheduler (``tcp://host:8786``); dask backend only.
+    out : path, optional
+        Results file, overriding the config's ``output`` (relative to the cwd).
+    resume : bool
+        True (default): keep an existing results file of the same config and run only the
+        scenes it lacks. False (``--fresh``): move existing results aside to ``<out>.bak``
+        and start over. A results file of a *different* config is never overwritten: with
+        ``resume`` it is an :class:`InputError`.
+    progress : {"auto", "bar", "log", "none"} or callable
+        "auto": an updating line on a TTY, one line per scene otherwise. A callable gets a
+        dict (done, total, failed, eta, row) after each scene.
+    simulate : callable, optional
+        Replacement for :func:`sweep.solver.simulate` (module-level, so that it pickles to
+        workers); for tests and benchmarks.
+    consolidate_every : float
+        Seconds between consolidations of the results file (see :mod:`sweep.store`).
+    connect_timeout : float
+        Seconds to wait for a dask scheduler.
+
+    Raises
+    ------
+    InputError
+        Invalid config or options, unwritable output, incompatible existing results.
+    SweepRuntimeError
+        Cluster unreachable, another writer on the same file, a worker crash.
+    """
+    t_start = time.monotonic()
+    cfg = as_config(config)
+    if backend not in BACKENDS:
+        raise InputError(f"backend must be one of {', '.join(BACKENDS)} (got {backend!r})")
+    if jobs is not None:
+        jobs = check_int("jobs", jobs, 1, 4096)
+    if scheduler is not None and backend != "dask":
+        raise InputError("scheduler: an address is only used with backend dask "
+                         "(add --backend dask)")
+    if not callable(progress) and progress not in PROGRESS_MODES:
+        raise InputError(f"progress must be one of {', '.join(PROGRESS_MODES)} "
+                         f"(got {progress!r})")
+    consolidate_every = check_range("consolidate_every", consolidate_every, 0.0, 1e6)
+    connect_timeout = check_range("connect_timeout", connect_timeout, 0.0, 3600.0, lo_open=True)
+    path = cfg.output_path(out)
+    check_output_writable(path)
+    tasks = cfg.tasks()
+
+    store = ResultStore(path, config_hash=cfg.config_hash, config_name=cfg.name,
+                        config_text=cfg.text, config_source=cfg.source, n_scenes=len(tasks),
+                        trajectories=cfg.trajectories, template_row=template_row(cfg),
+                        interval=consolidate_every)
+    try:
+        store.prepare(resume=resume)
+    except StoreBusyError as exc:
+        raise SweepRuntimeError(str(exc)) from None
+
+    client = cluster = None
+    try:
+        if backend == "dask":
+            client, cluster = _connect_dask(scheduler, jobs, connect_timeout)
+        done = store.begin(fresh=not resume)
+    except BaseException:
+        store.abort()
+        _close_dask(client, cluster)
+        raise
+
+    todo = [(sid, scene) for sid, scene in tasks if sid not in done]
+    skipped = len(tasks) - len(todo)
+    prog = Progress(progress, total=len(tasks), already=skipped, stream=stream)
+    if backend == "loky":
+        n_jobs = min(jobs or os.cpu_count() or 1, max(len(todo), 1))
+        where = f"{n_jobs} loky worker{'s' if n_jobs > 1 else ''}"
+    else:
+        n_jobs = jobs or -1
+        where = f"dask cluster {scheduler or 'LocalCluster'}"
+    if todo:
+        prog.message(f"sweep {cfg.name}: {len(tasks)} scenes, {skipped} already done, "
+                     f"{len(todo)} to run on {where} -> {path}")
+    else:
+        prog.message(f"sweep {cfg.name}: all {len(tasks)} scenes already done -> {path}")
+    if store.backup is not None:
+        prog.message(f"previous results moved to {store.backup}")
+
+    ran = failed = 0
+    failed_ids = []
+    completed = False
+    try:
+        if todo:
+            if simulate is None:
+                _warm_parent()
+            prog.start()
+            results = _results(todo, cfg, backend, n_jobs, client, simulate)
+            try:
+                for row, traj in results:
+                    store.append(row, traj)
+                    ran += 1
+                    if row.get("status") != "ok":
+                        failed += 1
+                        failed_ids.append(row["scene_id"])
+                    prog.update(row)
+                    store.maybe_consolidate()
+            finally:
+                with warnings.catch_warnings():  # joblib warns about cancelled tasks
+                    warnings.simplefilter("ignore")
+                    results.close()
+        completed = True
+    except (KeyboardInterrupt, SystemExit):
+        prog.close()
+        _finish_store(store)
+        raise
+    except Exception as exc:
+        prog.close()
+        _finish_store(store)
+        raise SweepRuntimeError(
+            f"sweep stopped after {ran} of {len(todo)} scenes ({type(exc).__name__}: "
+            f"{_first_line(exc)}); finished scenes are saved in {path}, run the same "
+            f"command again to resume") from exc
+    finally:
+        _close_dask(client, cluster)
+    if completed:
+        prog.close()
+        store.finish()
+    return SweepReport(output=path, name=cfg.name, total=len(tasks), skipped=skipped, ran=ran,
+                       failed=failed, wall_s=time.monotonic() - t_start, backend=backend,
+                       jobs=n_jobs, backup=store.backup, failed_ids=failed_ids)
+
+
+def _finish_store(store: ResultStore) -> None:
+    try:
+        store.finish()
+    except Exception:
+        store.abort()
+
+
+def _close_dask(client, cluster) -> None:
+    for obj in (client, cluster):
+        if obj is not None:
+            try:
+                obj.close()
+            except Exception:  # pragma: no cover
+                pass
+
+
+def _warm_parent() -> None:
+    """Compile (or load) the Numba kernels once, in the parent, before the workers start."""
+    try:
+        from . import solver
+    except ImportError as exc:
+        raise SweepRuntimeError(f"cannot import the solver ({exc})") from None
+    if hasattr(solver, "warm_up"):
+        solver.warm_up()
+
+
+def _results(todo, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate):
+    """Yield ``(row, trajectory)`` per scene, in completion order."""
+    from joblib import Parallel, delayed, parallel_config
+
+    calls = (delayed(run_scene)(scene, cfg.numerics, cfg.trajectories, simulate)
+             for _, scene in todo)
+    if backend == "loky" and n_jobs == 1:
+        try:
+            from threadpoolctl import threadpool_limits
+            limits = threadpool_limits(limits=1)
+        except Exception:  # pragma: no cover
+            limits = None
+        try:
+            for _, scene in todo:
+                yield run_scene(scene, cfg.numerics, cfg.trajectories, simulate,
+                                in_worker=False)
+        finally:
+            if limits is not None:
+                limits.restore_original_limits()
+        return
+    if backend == "loky":
+        ctx = parallel_config(backend="loky", inner_max_num_threads=1)
+    else:
+        ctx = parallel_config(backend="dask", client=client, wait_for_workers_timeout=60)
+    with ctx:
+        par = Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1,
+                       pre_dispatch="2*n_jobs")
+        yield from par(calls)

@@ -1,0 +1,735 @@
+"""Crash-safe HDF5 store of a sweep: one results file per sweep, plus a journal while running.
+
+Layout on disk for ``output = results/x.h5``::
+
+    results/x.h5            consolidated HDF5 file (the "main file"); never opened for writing,
+                            only ever replaced as a whole with os.replace
+    results/x.h5.parts/     exists while a sweep writes (or after it was killed):
+        meta.json           config hash, name and text, start time (written atomically)
+        journal.jsonl       one JSON line per finished scene: its runs-table row
+        traj/<id>.h5        trajectory of one scene (written to a temporary name, fsync-free,
+                            then os.replace'd; always written *before* the scene's journal line)
+    results/x.h5.lock       advisory lock (flock) held by the single writer
+    results/x.h5.tmp        a consolidation in progress (a stale one is deleted on next open)
+
+Crash safety. The only writer is the parent process of :func:`sweep.run_sweep`. When a scene
+finishes, its trajectory file (if any) is moved into place, then its row is appended to the
+journal with a single ``write`` on an ``O_APPEND`` descriptor. Neither step can corrupt earlier
+data: a kill (SIGKILL included) can at worst leave a torn *last* line, which readers ignore and
+the next writer truncates away. Every few seconds and at the end the writer *consolidates*:
+it writes the complete file (previous main file + journal) to ``x.h5.tmp``, fsyncs it and
+``os.replace``-s it over ``x.h5``. A reader therefore always sees either the old or the new
+complete file, never a half-written one; the main file is never modified in place, so no
+crash can damage it. After the final consolidation the ``.parts`` directory is removed and the
+sweep is a single self-contained HDF5 file.
+
+Source of truth: the main file *plus* the journal. :func:`load` reads the journal first and
+then the main file and returns their union (one row per scene id), so it returns every scene
+that finished before a kill, even if the kill came before the next consolidation. Resuming a
+sweep (running the same command again) reads the same union and skips those scenes.
+The journal is not fsynced per scene (a process kill cannot lose page-cache data); it is
+fsynced at each consolidation, so a power loss loses at most the last few seconds.
+
+File contents (plain arrays and text only; no pickles):
+
+* ``/runs/<column>``: one 1-D dataset per column of the runs table (float64 with NaN for
+  missing values, int64, uint8 for booleans (attribute ``kind = "bool"``), or variable-length
+  UTF-8 strings); ``/runs`` attribute ``columns`` gives the column order. One row per finished
+  scene: ``scene_id``, the scene parameters, the numerics (``num_*``), every scalar result
+  (:data:`sweep.scene.RESULT_SCALARS`, incl. ``status``, ``reason``, ``wall_s``) and the
+  scheduler's ``task_wall_s`` and ``task_cpu_s`` (wall and CPU seconds of the task in its
+  worker; CPU well below wall means a loaded machine), ``worker`` (host:pid) and
+  ``finished_at`` (unix time).
+* ``/trajectories/<scene_id>/{t, delta, P, a, a_inner}`` when the config asks for them.
+* File attributes: ``format``, ``format_version``, ``config_name``, ``config_hash``,
+  ``config_text``, ``config_source``, ``package_version``, ``git_commit``, ``numba_version``,
+  ``numpy_version``, ``h5py_version``, ``python_version``, ``started_at``, ``updated_at``,
+  ``finished_at`` (ISO 8601 UTC; ``finished_at`` is empty until every scene is done),
+  ``n_scenes`` (size of the grid), ``n_finished``, ``complete``, ``trajectories``.
+"""
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import math
+import os
+import platform
+import shutil
+import subprocess
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import h5py
+import numpy as np
+
+from .errors import InputError
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - not POSIX: no advisory lock
+    fcntl = None
+
+if TYPE_CHECKING:  # pandas is imported lazily: sweep workers never need it
+    import pandas as pd
+
+FORMAT = "visco-sweep-results"
+FORMAT_VERSION = 1
+JOURNAL = "journal.jsonl"
+META = "meta.json"
+
+
+class StoreBusyError(RuntimeError):
+    """Another process is writing the same results file."""
+
+
+# ----------------------------------------------------------------------------- paths
+def parts_dir(path) -> Path:
+    path = Path(path)
+    return path.with_name(path.name + ".parts")
+
+
+def _lock_path(path: Path) -> Path:
+    return path.with_name(path.name + ".lock")
+
+
+def _tmp_path(path: Path) -> Path:
+    return path.with_name(path.name + ".tmp")
+
+
+def now_iso() -> str:
+    return datetime.now(timezone.utc).isoformat(timespec="seconds")
+
+
+def _fsync_path(p: Path, directory: bool = False) -> None:
+    try:
+        fd = os.open(p, os.O_RDONLY | (getattr(os, "O_DIRECTORY", 0) if directory else 0))
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+# ----------------------------------------------------------------------------- values
+def plain(value):
+    """A JSON/HDF5-friendly Python value (numpy scalars unwrapped, objects stringified)."""
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value)
+    return str(value)
+
+
+def plain_row(row: dict) -> dict:
+    return {str(k): plain(v) for k, v in row.items()}
+
+
+def _column_kind(values) -> str:
+    """Storage kind of a column: "str", "bool", "int" or "float" (None -> NaN)."""
+    has_none = False
+    kinds = set()
+    for v in values:
+        if v is None:
+            has_none = True
+        elif isinstance(v, str):
+            return "str"
+        elif isinstance(v, bool):
+            kinds.add("bool")
+        elif isinstance(v, int):
+            kinds.add("int")
+        else:
+            kinds.add("float")
+    if not has_none and kinds == {"bool"}:
+        return "bool"
+    if not has_none and kinds == {"int"}:
+        return "int"
+    return "float"
+
+
+def _column_array(values, kind: str) -> np.ndarray:
+    if kind == "str":
+        return np.array(["" if v is None else str(v) for v in values], dtype=object)
+    if kind == "bool":
+        return np.array([1 if v else 0 for v in values], dtype=np.uint8)
+    if kind == "int":
+        return np.array(values, dtype=np.int64)
+    return np.array([math.nan if v is None else float(v) for v in values], dtype=np.float64)
+
+
+def _frame_from_rows(rows: list[dict], columns: list[str] | None = None) -> pd.DataFrame:
+    import pandas as pd
+    if columns is None:
+        columns = _column_order(rows)
+    data = {}
+    for c in columns:
+        vals = [r.get(c) for r in rows]
+        kind = _column_kind(vals)
+        arr = _column_array(vals, kind)
+        data[c] = arr.astype(bool) if kind == "bool" else arr
+    return pd.DataFrame(data, columns=columns)
+
+
+def _column_order(rows) -> list[str]:
+    order: dict[str, None] = {"scene_id": None}
+    for r in rows:
+        for k in r:
+            order.setdefault(k, None)
+    return list(order)
+
+
+# ----------------------------------------------------------------------------- reading
+def _read_journal(path: Path) -> list[dict]:
+    """Complete rows of the journal of ``path`` (a torn or garbled line is skipped)."""
+    jp = parts_dir(path) / JOURNAL
+    try:
+        data = jp.read_bytes()
+    except (FileNotFoundError, NotADirectoryError):
+        return []
+    rows = []
+    for line in data.split(b"\n")[:-1]:  # the piece after the last newline is incomplete
+        if not line.strip():
+            continue
+        try:
+            row = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(row, dict) and isinstance(row.get("scene_id"), str):
+            rows.append(row)
+    return rows
+
+
+def _open_main(path: Path):
+    try:
+        f = h5py.File(path, "r")
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: not a readable HDF5 results file ({exc})") from None
+    if f.attrs.get("format") != FORMAT:
+        f.close()
+        raise InputError(f"{path}: not a visco-sweep results file (no format attribute "
+                         f"{FORMAT!r})")
+    return f
+
+
+def _read_runs_frame(f) -> pd.DataFrame:
+    import pandas as pd
+    if "runs" not in f:
+        return pd.DataFrame({"scene_id": pd.Series([], dtype=object)})
+    g = f["runs"]
+    columns = [str(c) for c in g.attrs.get("columns", list(g.keys()))]
+    data = {}
+    for c in columns:
+        ds = g[c]
+        kind = ds.attrs.get("kind", "")
+        if kind == "str" or h5py.check_string_dtype(ds.dtype) is not None:
+            data[c] = np.array(ds.asstr()[()], dtype=object)
+        elif kind == "bool":
+            data[c] = ds[()].astype(bool)
+        else:
+            data[c] = ds[()]
+    return pd.DataFrame(data, columns=columns)
+
+
+def _read_runs_rows(f) -> list[dict]:
+    df = _read_runs_frame(f)
+    rows = []
+    cols = list(df.columns)
+    for rec in df.itertuples(index=False, name=None):
+        rows.append({c: plain(v) for c, v in zip(cols, rec)})
+    return rows
+
+
+def read_attrs(path) -> dict:
+    """File attributes of a results file (the journal's meta if no main file exists yet)."""
+    path = Path(path)
+    if path.exists():
+        with _open_main(path) as f:
+            return {k: plain(v) if not isinstance(v, np.ndarray) else v.tolist()
+                    for k, v in f.attrs.items()}
+    meta = parts_dir(path) / META
+    if meta.exists():
+        return json.loads(meta.read_text())
+    raise FileNotFoundError(f"no results at {path}")
+
+
+def load(path) -> pd.DataFrame:
+    """The runs table of a sweep as a DataFrame: one row per finished scene.
+
+    Includes scenes that finished after the last consolidation of a running or killed sweep
+    (read from its journal). Columns: ``scene_id``, scene parameters, ``num_*`` numerics,
+    scalar results, ``status``, ``reason``, ``wall_s``, ``task_wall_s``, ``worker``,
+    ``finished_at``. Missing numbers are NaN (e.g. ``delta0`` of an ``a0`` scene).
+    """
+    import pandas as pd
+    path = Path(path)
+    # journal first, then main: a consolidation that removes the journal in between has
+    # already put its rows into the main file.
+    jrows = _read_journal(path)
+    if path.exists():
+        with _open_main(path) as f:
+            main = _read_runs_frame(f)
+    elif jrows or parts_dir(path).exists():
+        main = None
+    else:
+        raise FileNotFoundError(f"no results at {path}")
+    if main is None:
+        return _dedupe(_frame_from_rows(jrows)) if jrows else \
+            pd.DataFrame({"scene_id": pd.Series([], dtype=object)})
+    known = set(main["scene_id"])
+    extra = [r for r in jrows if r["scene_id"] not in known]
+    if not extra:
+        return main
+    cols = list(main.columns) + [c for c in _column_order(extra) if c not in main.columns]
+    jf = _frame_from_rows(extra, cols)
+    if len(main) == 0:
+        return _dedupe(jf)
+    return _dedupe(pd.concat([main, jf], ignore_index=True))
+
+
+def _dedupe(df: pd.DataFrame) -> pd.DataFrame:
+    return df.drop_duplicates("scene_id", keep="first").reset_index(drop=True)
+
+
+def load_trajectory(path, scene_id: str) -> dict:
+    """Trajectory arrays (``t``, ``delta``, ``P``, ``a``, ``a_inner``) of one scene."""
+    path = Path(path)
+    part = parts_dir(path) / "traj" / f"{scene_id}.h5"
+    if part.exists():
+        with contextlib.suppress(OSError), h5py.File(part, "r") as f:
+            return {k: f[k][()] for k in f.keys()}
+    if path.exists():
+        with _open_main(path) as f:
+            g = f.get("trajectories")
+            if g is not None and scene_id in g:
+                return {k: g[scene_id][k][()] for k in g[scene_id].keys()}
+            trajectories = bool(f.attrs.get("trajectories", 0))
+    elif parts_dir(path).exists():
+        trajectories = bool(read_attrs(path).get("trajectories", False))
+    else:
+        raise FileNotFoundError(f"no results at {path}")
+    if not trajectories:
+        raise KeyError(f"{path} holds no trajectories (set store: {{trajectories: true}} in "
+                       f"the config to keep them)")
+    raise KeyError(f"no trajectory for scene {scene_id!r} in {path}")
+
+
+# ----------------------------------------------------------------------------- provenance
+def provenance() -> dict:
+    """Versions and git commit of the code that writes a results file."""
+    import numba
+
+    from . import __version__
+
+    commit = "unknown"
+    here = Path(__file__).resolve().parent
+    try:
+        out = subprocess.run(["git", "-C", str(here), "rev-parse", "HEAD"], capture_output=True,
+                             text=True, timeout=5)
+        if out.returncode == 0:
+            commit = out.stdout.strip()
+            dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain",
+                                    "--untracked-files=no"], capture_output=True, text=True,
+                                   timeout=5)
+            if dirty.returncode == 0 and dirty.stdout.strip():
+                commit += "-dirty"
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return {
+        "package_version": __version__,
+        "git_commit": commit,
+        "numba_version": numba.__version__,
+        "numpy_version": np.__version__,
+        "h5py_version": h5py.__version__,
+        "python_version": platform.python_version(),
+    }
+
+
+# ----------------------------------------------------------------------------- writing
+def _write_traj_file(target: Path, traj: dict) -> None:
+    tmp = target.with_name(target.name + f".tmp{os.getpid()}")
+    with h5py.File(tmp, "w") as f:
+        for k, v in traj.items():
+            f.create_dataset(str(k), data=np.asarray(v, dtype=np.float64))
+    os.replace(tmp, target)
+
+
+def _backup_name(path: Path) -> Path:
+    cand = path.with_name(path.name + ".bak")
+    i = 1
+    while cand.exists() or parts_dir(cand).exists():
+        cand = path.with_name(f"{path.name}.bak{i}")
+        i += 1
+    return cand
+
+
+class ResultStore:
+    """The single writer of one results file (see the module docstring for the layout).
+
+    Use: ``prepare(resume)`` (lock + compatibility checks, no changes on disk),
+    ``begin(fresh)`` (returns the ids already finished), ``append(row, traj)`` per scene,
+    ``maybe_consolidate()`` now and then, ``finish(complete)`` at the end (also on errors).
+    """
+
+    def __init__(self, path, *, config_hash: str, config_name: str = "", config_text: str = "",
+                 config_source: str = "", n_scenes: int = 0, trajectories: bool = False,
+                 template_row: dict | None = None, interval: float = 5.0):
+        self.path = Path(path)
+        self.parts = parts_dir(self.path)
+        self.config_hash = config_hash
+        self.meta = {
+            "format": FORMAT, "format_version": FORMAT_VERSION,
+            "config_name": config_name, "config_hash": config_hash,
+            "config_text": config_text, "config_source": config_source,
+            "n_scenes": int(n_scenes), "trajectories": bool(trajectories),
+            "started_at": now_iso(),
+        }
+        self.trajectories = bool(trajectories)
+        self.template = plain_row(template_row or {"scene_id": ""})
+        self.interval = float(interval)
+        self.rows: list[dict] = []
+        self._ids: dict[str, int] = {}
+        self._in_main: set[str] = set()
+        self._lock_fd = None
+        self._jfd = None
+        self._dirty = False
+        self._main_complete = False
+        self._last = time.monotonic()
+        self._last_cost = 0.0
+        self.backup: Path | None = None
+        self._prov = None
+
+    # -- locking ----------------------------------------------------------------
+    def _acquire(self) -> None:
+        lp = _lock_path(self.path)
+        if fcntl is None:  # pragma: no cover
+            return
+        for _ in range(5):
+            fd = os.open(lp, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as exc:
+                os.close(fd)
+                if exc.errno in (errno.EAGAIN, errno.EACCES):
+                    raise StoreBusyError(f"another sweep is writing {self.path} (lock "
+                                         f"{lp} is held); wait for it or use --out") from None
+                raise
+            try:
+                same = os.fstat(fd).st_ino == os.stat(lp).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                self._lock_fd = fd
+                return
+            os.close(fd)  # the lock file was replaced under us; retry
+        raise StoreBusyError(f"cannot lock {lp}")
+
+    def _release(self) -> None:
+        if self._lock_fd is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(_lock_path(self.path))
+            os.close(self._lock_fd)
+            self._lock_fd = None
+
+    # -- checks -----------------------------------------------------------------
+    def _existing_hashes(self) -> list[tuple[str, str]]:
+        found = []
+        if self.path.exists():
+            if self.path.is_dir():
+                raise InputError(f"output {self.path} is a directory; give a file path "
+                                 f"such as {self.path}/results.h5")
+            try:
+                with _open_main(self.path) as f:
+                    found.append((str(self.path), str(f.attrs.get("config_hash", ""))))
+            except InputError as exc:
+                raise InputError(f"{exc}; refusing to overwrite it: use --out to write "
+                                 f"elsewhere, or --fresh to move it aside to a .bak file") \
+                    from None
+        meta = self.parts / META
+        if meta.exists():
+            try:
+                found.append((str(self.parts), json.loads(meta.read_text())["config_hash"]))
+            except (ValueError, KeyError, OSError):
+                found.append((str(self.parts), "?"))
+        return found
+
+    def prepare(self, resume: bool = True) -> None:
+        """Take the lock and check that the existing results (if any) are compatible.
+
+        With ``resume`` an existing file written by a different config is an
+        :class:`InputError`; nothing on disk is changed here either way.
+        """
+        self._acquire()
+        try:
+            hashes = self._existing_hashes() if resume else []
+            if not resume and self.path.is_dir():
+                raise InputError(f"output {self.path} is a directory; give a file path")
+            for where, h in hashes:
+                if h != self.config_hash:
+                    raise InputError(
+                        f"{where} holds results of a different config (config hash {h}, this "
+                        f"config {self.config_hash}); use --fresh to start over (the old file "
+                        f"is kept as a .bak) or --out to write elsewhere")
+        except BaseException:
+            self._release()
+            raise
+
+    # -- opening ----------------------------------------------------------------
+    def begin(self, fresh: bool = False) -> set[str]:
+        """Move old results aside (``fresh``) or load them (resume); return finished ids."""
+        with contextlib.suppress(FileNotFoundError):
+            _tmp_path(self.path).unlink()
+        if fresh and (self.path.exists() or self.parts.exists()):
+            self.backup = _backup_name(self.path)
+            if self.path.exists():
+                os.replace(self.path, self.backup)
+            if self.parts.exists():
+                os.replace(self.parts, parts_dir(self.backup))
+        started = None
+        if self.path.exists():
+            with _open_main(self.path) as f:
+                started = f.attrs.get("started_at")
+                self._main_complete = bool(f.attrs.get("complete", 0))
+                for row in _read_runs_rows(f):
+                    self._add(row)
+                self._in_main = set(self._ids)
+        meta = self.parts / META
+        if meta.exists() and started is None:
+            with contextlib.suppress(ValueError, OSError, KeyError):
+                started = json.loads(meta.read_text())["started_at"]
+        if started:
+            self.meta["started_at"] = str(started)
+        for row in _read_journal(self.path):
+            if row["scene_id"] not in self._ids:
+                self._add(row)
+                self._dirty = True
+        # the main file exists before the journal does, so a reader always finds a schema
+        if not self.path.exists() or self._dirty:
+            self.consolidate()
+        # journal: create or repair (truncate a torn last line), then open for appending
+        (self.parts / "traj").mkdir(parents=True, exist_ok=True)
+        if not meta.exists():
+            tmp = meta.with_name(META + ".tmp")
+            tmp.write_text(json.dumps(self.meta))
+            os.replace(tmp, meta)
+        jp = self.parts / JOURNAL
+        if jp.exists():
+            data = jp.read_bytes()
+            if data and not data.endswith(b"\n"):
+                with open(jp, "r+b") as fh:
+                    fh.truncate(data.rfind(b"\n") + 1)
+        self._jfd = os.open(jp, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        return set(self._ids)
+
+    def _add(self, row: dict) -> None:
+        self._ids[row["scene_id"]] = len(self.rows)
+        self.rows.append(row)
+
+    @property
+    def finished(self) -> set[str]:
+        return set(self._ids)
+
+    # -- appending --------------------------------------------------------------
+    def append(self, row: dict, trajectory: dict | None = None) -> None:
+        """Record one finished scene (trajectory file first, then its journal line)."""
+        row = plain_row(row)
+        sid = row["scene_id"]
+        if self.trajectories and trajectory:
+            _write_traj_file(self.parts / "traj" / f"{sid}.h5", trajectory)
+        line = (json.dumps(row, separators=(",", ":"), allow_nan=True) + "\n").encode()
+        view = memoryview(line)
+        while view:
+            n = os.write(self._jfd, view)
+            view = view[n:]
+        if sid in self._ids:
+            self.rows[self._ids[sid]] = row
+        else:
+            self._add(row)
+        self._dirty = True
+
+    def maybe_consolidate(self) -> bool:
+        """Consolidate if ``interval`` seconds have passed since the last consolidation.
+
+        The wait is also at least 20x the cost of the last consolidation (at most ~5% of the
+        time goes to consolidating a large file), except with ``interval == 0``, which
+        consolidates after every scene (for tests).
+        """
+        wait = self.interval if self.interval == 0 else max(self.interval, 20 * self._last_cost)
+        if self._dirty and time.monotonic() - self._last >= wait:
+            self.consolidate()
+            return True
+        return False
+
+    # -- consolidation ----------------------------------------------------------
+    def _write_runs(self, f) -> None:
+        g = f.create_group("runs")
+        rows = self.rows
+        columns = _column_order([self.template] + rows)
+        for c in columns:
+            vals = [r.get(c) for r in rows] if rows else [self.template.get(c)]
+            kind = _column_kind(vals)
+            arr = _column_array(vals, kind)[: len(rows)]
+            if kind == "str":
+                ds = g.create_dataset(c, data=arr, dtype=h5py.string_dtype("utf-8"))
+            else:
+                ds = g.create_dataset(c, data=arr)
+            ds.attrs["kind"] = kind
+        g.attrs["columns"] = np.array(columns, dtype=h5py.string_dtype("utf-8"))
+
+    def consolidate(self, complete: bool | None = None) -> None:
+        """Write main file + journal to ``<output>.tmp``, fsync, and os.replace it in place."""
+        t0 = time.monotonic()
+        if self._jfd is not None:
+            with contextlib.suppress(OSError):
+                os.fsync(self._jfd)
+        if self._prov is None:
+            self._prov = provenance()
+        n_done = len(self.rows)
+        if complete is None:
+            complete = self.meta["n_scenes"] > 0 and n_done >= self.meta["n_scenes"]
+        tmp = _tmp_path(self.path)
+        old = None
+        try:
+            if self.trajectories and self.path.exists():
+                old = h5py.File(self.path, "r")
+            with h5py.File(tmp, "w") as f:
+                for k, v in {**self.meta, **self._prov}.items():
+                    f.attrs[k] = v
+                f.attrs["updated_at"] = now_iso()
+                f.attrs["finished_at"] = now_iso() if complete else ""
+                f.attrs["n_finished"] = n_done
+                f.attrs["complete"] = bool(complete)
+                self._write_runs(f)
+                if self.trajectories:
+                    tg = f.create_group("trajectories")
+                    old_tg = old.get("trajectories") if old is not None else None
+                    for row in self.rows:
+                        sid = row["scene_id"]
+                        part = self.parts / "traj" / f"{sid}.h5"
+                        if part.exists():
+                            sub = tg.create_group(sid)
+                            with h5py.File(part, "r") as p:
+                                for k in p.keys():
+                                    sub.create_dataset(k, data=p[k][()])
+                        elif old_tg is not None and sid in old_tg:
+                            old.copy(old_tg[sid], tg, name=sid)
+        finally:
+            if old is not None:
+                old.close()
+        _fsync_path(tmp)
+        os.replace(tmp, self.path)
+        _fsync_path(self.path.parent, directory=True)
+        self._in_main = set(self._ids)
+        self._dirty = False
+        self._main_complete = bool(complete)
+        self._last = time.monotonic()
+        self._last_cost = self._last - t0
+
+    def finish(self, complete: bool | None = None) -> None:
+        """Final consolidation, then remove the journal (only if that succeeded) and unlock."""
+        try:
+            if self._jfd is not None:
+                if complete is None:
+                    n = self.meta["n_scenes"]
+                    complete = n > 0 and len(self.rows) >= n
+                if self._dirty or complete != self._main_complete or not self.path.exists():
+                    self.consolidate(complete=complete)
+                os.close(self._jfd)
+                self._jfd = None
+                shutil.rmtree(self.parts, ignore_errors=True)
+        finally:
+            self._release()
+
+    def abort(self) -> None:
+        """Release without consolidating (the journal keeps everything for a resume)."""
+        if self._jfd is not None:
+            with contextlib.suppress(OSError):
+                os.close(self._jfd)
+            self._jfd = None
+        self._release()
+
+
+# ----------------------------------------------------------------------------- summary
+SCENE_PARAMS = ("n", "k", "mu", "rate", "a0", "delta0", "material", "stop")
+
+
+def _g(x) -> str:
+    return f"{x:.4g}" if isinstance(x, (float, np.floating)) else str(x)
+
+
+def summary(path, slowest: int = 5) -> str:
+    """A human-readable summary of a results file (what ``sweep info`` prints)."""
+    path = Path(path)
+    df = load(path)
+    attrs = read_attrs(path)
+    lines = [f"{path}"]
+    name = attrs.get("config_name", "?")
+    total = int(attrs.get("n_scenes", 0) or 0)
+    lines.append(f"  sweep {name!r}  config hash {attrs.get('config_hash', '?')}  "
+                 f"package {attrs.get('package_version', '?')}  commit "
+                 f"{str(attrs.get('git_commit', '?'))[:12]}")
+    lines.append(f"  started {attrs.get('started_at', '?')}  updated "
+                 f"{attrs.get('updated_at', '?')}  finished "
+                 f"{attrs.get('finished_at') or '(not finished)'}")
+    pending = parts_dir(path).exists()
+    lines.append(f"  scenes: {len(df)} finished of {total}"
+                 + ("  (journal present: running, or killed; rerun to resume)" if pending
+                    else ""))
+    if len(df) and "status" in df:
+        counts = df["status"].value_counts()
+        lines.append("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    varying, fixed = [], []
+    for c in list(SCENE_PARAMS) + [c for c in df.columns if c.startswith("num_")]:
+        if c not in df or not len(df):
+            continue
+        col = df[c]
+        if col.dtype.kind in "fiu":
+            col = col.dropna()
+            if not len(col):
+                continue
+            uniq = np.unique(col)
+            if len(uniq) > 1:
+                varying.append(f"{c}: {len(uniq)} values in [{_g(uniq.min())}, "
+                               f"{_g(uniq.max())}]")
+            else:
+                fixed.append(f"{c}={_g(uniq[0])}")
+        else:
+            uniq = sorted(set(map(str, col)))
+            if len(uniq) > 1:
+                varying.append(f"{c}: {', '.join(uniq)}")
+            else:
+                fixed.append(f"{c}={uniq[0]}")
+    if varying:
+        lines.append("  varying:")
+        lines.extend(f"    {v}" for v in varying)
+    if fixed:
+        lines.append("  fixed: " + ", ".join(fixed))
+    if len(df) and "wall_s" in df:
+        wall = df["wall_s"].astype(float)
+        lines.append(f"  wall time per scene: median {np.nanmedian(wall):.3g} s, "
+                     f"total {np.nansum(wall):.4g} s")
+        params = [c for c in SCENE_PARAMS if c in df and len(set(map(str, df[c]))) > 1]
+        top = df.assign(_w=wall).sort_values("_w", ascending=False).head(slowest)
+        lines.append(f"  slowest {len(top)}:")
+        for _, r in top.iterrows():
+            desc = " ".join(f"{c}={_g(r[c])}" for c in params)
+            lines.append(f"    {r['scene_id']}  {r['_w']:.3g} s  {r.get('status', '')}  {desc}")
+    if len(df) and "status" in df:
+        failed = df[df["status"] != "ok"]
+        if len(failed):
+            lines.append(f"  failures ({len(failed)}):")
+            params = [c for c in SCENE_PARAMS if c in df and len(set(map(str, df[c]))) > 1]
+            for _, r in failed.head(20).iterrows():
+                desc = " ".join(f"{c}={_g(r[c])}" for c in params)
+                lines.append(f"    {r['scene_id']}  {desc}  reason: {r.get('reason', '')}")
+            if len(failed) > 20:
+                lines.append(f"    ... and {len(failed) - 20} more")
+    return "\n".join(lines)

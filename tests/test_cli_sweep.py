@@ -1,0 +1,306 @@
+"""`sweep run` / `sweep info` end to end, bad input, and SIGKILL at several moments + resume."""
+from __future__ import annotations
+
+import os
+import queue
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections import Counter
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from sweep.cli import main
+from sweep.config import load_config
+from sweep.scheduler import run_sweep
+from sweep.store import load, parts_dir, read_attrs
+
+ROOT = Path(__file__).resolve().parents[1]
+SWEEP = [sys.executable, "-m", "sweep.cli"]
+LOG_RE = re.compile(r"^\[\s*\d+/\d+\] ([0-9a-f]{16}) (ok|failed) ")
+
+TINY = """\
+name: tiny
+grid:
+  n: [0.4, 1.6]
+  rate: [1, 100]
+  a0: 2.0
+numerics: {preset: fast, nodes: 60}
+output: out/tiny.h5
+"""
+
+
+def write(path: Path, text: str) -> Path:
+    path.write_text(text)
+    return path
+
+
+def fake_simulate(scene, numerics):
+    from sweep.scene import Result
+    return Result(scene=scene, numerics=numerics, status="ok", pull_off=scene.n)
+
+
+def run_cli(args, cwd, timeout=240):
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    return subprocess.run(SWEEP + list(args), cwd=cwd, capture_output=True, text=True,
+                          timeout=timeout, env=env)
+
+
+def one_error_line(err: str) -> str:
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1, err
+    assert lines[0].startswith("error: "), err
+    return lines[0]
+
+
+# ----------------------------------------------------------------------------- happy path
+def test_run_then_info_real_solver(tmp_path):
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    res = run_cli(["run", str(cfg), "-j", "2"], cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    out = tmp_path / "out" / "tiny.h5"                 # relative to the working directory
+    assert "tiny: 4 scenes (4 ran, 0 already done" in res.stdout
+    assert str(out) in res.stdout
+    logged = [LOG_RE.match(ln).group(1) for ln in res.stderr.splitlines() if LOG_RE.match(ln)]
+    assert len(logged) == 4                             # not a TTY: one line per scene
+    df = load(out)
+    assert sorted(df.scene_id) == sorted(logged)
+    assert set(df.status) <= {"ok", "failed"}
+    attrs = read_attrs(out)
+    assert attrs["config_text"] == TINY and attrs["complete"]
+    assert attrs["numba_version"] and attrs["git_commit"]
+    info = run_cli(["info", str(out)], cwd=tmp_path)
+    assert info.returncode == 0, info.stderr
+    assert "scenes: 4 finished of 4" in info.stdout and "status:" in info.stdout
+    assert "n: 2 values in [0.4, 1.6]" in info.stdout and "slowest 4:" in info.stdout
+    again = run_cli(["run", str(cfg)], cwd=tmp_path)   # resume: nothing left to do
+    assert again.returncode == 0 and "(0 ran, 4 already done" in again.stdout
+
+
+def test_fresh_keeps_old_file_as_backup(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    run_sweep(cfg, jobs=1, simulate=fake_simulate, progress="none")
+    other = write(tmp_path / "other.yaml", TINY.replace("rate: [1, 100]", "rate: [1, 10]"))
+    before = (tmp_path / "out/tiny.h5").read_bytes()
+    # a different config into the same output: refused, file untouched, exit 2
+    assert main(["run", str(other), "--progress", "none"]) == 2
+    assert (tmp_path / "out/tiny.h5").read_bytes() == before
+    # --fresh moves the old file aside before writing the new one
+    run_sweep(other, jobs=1, simulate=fake_simulate, progress="none", resume=False)
+    assert (tmp_path / "out/tiny.h5.bak").read_bytes() == before
+    assert sorted(load("out/tiny.h5").rate.unique()) == [1.0, 10.0]
+
+
+# ----------------------------------------------------------------------------- bad input
+BAD_CONFIGS = {
+    "malformed": ("name: x\ngrid: {n: [0.4, 1.6\n", "not valid YAML at line"),
+    "types": ("name: x\ngrid: {n: abc, rate: [1], a0: 2}\nstore: {trajectories: 3}\n",
+              "2 problems: grid.n must be a number (got 'abc'); store.trajectories"),
+    "range": ("name: x\ngrid: {n: 0.8, rate: 1, a0: 2, mu: 50}\n",
+              "grid.mu must be in [0.5, 20] (got 50)"),
+    "unknown": ("name: x\ngrid: {n: 0.8, rate: 1, a0: 2, speed: 3}\n",
+                "grid.speed: unknown axis (allowed:"),
+    "code": ("name: !!python/object/apply:os.getcwd []\ngrid: {n: 0.8, rate: 1, a0: 2}\n",
+             "not valid YAML"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_CONFIGS))
+def test_bad_config_exit_2_one_line(tmp_path, capsys, case):
+    text, needle = BAD_CONFIGS[case]
+    cfg = write(tmp_path / "bad.yaml", text)
+    assert main(["run", str(cfg), "--out", str(tmp_path / "r.h5")]) == 2
+    line = one_error_line(capsys.readouterr().err)
+    assert needle in line
+    assert not (tmp_path / "r.h5").exists()
+
+
+@pytest.mark.parametrize("args, needle, code", [
+    (["--out", "{tmp}/afile/r.h5"], "cannot create directory", 2),
+    (["--out", "{tmp}"], "is a directory", 2),
+    (["--scheduler", "tcp://127.0.0.1:1"], "only used with backend dask", 2),
+    (["--backend", "spark"], "'spark' is not one of 'loky', 'dask'", 2),
+    (["-j", "0"], "jobs must be an integer in [1, 4096] (got 0)", 2),
+    (["-j", "two"], "'two' is not a valid integer", 2),
+    (["--backend", "dask", "--scheduler", "tcp://127.0.0.1:1", "--connect-timeout", "1"],
+     "cannot connect to the dask scheduler at tcp://127.0.0.1:1", 1),
+])
+def test_bad_options_exit_code_one_line(tmp_path, capsys, args, needle, code):
+    (tmp_path / "afile").write_text("x")
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    args = [a.replace("{tmp}", str(tmp_path)) for a in args]
+    if "--out" not in args:
+        args += ["--out", str(tmp_path / "r.h5")]
+    t0 = time.monotonic()
+    assert main(["run", str(cfg), *args]) == code
+    assert time.monotonic() - t0 < 15
+    assert needle in one_error_line(capsys.readouterr().err)
+    assert not (tmp_path / "r.h5").exists()
+
+
+def test_missing_config_and_bad_results_file(tmp_path, capsys):
+    assert main(["run", str(tmp_path / "nope.yaml")]) == 2
+    assert "no such file" in one_error_line(capsys.readouterr().err)
+    assert main(["info", str(tmp_path / "nope.h5")]) == 2
+    assert "no results at" in one_error_line(capsys.readouterr().err)
+    junk = tmp_path / "junk.h5"
+    junk.write_bytes(b"not hdf5")
+    assert main(["info", str(junk)]) == 2
+    assert "not a readable HDF5 results file" in one_error_line(capsys.readouterr().err)
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    assert main(["run", str(cfg), "--out", str(junk)]) == 2     # never overwritten
+    assert "refusing to overwrite" in one_error_line(capsys.readouterr().err)
+    assert junk.read_bytes() == b"not hdf5"
+
+
+def test_dask_backend_cli_matches_loky(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    res = run_cli(["run", str(cfg), "-j", "2", "--out", "loky.h5"], cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        res = run_cli(["run", str(cfg), "--backend", "dask", "--scheduler",
+                       cluster.scheduler_address, "--out", "dask.h5"], cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    a = load(tmp_path / "loky.h5").set_index("scene_id").sort_index()
+    b = load(tmp_path / "dask.h5").set_index("scene_id").sort_index()
+    assert list(a.index) == list(b.index) and len(a) == 4
+    assert list(a.status) == list(b.status)
+    np.testing.assert_array_equal(a.pull_off.values, b.pull_off.values)
+
+
+# ----------------------------------------------------------------------------- SIGKILL
+KILL_CFG = """\
+name: killme
+grid:
+  n: [0.4, 0.8, 1.6]
+  rate: [1, 10, 100, 1000]
+  a0: [2.0, 2.5]
+numerics: {preset: fast, nodes: 60}
+output: kill.h5
+"""
+
+
+class Sweep:
+    """A `sweep run` subprocess whose stderr lines are collected by a thread."""
+
+    def __init__(self, cwd, args):
+        self.p = subprocess.Popen(SWEEP + args, cwd=cwd, stderr=subprocess.PIPE,
+                                  stdout=subprocess.PIPE, text=True, start_new_session=True,
+                                  env={**os.environ, "PYTHONUNBUFFERED": "1"})
+        self.lines: queue.Queue = queue.Queue()
+        self.ids: list[str] = []
+        self.times: list[float] = []
+        threading.Thread(target=self._pump, daemon=True).start()
+
+    def _pump(self):
+        for line in self.p.stderr:
+            self.lines.put((time.monotonic(), line))
+
+    def _take(self, item):
+        t, line = item
+        m = LOG_RE.match(line)
+        if m:
+            self.ids.append(m.group(1))
+            self.times.append(t)
+
+    def scene_interval(self, default=0.05):
+        """Mean time between two logged scenes in this run (to scale the kill delays)."""
+        if len(self.times) < 2:
+            return default
+        return (self.times[-1] - self.times[0]) / (len(self.times) - 1)
+
+    def wait_lines(self, n, timeout=120):
+        """Block until ``n`` scene lines were logged in this run (or the process ended)."""
+        deadline = time.monotonic() + timeout
+        while len(self.ids) < n and time.monotonic() < deadline:
+            try:
+                item = self.lines.get(timeout=0.005)
+            except queue.Empty:
+                if self.p.poll() is not None and self.lines.empty():
+                    return
+                continue
+            self._take(item)
+
+    def drain(self):
+        while True:
+            try:
+                item = self.lines.get_nowait()
+            except queue.Empty:
+                return
+            self._take(item)
+
+    def kill(self):
+        self.p.send_signal(signal.SIGKILL)           # the parent, mid-whatever-it-does
+        self.p.wait(timeout=30)
+        time.sleep(0.05)
+        self.drain()
+        try:
+            os.killpg(self.p.pid, signal.SIGKILL)    # then its orphaned loky workers
+        except ProcessLookupError:
+            pass
+        return self.p.returncode
+
+
+def test_sigkill_at_several_moments_then_resume(tmp_path):
+    cfg = write(tmp_path / "kill.yaml", KILL_CFG)
+    tasks = [sid for sid, _ in load_config(cfg).tasks()]
+    assert len(tasks) == 24
+    out = tmp_path / "kill.h5"
+    args = ["run", str(cfg), "-j", "2", "--progress", "log", "--consolidate-every", "0"]
+    logged: Counter = Counter()
+    snapshot: dict[str, float] = {}                  # scene id -> finished_at at kill time
+    # moments: during start-up, right after the 1st scene of a run, and after a few scenes
+    # plus a fraction of the time per scene (so that kills land between and during scene
+    # writes and consolidations, which happen after every scene here), whatever the speed
+    plan = [("time", 0.4), ("lines", 1, 0.0), ("lines", 2, 0.15), ("lines", 3, 0.5),
+            ("lines", 2, 0.8)]
+    kills = 0
+    for step in plan:
+        run = Sweep(tmp_path, args)
+        if step[0] == "time":
+            time.sleep(step[1])
+        else:
+            run.wait_lines(step[1])
+            time.sleep(step[2] * run.scene_interval())
+        if run.p.poll() is not None:                 # finished before the kill: too fast
+            run.drain()
+            logged.update(run.ids)
+            break
+        rc = run.kill()
+        assert rc == -signal.SIGKILL
+        kills += 1
+        logged.update(run.ids)
+        if not run.ids and not out.exists() and not parts_dir(out).exists():
+            continue                                 # killed before the store existed
+        df = load(out)                               # readable right after the kill
+        assert df.scene_id.is_unique
+        assert set(run.ids) <= set(df.scene_id)      # every logged scene is on disk
+        for sid, fin in zip(df.scene_id, df.finished_at):
+            assert snapshot.setdefault(sid, fin) == fin   # earlier rows never recomputed
+        if out.exists():                             # the main file itself is never torn
+            with h5py.File(out, "r") as f:
+                assert len(f["runs/scene_id"]) <= len(df)
+    assert kills >= 4, "sweep finished too quickly to be killed several times"
+    final = run_cli(args, cwd=tmp_path)
+    assert final.returncode == 0, final.stderr
+    final_ids = [LOG_RE.match(ln).group(1) for ln in final.stderr.splitlines()
+                 if LOG_RE.match(ln)]
+    logged.update(final_ids)
+    df = load(out)
+    assert sorted(df.scene_id) == sorted(tasks)      # complete
+    assert max(logged.values()) == 1, logged.most_common(3)   # no scene ran twice
+    assert not set(final_ids) & set(snapshot)        # the rerun skipped finished scenes
+    for sid, fin in zip(df.scene_id, df.finished_at):
+        if sid in snapshot:
+            assert snapshot[sid] == fin
+    assert not parts_dir(out).exists() and read_attrs(out)["complete"]
+    assert f"{len(tasks) - len(final_ids)} already done" in final.stdout

@@ -1,0 +1,263 @@
+"""Sweep configs: format, ranges, defaults, validation (every problem at once), shipped files."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from sweep.config import AXIS_DEFAULTS, config_from_dict, load_config, parse_config
+from sweep.errors import InputError
+from sweep.scene import Numerics, Scene, scene_id
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIGS = ROOT / "configs"
+PAPER = Path("/work/shared/reference/paper_values.yaml")
+
+
+def base(**over):
+    d = {"name": "t", "grid": {"n": [0.4, 1.6], "rate": [1, 100], "a0": 2.0},
+         "numerics": {"preset": "fast"}}
+    d.update(over)
+    return d
+
+
+def values(cfg, axis):
+    return sorted({getattr(s, axis) for s in cfg.scenes()}, key=lambda v: (v is None, v))
+
+
+# ----------------------------------------------------------------------------- format
+def test_cartesian_product_and_scene_ids():
+    cfg = config_from_dict(base())
+    tasks = cfg.tasks()
+    assert len(tasks) == 4
+    assert {(s.n, s.rate) for _, s in tasks} == {(0.4, 1.0), (0.4, 100.0), (1.6, 1.0),
+                                                 (1.6, 100.0)}
+    for sid, s in tasks:
+        assert sid == scene_id(s, Numerics.preset("fast"))
+        assert s.a0 == 2.0 and s.delta0 is None
+
+
+def test_defaults_documented_values():
+    cfg = config_from_dict({"name": "d", "grid": {"n": 0.8, "rate": 10, "a0": 3}})
+    (s,) = cfg.scenes()
+    assert s.k == 0.1 and s.mu == 3.24 and s.material == "mpl" and s.stop == "pulloff"
+    assert AXIS_DEFAULTS["k"] == 0.1 and AXIS_DEFAULTS["mu"] == 3.24
+    assert cfg.numerics == Numerics.preset("balanced")
+    assert cfg.trajectories is False
+    assert cfg.output == "results/d.h5"
+
+
+def test_ranges_log10_and_linspace():
+    cfg = config_from_dict(base(grid={"n": 0.8, "rate": {"log10": [0, 6, 13]},
+                                      "a0": {"linspace": [1, 8, 15]}}))
+    rates = values(cfg, "rate")
+    assert len(rates) == 13
+    np.testing.assert_allclose(rates, np.logspace(0, 6, 13))
+    assert any(math.isclose(r, 10 ** 0.5) for r in rates)
+    np.testing.assert_allclose(values(cfg, "a0"), np.arange(1.0, 8.01, 0.5))
+
+
+def test_numeric_strings_and_scalars_accepted():
+    # YAML 1.1 reads 1e6 as a string; it must still be a number here
+    cfg = parse_config("name: s\ngrid: {n: 0.8, rate: [1e6, 1.0e2], a0: 2}\n")
+    assert values(cfg, "rate") == [100.0, 1e6]
+
+
+def test_delta0_axis_and_material_stop_axes():
+    cfg = config_from_dict(base(grid={"n": 0.8, "rate": 1, "delta0": [0.5, 1.0],
+                                      "material": ["mpl", "sls"], "stop": "separation"}))
+    assert len(cfg.tasks()) == 4
+    assert {s.material for s in cfg.scenes()} == {"mpl", "sls"}
+    assert all(s.a0 is None and s.stop == "separation" for s in cfg.scenes())
+
+
+def test_grid_list_is_union_deduplicated():
+    g1 = {"n": [0.6, 0.8], "rate": 316.227766, "a0": 3.61}
+    g2 = {"n": 0.8, "rate": [100, 316.227766], "a0": 3.61}
+    cfg = config_from_dict(base(grid=[g1, g2]))
+    ids = [sid for sid, _ in cfg.tasks()]
+    assert len(ids) == len(set(ids)) == 3
+
+
+def test_numerics_preset_with_overrides():
+    cfg = config_from_dict(base(numerics={"preset": "fast", "nodes": 120}))
+    assert cfg.numerics == Numerics.preset("fast", nodes=120)
+    cfg = config_from_dict(base(numerics={"nodes": 80, "step": 0.2}))
+    assert cfg.numerics.nodes == 80 and cfg.numerics.step == 0.2
+
+
+def test_config_hash_tracks_results_not_formatting():
+    a = parse_config("name: a\ngrid: {n: [0.4, 1.6], rate: 1, a0: 2}\n")
+    b = parse_config("# a comment\nname: other_name\ngrid:\n  n: [0.4, 1.6]\n  rate: 1.0\n"
+                     "  a0: 2\n  k: 0.1\n")
+    assert a.config_hash == b.config_hash
+    c = parse_config("name: a\ngrid: {n: [0.4, 1.6], rate: 2, a0: 2}\n")
+    d = parse_config("name: a\ngrid: {n: [0.4, 1.6], rate: 1, a0: 2}\nnumerics: {preset: fast}\n")
+    e = parse_config("name: a\ngrid: {n: [0.4, 1.6], rate: 1, a0: 2}\n"
+                     "store: {trajectories: true}\n")
+    assert len({a.config_hash, c.config_hash, d.config_hash, e.config_hash}) == 4
+
+
+def test_output_relative_to_cwd(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    cfg = config_from_dict(base(output="sub/x.h5"))
+    assert cfg.output_path() == tmp_path / "sub" / "x.h5"
+    assert cfg.output_path("/abs/y.h5") == Path("/abs/y.h5")
+
+
+# ----------------------------------------------------------------------------- validation
+def msg(**over) -> str:
+    with pytest.raises(InputError) as info:
+        config_from_dict(base(**over))
+    text = str(info.value)
+    assert "\n" not in text
+    return text
+
+
+def test_every_problem_reported_at_once():
+    text = msg(grid={"n": [-1, "abc"], "rate": {"log10": [0, 2]}, "foo": 1, "a0": 0.01},
+               numerics={"preset": "quick", "nodes": 3, "bar": 1},
+               store={"trajectories": "yes", "x": 1}, zz=1, name="bad name")
+    for needle in ["zz: unknown key", "name:", "grid.foo: unknown axis", "grid.n[0]",
+                   "grid.n[1] must be a number", "grid.rate.log10", "grid.a0 must be in",
+                   "numerics.preset", "numerics.nodes", "numerics: unknown key(s) bar",
+                   "store.trajectories", "store.x: unknown key"]:
+        assert needle in text, (needle, text)
+    assert text.startswith("<dict>: 12 problems: ")
+
+
+@pytest.mark.parametrize("over, needle", [
+    ({"grid": {"n": 6, "rate": 1, "a0": 2}}, "grid.n must be in (0, 5] (got 6)"),
+    ({"grid": {"n": 0.8, "rate": 0, "a0": 2}}, "grid.rate must be in (0, 1e+12]"),
+    ({"grid": {"n": 0.8, "rate": 1, "a0": 2, "mu": 0.1}}, "grid.mu must be in [0.5, 20]"),
+    ({"grid": {"n": 0.8, "rate": 1, "a0": 2, "delta0": 1}}, "exactly one of the axes a0"),
+    ({"grid": {"n": 0.8, "rate": 1}}, "exactly one of the axes a0"),
+    ({"grid": {"rate": 1, "a0": 2}}, "grid.n: required axis is missing"),
+    ({"grid": {"n": 0.8, "rate": [], "a0": 2}}, "grid.rate: must not be an empty list"),
+    ({"grid": {"n": 0.8, "rate": [True], "a0": 2}}, "grid.rate[0] must be a number"),
+    ({"grid": {"n": 0.8, "rate": {"log10": [0, 2, 2.5]}, "a0": 2}}, "(num) must be an integer"),
+    ({"grid": {"n": 0.8, "rate": {"geomspace": [1, 2, 3]}, "a0": 2}}, "a range must be"),
+    ({"grid": {"n": 0.8, "rate": 1, "a0": 2, "material": "elastic"}},
+     "grid.material must be one of mpl, sls"),
+    ({"grid": [{"n": 0.8, "rate": 1, "a0": 2}, {"n": 9, "rate": 1, "a0": 2}]}, "grid[1].n"),
+    ({"grid": "n=1"}, "grid: must be a mapping of axes"),
+    ({"grid": []}, "grid: must not be an empty list"),
+    ({"numerics": "fast"}, "numerics: must be a mapping"),
+    ({"numerics": {"nodes": 10}}, "numerics.nodes must be an integer in [20, 5000]"),
+    ({"store": {"trajectories": 1}}, "store.trajectories: must be true or false"),
+    ({"output": 3}, "output: must be a file path string"),
+    ({"output": "results/"}, "output: must name a file"),
+    ({"name": None}, "name: required key is missing"),
+    ({"grid": {"n": 0.8, "rate": {"linspace": [1, 2, 10000]}, "a0": {"linspace": [1, 2, 100]},
+               "k": {"linspace": [0.1, 0.2, 300]}}}, "more than the maximum"),
+])
+def test_bad_values_name_key_and_allowed(over, needle):
+    text = msg(**over)
+    assert needle in text, text
+
+
+def test_missing_grid_and_non_mapping():
+    with pytest.raises(InputError, match="grid: required key is missing"):
+        config_from_dict({"name": "x"})
+    with pytest.raises(InputError, match="config must be a mapping"):
+        parse_config("- a\n- b\n")
+    with pytest.raises(InputError, match="config is empty"):
+        parse_config("")
+
+
+def test_malformed_yaml_one_line_with_position():
+    with pytest.raises(InputError) as info:
+        parse_config("name: x\ngrid: {n: [0.4, 1.6\n", source="bad.yaml")
+    text = str(info.value)
+    assert text.startswith("bad.yaml: not valid YAML at line") and "\n" not in text
+
+
+def test_duplicate_keys_rejected():
+    with pytest.raises(InputError, match="duplicate key 'n'"):
+        parse_config("name: x\ngrid:\n  n: 0.4\n  n: 0.8\n  rate: 1\n  a0: 2\n")
+
+
+def test_safe_loader_never_builds_objects_or_runs_code(tmp_path):
+    marker = tmp_path / "pwned"
+    evil = (f"name: !!python/object/apply:os.system ['touch {marker}']\n"
+            "grid: {n: 0.8, rate: 1, a0: 2}\n")
+    with pytest.raises(InputError, match="not valid YAML"):
+        parse_config(evil)
+    assert not marker.exists()
+    with pytest.raises(InputError, match="not valid YAML"):
+        parse_config("name: !!python/name:os.system\ngrid: {n: 0.8, rate: 1, a0: 2}\n")
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(InputError, match="no such file"):
+        load_config(tmp_path / "nope.yaml")
+    with pytest.raises(InputError, match="is a directory"):
+        load_config(tmp_path)
+
+
+# ----------------------------------------------------------------------------- shipped
+def test_shipped_configs_are_valid():
+    names = {p.stem for p in CONFIGS.glob("*.yaml")}
+    assert {"smoke", "threshold", "v_vs_r", "fig3"} <= names
+    for p in CONFIGS.glob("*.yaml"):
+        cfg = load_config(p)
+        assert cfg.name == p.stem
+        assert cfg.output == f"results/{p.stem}.h5"
+        assert len(cfg.tasks()) >= 1
+
+
+def test_smoke_config_is_small_and_fast():
+    cfg = load_config(CONFIGS / "smoke.yaml")
+    assert 2 <= len(cfg.tasks()) <= 8
+    assert cfg.numerics == Numerics.preset("fast")
+
+
+def test_threshold_campaign():
+    cfg = load_config(CONFIGS / "threshold.yaml")
+    assert values(cfg, "n") == [0.4, 0.6, 0.8, 1.6]
+    assert values(cfg, "k") == [0.1]
+    a0 = values(cfg, "a0")
+    assert a0[0] <= 1.5 and a0[-1] >= 7.0 and len(a0) >= 10
+    rates = values(cfg, "rate")
+    assert math.isclose(rates[0], 1.0) and math.isclose(rates[-1], 1e6)
+    assert any(math.isclose(r, 10 ** 0.5) for r in rates)  # the paper's reference rate
+    assert cfg.numerics == Numerics.preset("balanced")
+    # a0 covers the collapse P_po = 0.3 a0t^2.7 up to the saturation 1.5/k
+    assert a0[-1] > (1.5 / 0.1 / 0.3) ** (1 / 2.7)
+
+
+def test_v_vs_r_campaign():
+    cfg = load_config(CONFIGS / "v_vs_r.yaml")
+    assert values(cfg, "n") == [0.4, 0.6, 0.8, 1.6]
+    assert values(cfg, "k") == [0.01, 0.05, 0.1]
+    rates = values(cfg, "rate")
+    assert np.log10(rates[-1] / rates[0]) >= 5
+    for s in cfg.scenes():  # above the threshold radius of its k
+        assert s.a0 >= (1.5 / s.k / 0.3) ** (1 / 2.7)
+
+
+def test_fig3_matches_paper_panels():
+    cfg = load_config(CONFIGS / "fig3.yaml")
+    assert cfg.trajectories is True
+    fig3 = yaml.safe_load(PAPER.read_text())["fig3_trajectories"]
+    want = set()
+    for panel in ("a", "b", "c"):
+        p = fig3[panel]
+        axes = {k: (v if isinstance(v, list) else [v]) for k, v in p.items()}
+        for n in axes["n"]:
+            for a0 in axes["a0"]:
+                for rate in axes["rate"]:
+                    want.add((float(n), float(a0), round(float(rate), 3)))  # YAML: 1.0e2 is a str
+    got = {(s.n, s.a0, round(s.rate, 3)) for s in cfg.scenes()}
+    assert got == want
+    assert len(cfg.tasks()) == len(want) == 8
+
+
+def test_to_dict_round_trip():
+    cfg = load_config(CONFIGS / "threshold.yaml")
+    again = config_from_dict(cfg.to_dict())
+    assert again.config_hash == cfg.config_hash
+    assert isinstance(Scene.from_dict(cfg.scenes()[0].to_dict()), Scene)

@@ -1,0 +1,279 @@
+"""The scheduler: joblib/loky and dask backends, streaming writes, resume, worker set-up.
+
+Most tests inject a cheap module-level ``simulate`` (it pickles to workers by reference);
+``test_real_solver_sequential_and_parallel_agree`` runs the real solver on tiny scenes.
+"""
+from __future__ import annotations
+
+import io
+import json
+import math
+import os
+import time
+
+import numpy as np
+import pytest
+
+from sweep import scheduler
+from sweep.config import config_from_dict
+from sweep.errors import InputError
+from sweep.scene import Numerics, Result, Scene
+from sweep.scheduler import Progress, SweepRuntimeError, run_scene, run_sweep
+from sweep.store import load, load_trajectory, parts_dir, read_attrs
+
+
+def fake_simulate(scene, numerics):
+    """Deterministic stand-in for the solver: a short sleep, fails for n > 1 at high rates."""
+    time.sleep(0.05)
+    if scene.n > 1 and scene.rate > 50:
+        return Result(scene=scene, numerics=numerics, status="failed", reason="fake: no pull-off")
+    t = np.linspace(0.0, 1.0, 5)
+    return Result(scene=scene, numerics=numerics, status="ok",
+                  pull_off=scene.n * math.log10(scene.rate + 1.0) + 1.0, steps=4, wall_s=0.05,
+                  trajectory={"t": t, "delta": -t, "P": -t * scene.n, "a": 2 - t,
+                              "a_inner": 1.5 - t})
+
+
+def raising_simulate(scene, numerics):
+    if scene.n > 1:
+        raise ZeroDivisionError("boom\nsecond line")
+    return fake_simulate(scene, numerics)
+
+
+def thread_probe(scene, numerics):
+    """Report the worker's thread settings in the reason field."""
+    import numba
+
+    info = {v: os.environ.get(v) for v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+                                           "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")}
+    info["numba"] = numba.config.NUMBA_NUM_THREADS
+    info["pid"] = os.getpid()
+    return Result(scene=scene, numerics=numerics, status="ok", reason=json.dumps(info))
+
+
+def cfg(n=(0.4, 1.6), rate=(1, 100), a0=2.0, trajectories=False, name="t"):
+    return config_from_dict({"name": name, "grid": {"n": list(n), "rate": list(rate), "a0": a0},
+                             "numerics": {"preset": "fast", "nodes": 60},
+                             "store": {"trajectories": trajectories}})
+
+
+def test_loky_two_workers_all_rows(tmp_path):
+    c = cfg(n=(0.4, 0.8, 1.6), rate=(1, 10, 100), trajectories=True)
+    out = tmp_path / "r.h5"
+    rep = run_sweep(c, jobs=2, out=out, simulate=fake_simulate, progress="none")
+    assert (rep.total, rep.ran, rep.skipped, rep.failed) == (9, 9, 0, 1)
+    df = load(out)
+    assert sorted(df.scene_id) == sorted(sid for sid, _ in c.tasks())
+    assert df["worker"].nunique() == 2                # both processes did work
+    assert (df["task_wall_s"] >= 0.05).all()
+    bad = df[df.status == "failed"]
+    assert list(bad.reason) == ["fake: no pull-off"] and np.isnan(bad.pull_off).all()
+    ok = df[df.status == "ok"].iloc[0]
+    np.testing.assert_allclose(ok.pull_off, ok.n * math.log10(ok.rate + 1) + 1)
+    assert len(load_trajectory(out, ok.scene_id)["P"]) == 5
+    assert not parts_dir(out).exists() and read_attrs(out)["complete"]
+
+
+def test_rerun_skips_everything_and_keeps_file(tmp_path):
+    c, out = cfg(), tmp_path / "r.h5"
+    run_sweep(c, jobs=1, out=out, simulate=fake_simulate, progress="none")
+    before = load(out)
+    mtime = os.stat(out).st_mtime_ns
+    rep = run_sweep(c, jobs=2, out=out, simulate=raising_simulate, progress="none")
+    assert (rep.ran, rep.skipped) == (0, 4)
+    assert os.stat(out).st_mtime_ns == mtime          # nothing to do: file not rewritten
+    assert load(out).equals(before)
+
+
+def test_interrupted_sweep_resumes_without_rerunning(tmp_path):
+    c = cfg(n=(0.4, 0.6, 0.8), rate=(1, 3, 10, 30))
+    out = tmp_path / "r.h5"
+    seen = []
+
+    def stop_after_five(info):
+        seen.append(info["row"]["scene_id"])
+        if info["done"] == 5:
+            raise RuntimeError("simulated crash of the parent loop")
+    with pytest.raises(SweepRuntimeError, match="after 5 of 12 scenes.*run the same command"):
+        run_sweep(c, jobs=2, out=out, simulate=fake_simulate, progress=stop_after_five)
+    assert sorted(load(out).scene_id) == sorted(seen)
+    rest = []
+    rep = run_sweep(c, jobs=2, out=out, simulate=fake_simulate,
+                    progress=lambda info: rest.append(info["row"]["scene_id"]))
+    assert (rep.ran, rep.skipped) == (7, 5)
+    assert not set(rest) & set(seen)
+    assert sorted(load(out).scene_id) == sorted(sid for sid, _ in c.tasks())
+
+
+def test_exception_in_a_scene_is_a_failed_row(tmp_path):
+    out = tmp_path / "r.h5"
+    rep = run_sweep(cfg(), jobs=2, out=out, simulate=raising_simulate, progress="none")
+    df = load(out)
+    assert rep.failed == 2 and len(df) == 4
+    bad = df[df.n > 1]
+    assert (bad.status == "failed").all()
+    assert all(r == "exception ZeroDivisionError: boom second line" for r in bad.reason)
+    assert (bad.wall_s > 0).all()
+
+
+def test_one_thread_per_worker(tmp_path, monkeypatch):
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                "NUMBA_NUM_THREADS"):
+        monkeypatch.delenv(var, raising=False)         # not inherited from `make test`
+    out = tmp_path / "r.h5"
+    run_sweep(cfg(), jobs=2, out=out, simulate=thread_probe, progress="none")
+    infos = [json.loads(r) for r in load(out).reason]
+    assert all(i["pid"] != os.getpid() for i in infos)  # ran in worker processes
+    for info in infos:
+        assert info["OMP_NUM_THREADS"] == info["NUMBA_NUM_THREADS"] == "1", info
+        assert info["OPENBLAS_NUM_THREADS"] == info["MKL_NUM_THREADS"] == "1", info
+        assert info["numba"] == 1, info
+
+
+def test_worker_warms_numba_cache_once(monkeypatch):
+    import sweep.solver as solver
+    calls = []
+    monkeypatch.setattr(solver, "warm_up", lambda: calls.append(1) or 0.0, raising=False)
+    monkeypatch.setattr(solver, "simulate", fake_simulate)
+    monkeypatch.setattr(scheduler, "_WORKER_READY", False)
+    for var in scheduler.THREAD_VARS:                   # run_scene sets these if unset
+        monkeypatch.setenv(var, os.environ.get(var, "1"))
+    for _ in range(3):
+        row, traj = run_scene(Scene(n=0.4, rate=1, a0=2), Numerics.preset("fast"))
+    assert calls == [1] and row["status"] == "ok" and traj is None
+
+
+def test_dask_local_cluster_matches_loky(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    c = cfg(n=(0.4, 0.8, 1.6), rate=(1, 100))
+    run_sweep(c, jobs=2, out=tmp_path / "loky.h5", simulate=fake_simulate, progress="none")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        rep = run_sweep(c, backend="dask", scheduler=cluster.scheduler_address,
+                        out=tmp_path / "dask.h5", simulate=fake_simulate, progress="none")
+    assert rep.ran == 6
+    a = load(tmp_path / "loky.h5").set_index("scene_id").sort_index()
+    b = load(tmp_path / "dask.h5").set_index("scene_id").sort_index()
+    assert list(a.index) == list(b.index)
+    np.testing.assert_array_equal(a.pull_off.values, b.pull_off.values)
+    assert b.worker.nunique() == 2
+    assert not set(a.worker) & set(b.worker)
+
+
+def test_unreachable_scheduler_fails_fast_and_writes_nothing(tmp_path):
+    out = tmp_path / "sub" / "r.h5"
+    t0 = time.monotonic()
+    with pytest.raises(SweepRuntimeError, match="cannot connect to the dask scheduler at "
+                                                "tcp://127.0.0.1:1"):
+        run_sweep(cfg(), backend="dask", scheduler="tcp://127.0.0.1:1", out=out,
+                  simulate=fake_simulate, connect_timeout=1.0, progress="none")
+    assert time.monotonic() - t0 < 15
+    assert not out.exists() and not parts_dir(out).exists()
+    assert not (out.parent / "r.h5.lock").exists()
+
+
+@pytest.mark.parametrize("kw, needle", [
+    ({"backend": "spark"}, "backend must be one of loky, dask"),
+    ({"jobs": 0}, "jobs must be an integer in [1, 4096]"),
+    ({"scheduler": "tcp://x:1"}, "only used with backend dask"),
+    ({"progress": "fancy"}, "progress must be one of"),
+])
+def test_bad_options(tmp_path, kw, needle):
+    with pytest.raises(InputError) as info:
+        run_sweep(cfg(), out=tmp_path / "r.h5", simulate=fake_simulate, **kw)
+    assert needle in str(info.value)
+    assert not (tmp_path / "r.h5").exists()
+
+
+def test_unwritable_output(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(InputError, match="cannot create directory"):
+        run_sweep(cfg(), out=blocker / "r.h5", simulate=fake_simulate)
+    with pytest.raises(InputError, match="is a directory"):
+        run_sweep(cfg(), out=tmp_path, simulate=fake_simulate)
+
+
+def test_progress_bar_and_log_lines():
+    buf = io.StringIO()
+    p = Progress("bar", total=40, already=10, stream=buf)
+    p.start()
+    p.update({"scene_id": "a", "status": "ok"})
+    p.update({"scene_id": "b", "status": "failed"})
+    p.close()
+    text = buf.getvalue()
+    assert "\r[12/40] 1 failed  ETA 0:" in text and "\n" in text[-1:]
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+    assert Progress("auto", total=3, already=0, stream=Tty()).mode == "bar"
+    buf = io.StringIO()
+    p = Progress("auto", total=3, already=0, stream=buf)   # not a TTY -> log lines
+    assert p.mode == "log"
+    p.update({"scene_id": "abc", "status": "ok", "pull_off": 1.23456789, "wall_s": 0.5})
+    p.update({"scene_id": "def", "status": "failed", "pull_off": math.nan, "wall_s": 0.25,
+              "reason": "why"})
+    lines = buf.getvalue().splitlines()
+    assert lines == ["[1/3] abc ok pull_off=1.2346 wall=0.5s",
+                     "[2/3] def failed pull_off=nan wall=0.25s reason: why"]
+
+
+def test_real_solver_sequential_and_parallel_agree(tmp_path):
+    """The real solver through both paths (fast preset, tiny mesh): identical rows."""
+    c = cfg(n=(0.4, 1.6), rate=(1, 100))
+    r1 = run_sweep(c, jobs=1, out=tmp_path / "j1.h5", progress="none")
+    r2 = run_sweep(c, jobs=2, out=tmp_path / "j2.h5", progress="none")
+    assert r1.ran == r2.ran == 4
+    a = load(tmp_path / "j1.h5").set_index("scene_id").sort_index()
+    b = load(tmp_path / "j2.h5").set_index("scene_id").sort_index()
+    assert list(a.status) == list(b.status)
+    assert (a.status == "ok").sum() >= 2, a[["n", "rate", "status", "reason"]]
+    np.testing.assert_array_equal(a.pull_off.values, b.pull_off.values)
+    np.testing.assert_array_equal(a.steps.values, b.steps.values)
+
+
+def crashing_simulate(scene, numerics):
+    """Kills its worker process outright for one scene (like a segfault)."""
+    if scene.n > 1 and scene.rate > 50:
+        time.sleep(0.3)                                  # let the other scenes finish first
+        os._exit(3)
+    return fake_simulate(scene, numerics)
+
+
+def test_worker_crash_stops_sweep_keeps_results(tmp_path):
+    c = cfg(n=(0.4, 0.8, 1.6), rate=(1, 100))
+    out = tmp_path / "r.h5"
+    with pytest.raises(SweepRuntimeError, match="sweep stopped after .* run the same command"):
+        run_sweep(c, jobs=2, out=out, simulate=crashing_simulate, progress="none")
+    df = load(out)
+    assert 1 <= len(df) <= 5
+    assert not ((df.n > 1) & (df.rate > 50)).any()       # the crashed scene has no row
+    assert not parts_dir(out).exists()                   # consolidated before stopping
+    rep = run_sweep(c, jobs=2, out=out, simulate=fake_simulate, progress="none")
+    assert rep.skipped == len(df) and rep.ran == 6 - len(df)
+    assert len(load(out)) == 6
+
+
+def test_dask_without_address_starts_local_cluster(tmp_path):
+    pytest.importorskip("distributed")
+    out = tmp_path / "r.h5"
+    rep = run_sweep(cfg(), backend="dask", jobs=2, out=out, simulate=fake_simulate,
+                    progress="none")
+    assert rep.ran == 4 and load(out).worker.nunique() >= 1
+    assert all(w.split(":")[1] != str(os.getpid()) for w in load(out).worker)
+
+
+def test_consolidation_interval(tmp_path):
+    """With a zero interval the main file follows every scene; with a long one only the end."""
+    for interval, expect_mid in ((0.0, True), (1e6, False)):
+        out = tmp_path / f"r{interval}.h5"
+        sizes = []
+
+        def watch(info, out=out):
+            import h5py
+            with h5py.File(out, "r") as f:
+                sizes.append(len(f["runs/scene_id"]))
+        run_sweep(cfg(n=(0.4, 0.6, 0.8), rate=(1, 10)), jobs=1, out=out,
+                  simulate=fake_simulate, progress=watch, consolidate_every=interval)
+        assert (max(sizes) > 0) is expect_mid, sizes
+        assert len(load(out)) == 6

@@ -1,0 +1,214 @@
+"""The single-scene BEM solver against independent values, limits and the paper's trends.
+
+Reference values: ../shared/reference/independent_solutions.yaml (an independent solver with
+the exact hereditary integral, N = 1000..2000). Tolerances reflect OUR discretization
+(N = 500 on the automatic domain, spacing ~0.012): measured differences are < 0.1 %.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from sweep import Numerics, Scene, simulate
+from sweep.errors import InputError
+from sweep.theory import jkr_load
+
+REF = Path(__file__).resolve().parents[2] / "shared" / "reference" / "independent_solutions.yaml"
+
+
+def _ref():
+    if not REF.exists():
+        pytest.skip("shared/reference/independent_solutions.yaml not beside the checkout")
+    return yaml.safe_load(REF.read_text())
+
+
+def elastic(mu, a0=2.0, **num):
+    num = {"nodes": 1000, "domain": 5.0, "step": 0.05, "tol": 1e-9, **num}
+    return simulate(Scene(n=1.0, k=1.0, mu=mu, a0=a0, rate=1.0), Numerics(**num))
+
+
+@pytest.mark.parametrize("case", [0, pytest.param(1, marks=pytest.mark.slow)])
+def test_elastic_pull_off_matches_independent_solver(case):
+    # case 1 (mu = 6): at spacing 0.005 the crack tip snaps node to node (hundreds of folds,
+    # each found by the snap search): minutes, hence slow. Measured at N = 1000: 1.52267
+    # (yaml 1.5225); converged (N = 1500, 2000): 1.5199, 1.5198 -- the yaml's N = 1000 value
+    # is itself about 2.5e-3 above the mesh limit.
+    ref = _ref()["elastic"][case]
+    # the same mesh as the reference solver: N = 1000, spacing 0.005 (domain 5)
+    res = elastic(ref["mu"])
+    assert res.ok, res.reason
+    assert res.pull_off == pytest.approx(ref["pull_off"], abs=ref["tol"])
+
+
+def test_elastic_curve_approaches_jkr_as_mu_grows():
+    # the max-tension radius tends to the JKR contact edge: distance of P(a) from JKR shrinks
+    errs = []
+    for mu in (1.5, 2.5, 3.5):      # snap-free at spacing 0.005 (mu = 6 needs < 0.004)
+        res = elastic(mu, nodes=800, domain=4.0)
+        assert res.ok, res.reason
+        tr = res.trajectory
+        sel = (tr["a"] > 1.1) & (tr["a"] < 1.9)
+        errs.append(np.max(np.abs(tr["P"][sel] - jkr_load(tr["a"][sel]))))
+    # the LJ curve departs from JKR by O(1/mu): errs * mu is nearly constant (0.64 measured)
+    assert errs[0] > errs[1] > errs[2]
+    scaled = np.array(errs) * np.array([1.5, 2.5, 3.5])
+    assert np.ptp(scaled) < 0.1 * scaled.mean()
+
+
+def test_elastic_pull_off_converges_with_mesh():
+    # pull-off at mu = 3.24 on the reference domain: differences shrink with N
+    p = [elastic(3.24, nodes=n).pull_off for n in (250, 500, 1000)]
+    assert abs(p[1] - p[2]) < abs(p[0] - p[2])
+    assert abs(p[1] - p[2]) < 3e-4
+
+
+@pytest.mark.parametrize("name", ["A", "D", "F"])
+def test_viscoelastic_matches_independent_solver(name):
+    ref = next(c for c in _ref()["viscoelastic"] if c["name"] == name)
+    res = simulate(Scene(**ref["scene"]), Numerics.preset("balanced"))
+    assert res.ok, res.reason
+    assert res.pull_off == pytest.approx(ref["pull_off"], rel=3e-3)
+    assert res.a0_result == pytest.approx(ref["a0"], abs=0.01)
+    assert res.a_pulloff == pytest.approx(ref["a_pulloff"], abs=0.02)
+    assert res.crack_speed == pytest.approx(ref["crack_speed"], rel=0.05)   # +-5% (yaml)
+    assert res.delta0_result == ref["scene"]["delta0"]
+
+
+@pytest.mark.parametrize("n, rate", [(0.4, 3.16), (1.6, 316.2)])
+def test_prony_matches_exact_convolution(n, rate):
+    # same step sequence (da_max off), default Prony tolerance of the balanced preset
+    scene = Scene(n=n, k=0.1, mu=3.24, a0=2.0, rate=rate)
+    num = dict(nodes=100, step=0.2, da_max=1e6, tol=1e-9)
+    prony = simulate(scene, Numerics(**num, prony_rtol=1e-4))
+    exact = simulate(scene, Numerics(**num, exact=True))
+    assert prony.ok and exact.ok
+    assert prony.steps == exact.steps
+    assert prony.pull_off == pytest.approx(exact.pull_off, rel=2e-3)
+    assert exact.prony_terms == 0 and prony.prony_terms > 0
+
+
+def test_prony_error_shrinks_with_rtol():
+    scene = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=100.0)
+    num = dict(nodes=100, step=0.2, da_max=1e6, tol=1e-9)
+    exact = simulate(scene, Numerics(**num, exact=True)).pull_off
+    errs = [abs(simulate(scene, Numerics(**num, prony_rtol=r)).pull_off / exact - 1)
+            for r in (1e-2, 1e-6)]
+    assert errs[1] < errs[0]
+    assert errs[1] < 1e-5
+
+
+def fast(**scene):
+    return simulate(Scene(**{"n": 0.8, "k": 0.1, "mu": 3.24, **scene}), Numerics.preset("fast"))
+
+
+def test_pull_off_grows_with_rate():
+    p = [fast(a0=3.0, rate=r).pull_off for r in (1.0, 100.0, 1e4)]
+    assert p[0] < p[1] < p[2]
+
+
+def test_pull_off_grows_with_initial_contact_radius():
+    p = [fast(n=1.6, a0=a0, rate=316.2).pull_off for a0 in (1.71, 2.47, 3.61)]
+    assert p[0] < p[1] < p[2]
+
+
+def test_pull_off_grows_with_n_at_fixed_rate():
+    p = [fast(n=n, a0=3.61, rate=10**2.5).pull_off for n in (0.6, 0.8, 1.6)]
+    assert p[0] < p[1] < p[2]
+
+
+def test_slow_unloading_and_k_to_one_give_the_elastic_result():
+    el = fast(k=1.0, a0=2.0, rate=1.0).pull_off
+    assert fast(a0=2.0, rate=1e-4).pull_off == pytest.approx(el, rel=2e-3)
+    assert fast(k=0.999, a0=2.0, rate=100.0).pull_off == pytest.approx(el, rel=2e-3)
+
+
+def test_amplification_is_bounded_by_glassy_limit():
+    # pull-off cannot exceed the JKR value of the glassy material, 1.5/k (+ LJ correction)
+    res = fast(n=1.6, k=0.1, a0=3.0, rate=1e8)
+    assert res.ok
+    assert 1.5 < res.pull_off < 1.6 / 0.1
+
+
+def test_results_are_consistent():
+    res = fast(a0=2.5, rate=31.6)
+    tr = res.trajectory
+    assert res.ok
+    assert set(tr) == {"t", "delta", "P", "a", "a_inner"}
+    assert np.all(np.diff(tr["t"]) > 0) and np.all(np.diff(tr["delta"]) < 0)
+    assert res.pull_off == pytest.approx(-tr["P"].min(), rel=1e-3)
+    assert res.a_inner_pulloff < res.a_pulloff          # a_inner lies inside the edge
+    assert res.vhat == pytest.approx(res.crack_speed * 3.24**2 * math.pi ** (1 / 3)
+                                     / (243 / (256 * math.pi * (math.pi / 9) ** 2)), rel=1e-12)
+    assert res.steps == len(tr["t"]) - 1
+    assert res.a0_result == pytest.approx(2.5, abs=1e-8)
+
+
+def test_separation_mode_follows_the_curve_past_pull_off():
+    po = fast(a0=2.0, rate=10.0)
+    sep = simulate(Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0, stop="separation"),
+                   Numerics.preset("fast"))
+    assert sep.ok
+    assert sep.pull_off == pytest.approx(po.pull_off, rel=1e-9)
+    assert sep.trajectory["a"][-1] < 0.5 * po.a_pulloff
+
+
+def test_sls_material():
+    res = simulate(Scene(n=1.0, k=0.1, mu=3.24, a0=2.0, rate=10.0, material="sls"),
+                   Numerics.preset("fast"))
+    assert res.ok and res.prony_terms == 1
+
+
+EXTREMES = [
+    dict(n=0.1, k=1e-4, rate=1e8, a0=1.0, mu=1.0),
+    dict(n=2.0, k=1e-4, rate=1e8, a0=10.0, mu=1.0),
+    dict(n=0.1, k=0.99, rate=1e-3, a0=10.0, mu=1.0),
+    dict(n=2.0, k=1e-4, rate=1e-3, a0=1.0, mu=10.0),
+    dict(n=2.0, k=1e-4, rate=1e8, a0=1.0, mu=10.0),
+    dict(n=0.1, k=0.99, rate=1e8, a0=10.0, mu=10.0),
+]
+
+
+@pytest.mark.parametrize("scene", EXTREMES)
+def test_extremes_finish_with_a_finite_result_or_a_clear_failure(scene):
+    res = fast(**scene)
+    if res.ok:
+        assert np.isfinite(res.pull_off) and res.pull_off > 0
+        assert np.isfinite(res.crack_speed) and np.isfinite(res.a_pulloff)
+        assert all(np.all(np.isfinite(v)) for v in res.trajectory.values())
+    else:
+        assert res.reason and "nan" not in res.reason.lower()
+
+
+def test_under_resolved_mesh_is_refused_with_advice():
+    res = simulate(Scene(n=2, k=1e-4, rate=1e-3, a0=10, mu=10), Numerics.preset("fast"))
+    assert res.status == "failed" and "use nodes >=" in res.reason
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(n=-1, a0=2, rate=1), "n"), (dict(n=1, k=0, a0=2, rate=1), "k"),
+    (dict(n=1, k=1.5, a0=2, rate=1), "k"), (dict(n=1, a0=2, rate=float("nan")), "rate"),
+    (dict(n=1, rate=1), "a0/delta0"), (dict(n=1, a0=2, delta0=3, rate=1), "a0/delta0"),
+    (dict(n=1, a0=2, rate=1, material="foo"), "material"),
+])
+def test_bad_scene_input_names_the_parameter(kwargs, name):
+    with pytest.raises(InputError, match=name):
+        Scene(**kwargs)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(nodes=5), "nodes"), (dict(nodes=10.5), "nodes"), (dict(step=-1), "step"),
+    (dict(prony_rtol=1.0), "prony_rtol"), (dict(exact="yes"), "exact"),
+])
+def test_bad_numerics_input_names_the_parameter(kwargs, name):
+    with pytest.raises(InputError, match=name):
+        Numerics(**kwargs)
+
+
+def test_presets_and_unknown_preset():
+    assert Numerics.preset("fast").nodes < Numerics.preset("accurate").nodes
+    with pytest.raises(InputError, match="preset"):
+        Numerics.preset("turbo")

@@ -1,0 +1,295 @@
+"""The crash-safe HDF5 store: round trip, journal, consolidation, refusal to damage files."""
+from __future__ import annotations
+
+import json
+import math
+import os
+
+import h5py
+import numpy as np
+import pytest
+
+import sweep
+from sweep.errors import InputError
+from sweep.store import (JOURNAL, ResultStore, StoreBusyError, load, load_trajectory,
+                         parts_dir, read_attrs, summary)
+
+TEMPLATE = {"scene_id": "", "n": 0.0, "a0": None, "material": "mpl", "num_nodes": 0,
+            "num_exact": False, "status": "", "reason": "", "pull_off": math.nan, "steps": 0}
+
+
+def row(i, **over):
+    r = {"scene_id": f"id{i:04d}", "n": 0.4 + 0.1 * i, "a0": None if i % 2 else 2.0 + i,
+         "material": "mpl", "num_nodes": 60, "num_exact": bool(i % 3 == 0),
+         "status": "ok" if i % 4 else "failed", "reason": "" if i % 4 else "Newton failed: ü",
+         "pull_off": 1.0 + i if i % 4 else math.nan, "steps": 10 * i}
+    r.update(over)
+    return r
+
+
+def traj(i, n=7):
+    t = np.linspace(0.0, 1.0, n)
+    return {"t": t, "delta": -t * i, "P": t ** 2, "a": 2 - t, "a_inner": 1.5 - t}
+
+
+def make(path, n_scenes=6, trajectories=False, config_hash="h1", **kw):
+    return ResultStore(path, config_hash=config_hash, config_name="t", config_text="name: t\n",
+                       n_scenes=n_scenes, trajectories=trajectories, template_row=TEMPLATE, **kw)
+
+
+def test_round_trip_plain_types(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path)
+    st.prepare()
+    assert st.begin() == set()
+    for i in range(6):
+        st.append(row(i))
+    st.finish()
+    df = load(path)
+    assert list(df.scene_id) == [f"id{i:04d}" for i in range(6)]
+    assert df["n"].dtype == np.float64 and df["steps"].dtype == np.int64
+    assert df["num_exact"].dtype == bool and list(df["num_exact"]) == [i % 3 == 0
+                                                                        for i in range(6)]
+    assert np.isnan(df["a0"][1]) and df["a0"][2] == 4.0        # None -> NaN
+    assert np.isnan(df["pull_off"][0]) and df["pull_off"][5] == 6.0
+    assert df["reason"][0] == "Newton failed: ü" and df["reason"][1] == ""
+    assert not parts_dir(path).exists()                          # single self-contained file
+    attrs = read_attrs(path)
+    assert attrs["complete"] and attrs["n_finished"] == 6 and attrs["finished_at"]
+    assert attrs["config_text"] == "name: t\n" and attrs["config_hash"] == "h1"
+    for key in ("package_version", "git_commit", "numba_version", "numpy_version",
+                "started_at", "updated_at"):
+        assert attrs[key], key
+
+
+def test_sweep_reexports():
+    assert sweep.load is load and sweep.load_trajectory is load_trajectory
+
+
+def test_file_holds_plain_arrays_and_text_only(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path, trajectories=True)
+    st.prepare()
+    st.begin()
+    for i in range(3):
+        st.append(row(i), traj(i))
+    st.finish()
+    seen = []
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset):
+            dt = obj.dtype
+            ok = dt.kind in "fiu" or h5py.check_string_dtype(dt) is not None
+            assert ok, (name, dt)                     # no opaque/compound/object/pickle bytes
+            seen.append(name)
+    with h5py.File(path, "r") as f:
+        f.visititems(visit)
+        for k, v in f.attrs.items():
+            assert isinstance(v, (str, bytes, np.integer, np.floating, np.bool_, int, float,
+                                  bool)), (k, type(v))
+    assert "runs/scene_id" in seen and "trajectories/id0001/P" in seen
+
+
+def test_journal_is_read_before_consolidation(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path, interval=1e9)
+    st.prepare()
+    st.begin()                                # writes an empty consolidated file at once
+    assert len(load(path)) == 0 and "pull_off" in load(path).columns
+    for i in range(4):
+        st.append(row(i))
+        assert st.maybe_consolidate() is False
+    with h5py.File(path, "r") as f:
+        assert len(f["runs/scene_id"]) == 0   # main file not yet rewritten ...
+    df = load(path)                            # ... but load() sees every finished scene
+    assert list(df.scene_id) == [f"id{i:04d}" for i in range(4)]
+    assert np.isnan(df["a0"][1])
+    st.abort()                                 # like a kill: no final consolidation
+    st2 = make(path)
+    st2.prepare()
+    assert st2.begin() == {f"id{i:04d}" for i in range(4)}
+    st2.finish()
+    assert len(load(path)) == 4 and not parts_dir(path).exists()
+
+
+def test_torn_journal_line_ignored_then_repaired(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path, interval=1e9)
+    st.prepare()
+    st.begin()
+    st.append(row(1))
+    st.abort()
+    jp = parts_dir(path) / JOURNAL
+    with open(jp, "ab") as fh:                 # a write cut short by SIGKILL
+        fh.write(json.dumps(row(2)).encode()[:25])
+    assert list(load(path).scene_id) == ["id0001"]
+    st = make(path)
+    st.prepare()
+    assert st.begin() == {"id0001"}
+    st.append(row(3))
+    text = jp.read_bytes()
+    assert text.endswith(b"\n") and text.count(b"\n") == 2   # torn tail truncated
+    st.finish()
+    assert list(load(path).scene_id) == ["id0001", "id0003"]
+
+
+def test_consolidation_replaces_file_atomically(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path, interval=0.0)
+    st.prepare()
+    st.begin()
+    reader = h5py.File(path, "r")              # a reader holding the old version open
+    ino = os.stat(path).st_ino
+    st.append(row(1))
+    st.consolidate()
+    assert os.stat(path).st_ino != ino         # replaced, never written in place
+    assert len(reader["runs/scene_id"]) == 0   # the old reader still sees a valid file
+    reader.close()
+    assert not (tmp_path / "r.h5.tmp").exists()
+    st.finish()
+
+
+def test_trajectories(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path, trajectories=True, interval=1e9)
+    st.prepare()
+    st.begin()
+    st.append(row(1), traj(1))
+    got = load_trajectory(path, "id0001")      # from the journal's part file
+    np.testing.assert_array_equal(got["delta"], traj(1)["delta"])
+    st.consolidate()
+    st.append(row(2), traj(2, n=9))
+    st.finish()
+    for i, n in ((1, 7), (2, 9)):              # both now from the consolidated file
+        got = load_trajectory(path, f"id{i:04d}")
+        assert set(got) == {"t", "delta", "P", "a", "a_inner"} and len(got["t"]) == n
+    with pytest.raises(KeyError, match="no trajectory"):
+        load_trajectory(path, "nope")
+    # resume into the consolidated file keeps old trajectories when rewriting it
+    st = make(path, n_scenes=7, trajectories=True)
+    st.prepare()
+    st.begin()
+    st.append(row(3), traj(3))
+    st.finish()
+    assert len(load_trajectory(path, "id0001")["t"]) == 7
+
+
+def test_no_trajectories_message(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path)
+    st.prepare()
+    st.begin()
+    st.append(row(1), traj(1))                 # ignored: store.trajectories is false
+    st.finish()
+    with pytest.raises(KeyError, match="trajectories: true"):
+        load_trajectory(path, "id0001")
+
+
+def test_different_config_refused_and_file_untouched(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path)
+    st.prepare()
+    st.begin()
+    st.append(row(1))
+    st.finish()
+    before = path.read_bytes()
+    other = make(path, config_hash="h2")
+    with pytest.raises(InputError, match="different config.*--fresh.*--out"):
+        other.prepare(resume=True)
+    assert path.read_bytes() == before
+    assert not (tmp_path / "r.h5.lock").exists()  # lock released on refusal
+
+
+def test_fresh_moves_old_results_aside(tmp_path):
+    path = tmp_path / "r.h5"
+    for round_ in range(2):
+        st = make(path)
+        st.prepare()
+        st.begin()
+        st.append(row(round_))
+        if round_ == 0:
+            st.finish()
+        else:
+            st.abort()                          # second file left with a journal
+    new = make(path, config_hash="h2")
+    new.prepare(resume=False)
+    assert new.begin(fresh=True) == set()
+    new.append(row(9))
+    new.finish()
+    assert list(load(path).scene_id) == ["id0009"]
+    assert new.backup == tmp_path / "r.h5.bak"
+    assert sorted(load(new.backup).scene_id) == ["id0000", "id0001"]   # journal moved too
+    # a second --fresh never overwrites the first backup
+    again = make(path, config_hash="h3")
+    again.prepare(resume=False)
+    again.begin(fresh=True)
+    again.finish()
+    assert again.backup == tmp_path / "r.h5.bak1"
+    assert list(load(again.backup).scene_id) == ["id0009"]
+
+
+def test_foreign_file_refused(tmp_path):
+    path = tmp_path / "r.h5"
+    path.write_bytes(b"precious data, not HDF5")
+    st = make(path)
+    with pytest.raises(InputError, match="not a readable HDF5.*refusing to overwrite"):
+        st.prepare(resume=True)
+    with h5py.File(tmp_path / "o.h5", "w") as f:
+        f["x"] = [1, 2]
+    with pytest.raises(InputError, match="not a visco-sweep results file"):
+        make(tmp_path / "o.h5").prepare(resume=True)
+    assert path.read_bytes() == b"precious data, not HDF5"
+    with pytest.raises(InputError):
+        load(path)
+
+
+def test_single_writer_lock(tmp_path):
+    path = tmp_path / "r.h5"
+    a = make(path)
+    a.prepare()
+    a.begin()
+    with pytest.raises(StoreBusyError, match="another sweep is writing"):
+        make(path).prepare()
+    a.finish()
+    b = make(path)
+    b.prepare()                                # free again after finish
+    b.abort()
+
+
+def test_load_missing(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        load(tmp_path / "none.h5")
+
+
+def test_summary_text(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path, n_scenes=8)
+    st.prepare()
+    st.begin()
+    for i in range(6):
+        st.append({**row(i), "rate": 10.0 ** i, "wall_s": 0.1 * i})
+    st.finish()
+    text = summary(path, slowest=3)
+    assert "6 finished of 8" in text and "status: ok 4, failed 2" in text
+    assert "rate: 6 values in [1, 1e+05]" in text
+    assert "slowest 3:" in text and text.index("id0005") < text.index("id0004")
+    assert "failures (2):" in text and "Newton failed" in text
+
+
+def test_kill_during_consolidation_leaves_old_file(tmp_path):
+    """A consolidation cut short leaves only a stray .tmp: readers ignore it, writers drop it."""
+    path = tmp_path / "r.h5"
+    st = make(path, interval=1e9)
+    st.prepare()
+    st.begin()
+    st.append(row(1))
+    st.abort()
+    tmp = tmp_path / "r.h5.tmp"
+    tmp.write_bytes(b"\x89HDF\r\n\x1a\n half a file")        # torn consolidation
+    assert list(load(path).scene_id) == ["id0001"]
+    st = make(path)
+    st.prepare()
+    assert st.begin() == {"id0001"}
+    assert not tmp.exists()
+    st.finish()
+    assert list(load(path).scene_id) == ["id0001"]
