@@ -67,10 +67,20 @@ def plot_sweep(path, out=None) -> Path:
     ax.legend(fontsize=7)
     if has_traj:
         ax2 = axes[0, 1]
-        for _, row in ok.iterrows():
+        # one colour per group of the left panel, darker for faster unloading
+        color_of = {}
+        for line in ax.get_lines():
+            if line.get_label() and not line.get_label().startswith("JKR"):
+                color_of[line.get_label()] = line.get_color()
+        rates = np.log10(ok["rate"].astype(float))
+        span = max(float(rates.max() - rates.min()), 1e-12)
+        for _, row in ok.sort_values([*keys, "rate"] if keys else "rate").iterrows():
             tr = load_trajectory(path, str(row["scene_id"]))
-            ax2.plot(tr["a"], tr["P"], lw=1,
-                     label=f"n={row['n']:g}, rate={row['rate']:g}")
+            label = ", ".join(f"{k}={row[k]:g}" if isinstance(row[k], float) else f"{k}={row[k]}"
+                              for k in keys)
+            shade = 0.35 + 0.65 * (np.log10(float(row["rate"])) - float(rates.min())) / span
+            ax2.plot(tr["a"], tr["P"], lw=1, color=color_of.get(label, "C0"), alpha=shade,
+                     label=f"{label + ', ' if label else ''}rate={row['rate']:g}")
         a = np.linspace(0.5, max(3.0, float(ok["a0_result"].max())), 200)
         ax2.plot(a, jkr_load(a), "k--", lw=1, label="JKR (relaxed)")
         ax2.set_xlabel(r"contact radius $\hat a$")
