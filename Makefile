@@ -9,7 +9,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow bench clean
+.PHONY: help venv demo test test-slow bench bench-convergence clean
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
@@ -44,6 +44,9 @@ bench: $(STAMP)
 	$(BIN)/python -m sweep.benchmarks presets --out results/bench/presets.json
 	$(BIN)/python -m sweep.benchmarks scheduler --out results/bench/scheduler.json
 	$(BIN)/python -m sweep.benchmarks store --out results/bench/store.json
+
+bench-convergence: $(STAMP)
+	$(BIN)/python -m sweep.benchmarks convergence --mu 6 --out results/bench/convergence_mu6.json
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

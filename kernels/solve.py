@@ -59,7 +59,7 @@ RECOVERY_FLOOR = 0.05
 
 #: a failed step is halved down to this fraction of the largest step before it is taken
 #: for a fold of the discrete path (and the snapped state is looked for)
-SNAP_STEP_FRACTION = 1.0 / 64.0
+SNAP_STEP_FRACTION = 1.0 / 8.0
 
 #: pseudo-time iterations allowed for one snap of the crack tip at a fold
 RELAX_MAX_ITER = 300
@@ -298,7 +298,7 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, nod
                 break
             lam *= 0.5
         if not accepted:
-            if fresh and state[1] == 0:
+            if fresh:        # a line search failed on an exact Jacobian: give up
                 return False
             factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
             stats[STAT_FACTOR] += 1
@@ -388,7 +388,6 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, dr, hm, Jinv, d_base, W, sl
                 hp[i] = h[i + shift]
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
-        state[0] = 0
         if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, node_of,
                   state, c_base, stats):
             if crossing_radius(hp, dr, hm) < a_old:

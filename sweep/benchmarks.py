@@ -338,7 +338,33 @@ def bench_presets(repeat: int = 1) -> dict:
                          "pull_off_rel_err": r["pull_off"] / case["pull_off"] - 1,
                          "crack_speed_ref": case["crack_speed"],
                          "crack_speed_rel_err": r["crack_speed"] / case["crack_speed"] - 1})
+    # the elastic reference (k = 1, quasi-static): where coarse meshes cost the most
+    el = ref["elastic"][0]
+    scene = Scene(n=1.0, k=1.0, mu=el["mu"], a0=2.0, rate=1.0)
+    for name in PRESETS:
+        r = _scene_run(scene, Numerics.preset(name), repeat)
+        rows.append({"case": f"elastic mu={el['mu']}", "preset": name, **r,
+                     "pull_off_ref": el["pull_off"],
+                     "pull_off_rel_err": r["pull_off"] / el["pull_off"] - 1,
+                     "crack_speed_ref": None, "crack_speed_rel_err": None})
     return {"kind": "presets", "machine": _machine(), "rows": rows}
+
+
+def bench_convergence(mu: float = 6.0, nodes=(1000, 1500, 2000), domain: float = 5.0) -> dict:
+    """Mesh convergence of the elastic pull-off at a large Tabor parameter (lattice trapping
+    at coarse spacing), against the independent solver's value for that mu if it has one."""
+    import yaml
+    from .scene import Numerics, Scene
+    ref = yaml.safe_load(REFERENCE_YAML.read_text()) if REFERENCE_YAML.exists() else {}
+    ref_po = next((e["pull_off"] for e in ref.get("elastic", []) if e["mu"] == mu), None)
+    rows = []
+    for N in nodes:
+        r = _scene_run(Scene(n=1.0, k=1.0, mu=mu, a0=2.0, rate=1.0),
+                       Numerics(nodes=N, domain=domain, step=0.05, tol=1e-9), 1)
+        r["domain"] = domain
+        rows.append(r)
+    return {"kind": "convergence", "machine": _machine(), "mu": mu, "reference_pull_off": ref_po,
+            "rows": rows}
 
 
 def _write(report: dict, out: str | None) -> None:
@@ -384,6 +410,15 @@ def store_cmd(rows, trajectories, out):
 def scene_cmd(repeat, compile_, out):
     """Solver speed: presets, step/matvec ratio, Prony vs exact, compile time."""
     _write(bench_scene(repeat=repeat, compile_=compile_), out)
+
+
+@bench.command("convergence")
+@click.option("--mu", type=float, default=6.0, show_default=True)
+@click.option("--nodes", default="1000,1500,2000", show_default=True)
+@click.option("--out", default=None, help="JSON report path.")
+def convergence_cmd(mu, nodes, out):
+    """Mesh convergence of the elastic pull-off (spacing domain/(N-1), domain 5)."""
+    _write(bench_convergence(mu=mu, nodes=tuple(int(x) for x in nodes.split(","))), out)
 
 
 @bench.command("presets")
