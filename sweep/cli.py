@@ -180,7 +180,7 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
 def scene_command(n, k, mu, a0, delta0, rate, material, stop, preset, nodes, domain, step, exact,
                   as_json, trajectory):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
-    from .errors import as_float, check_int
+    from .errors import as_float
     from .scene import Numerics, Scene
     from .solver import simulate
 
@@ -191,8 +191,7 @@ def scene_command(n, k, mu, a0, delta0, rate, material, stop, preset, nodes, dom
     overrides = {}
     if nodes is not None:
         try:
-            overrides["nodes"] = check_int("nodes", int(nodes)) if nodes.strip().lstrip("-").isdigit() \
-                else check_int("nodes", nodes)
+            overrides["nodes"] = int(nodes.strip())
         except ValueError:
             raise InputError(f"nodes must be an integer (got {nodes!r})") from None
     if domain is not None:

@@ -1,0 +1,86 @@
+"""`sweep scene` and `sweep plot` from the command line."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from sweep.cli import main
+
+SCENE = ["scene", "--n", "0.8", "--k", "0.1", "--mu", "3.24", "--a0", "2.0", "--rate", "10",
+         "--preset", "fast"]
+
+
+def test_scene_json_has_the_promised_keys(capsys):
+    assert main(SCENE + ["--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("pull_off", "a_pulloff", "delta_pulloff", "crack_speed", "vhat", "steps",
+                "wall_s", "status", "a0_result", "delta0_result", "scene_id"):
+        assert key in out
+    assert out["status"] == "ok" and out["pull_off"] > 1.5
+
+
+def test_scene_with_delta0_reports_a0_and_delta0(capsys):
+    assert main(["scene", "--n", "0.8", "--delta0", "4.0", "--rate", "10", "--preset", "fast",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["delta0_result"] == 4.0 and out["a0_result"] > 1.0
+
+
+def test_scene_trajectory_and_text_output(capsys):
+    assert main(SCENE + ["--json", "--trajectory"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert len(out["trajectory"]["P"]) == out["steps"] + 1
+    assert main(SCENE) == 0
+    text = capsys.readouterr().out
+    assert "pull-off" in text and "crack" in text
+
+
+@pytest.mark.parametrize("args, name", [
+    (["--n", "-1"], "n must be"), (["--k", "2"], "k must be"), (["--rate", "abc"], "rate must be"),
+    (["--mu", "nan"], "mu must be"), (["--nodes", "3.5"], "nodes must be"),
+    (["--delta0", "3"], "a0/delta0"),
+])
+def test_scene_bad_input_one_line_exit_2(args, name, capsys):
+    argv = list(SCENE)
+    for flag, value in zip(args[::2], args[1::2]):
+        if flag in argv:
+            argv[argv.index(flag) + 1] = value
+        else:
+            argv += [flag, value]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and name in err
+
+
+def test_failed_scene_exits_1(capsys):
+    # a mesh far too coarse for mu = 10 is refused with advice, status failed
+    assert main(["scene", "--n", "1", "--mu", "10", "--a0", "10", "--rate", "1",
+                 "--preset", "fast", "--json"]) == 1
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "failed" and "use nodes >=" in out["reason"]
+
+
+def test_console_script_and_plot(tmp_path):
+    exe = Path(sys.executable).with_name("sweep")
+    proc = subprocess.run([str(exe), "scene", "--n", "0.8", "--rate", "1"], capture_output=True,
+                          text=True)
+    assert proc.returncode == 2 and proc.stderr.startswith("error: a0/delta0")
+    missing = subprocess.run([str(exe), "plot", str(tmp_path / "none.h5")], capture_output=True,
+                             text=True)
+    assert missing.returncode == 2 and "no such file" in missing.stderr
+
+
+def test_plot_of_a_sweep_with_trajectories(tmp_path, capsys):
+    cfg = tmp_path / "tiny.yaml"
+    cfg.write_text(
+        "name: tiny\n"
+        "grid: {n: 0.8, k: 0.1, mu: 3.24, a0: 2.0, rate: [1, 100]}\n"
+        "numerics: {preset: fast}\n"
+        "store: {trajectories: true}\n"
+        f"output: {tmp_path / 'tiny.h5'}\n")
+    assert main(["run", str(cfg), "-j", "1", "--progress", "none"]) == 0
+    png = tmp_path / "tiny.png"
+    assert main(["plot", str(tmp_path / "tiny.h5"), "--out", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
