@@ -843,7 +843,25 @@ class _Material:
         return f"{type(self).__name__}(E0={self.E0:.6g}, Einf={self.Einf:.6g}, tau0={self.tau0:.6g})"
 
 
-class MPLRetardation(_Material):
+class _MPL(_Material):
+    """The four constants shared by the two MPL models (E0, Einf, n, tau0); each subclass
+    is a different material built from them."""
+
+    def __init__(self, E0, Einf, n, tau0):
+        self.E0, self.Einf = _check_moduli(E0, Einf)
+        self.n = _check_n(n)
+        self.tau0 = check_positive("tau0", tau0)
+        self._rtab = None     # numerical relaxation table (MPLRetardation)
+        self._ctab = None     # numerical creep table (MPLRelaxation)
+
+    @classmethod
+    def from_k(cls, n, k, E0=1.0, tau0=1.0):
+        """Build from ``(n, k)`` with ``Einf = E0/k`` (dimensionless scenes: E0 = tau0 = 1)."""
+        k = check_range("k", k, 0.0, 1.0, lo_open=True)
+        return cls(E0, check_positive("E0", E0) / k, n, tau0)
+
+
+class MPLRetardation(_MPL):
     """Modified power law RETARDATION spectrum (paper eq. retspec).
 
     .. math:: L(\\tau) = \\frac{C_0 - C_\\infty}{\\Gamma(n)} (\\tau/\\tau_0)^n e^{-\\tau/\\tau_0}
@@ -876,17 +894,6 @@ class MPLRetardation(_Material):
         Characteristic time (> 0), the unit of ``t``.
     """
 
-    def __init__(self, E0, Einf, n, tau0):
-        self.E0, self.Einf = _check_moduli(E0, Einf)
-        self.n = _check_n(n)
-        self.tau0 = check_positive("tau0", tau0)
-        self._rtab = None
-
-    @classmethod
-    def from_k(cls, n, k, E0=1.0, tau0=1.0):
-        """Build from ``(n, k)`` with ``Einf = E0/k`` (dimensionless scenes: E0 = tau0 = 1)."""
-        k = check_range("k", k, 0.0, 1.0, lo_open=True)
-        return cls(E0, check_positive("E0", E0) / k, n, tau0)
 
     def _chat(self, t):
         T = t.ravel()
@@ -932,7 +939,7 @@ class MPLRetardation(_Material):
                 f"tau0={self.tau0:.6g})")
 
 
-class MPLRelaxation(_Material):
+class MPLRelaxation(_MPL):
     """Modified power law RELAXATION spectrum (paper eq. relspec) -- not the BEM's model.
 
     .. math:: H(\\tau) = \\frac{E_\\infty - E_0}{\\Gamma(n)} (\\tau_0/\\tau)^n e^{-\\tau_0/\\tau}
@@ -953,17 +960,6 @@ class MPLRelaxation(_Material):
     Parameters are as for :class:`MPLRetardation` (same four constants, different material).
     """
 
-    def __init__(self, E0, Einf, n, tau0):
-        self.E0, self.Einf = _check_moduli(E0, Einf)
-        self.n = _check_n(n)
-        self.tau0 = check_positive("tau0", tau0)
-        self._ctab = None
-
-    @classmethod
-    def from_k(cls, n, k, E0=1.0, tau0=1.0):
-        """Build from ``(n, k)`` with ``Einf = E0/k``."""
-        k = check_range("k", k, 0.0, 1.0, lo_open=True)
-        return cls(E0, check_positive("E0", E0) / k, n, tau0)
 
     def _rhat(self, t):
         with np.errstate(divide="ignore"):
