@@ -8,7 +8,6 @@ The most tensile traction -sigma_0 is reached at h_m = 3^(1/6) h0.
 """
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 

@@ -17,7 +17,8 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 from .errors import InputError  # noqa: E402
 from .scene import PRESETS, Numerics, Result, Scene, scene_id  # noqa: E402
 from .solver import simulate, warm_up  # noqa: E402
-
-
 from .store import load, load_trajectory  # noqa: E402  (results files of sweeps)
 from .scheduler import run_sweep  # noqa: E402  (the Python entry point of `sweep run`)
+
+__all__ = ["InputError", "PRESETS", "Numerics", "Result", "Scene", "scene_id", "simulate",
+           "warm_up", "load", "load_trajectory", "run_sweep", "__version__"]

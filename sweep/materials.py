@@ -1322,7 +1322,7 @@ class _Fitter:
         if idx.size:
             idx = idx[np.argsort(r[idx])[-6:]]
             x = np.log(tc)
-            x0, x1, x2 = x[idx - 1], x[idx], x[idx + 1]
+            x1, x2 = x[idx], x[idx + 1]
             f0, f1, f2 = r[idx - 1], r[idx], r[idx + 1]
             den = (f0 - 2.0 * f1 + f2)
             with np.errstate(divide="ignore", invalid="ignore"):
