@@ -34,6 +34,7 @@ from kernels.solve import (N_STATS, RECOVERY, RECOVERY_FLOOR, STAT_FACTOR, STAT_
 
 from . import units
 from .scene import Numerics, Result, Scene
+from .theory import jkr_contact_radius
 
 #: Newton iterations per solve: a good step converges in 2-5 (quadratic predictor); a solve
 #: that needs more is better retried with a smaller step or taken for a fold
@@ -63,23 +64,15 @@ def lj_constants(mu: float) -> tuple[float, float]:
 
 # ----------------------------------------------------------------------------- JKR guess
 
-def jkr_radius_from_indentation(delta: float) -> float:
-    """Largest root a of delta = a^2 - sqrt(2a) (the stable JKR branch); 0 if none."""
-    if delta < -0.75:
-        return 0.0
-    lo, hi = 0.5, max(2.0, math.sqrt(abs(delta)) + 2.0)
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if mid * mid - math.sqrt(2.0 * mid) < delta:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+def jkr_radius(delta: float) -> float:
+    """JKR contact radius at indentation ``delta`` (stable branch); 0 below the fixed-grip
+    fold delta = -3/4, where JKR has no contact."""
+    return float(jkr_contact_radius(indentation=delta)) if delta >= -0.75 else 0.0
 
 
 def jkr_gap_guess(r: np.ndarray, delta: float, h0: float) -> np.ndarray:
     """JKR gap (Hertz + flat-punch deflection) at indentation ``delta``, floored at h0."""
-    a = jkr_radius_from_indentation(delta)
+    a = jkr_radius(delta)
     rigid = -delta + h0 + 0.5 * r**2
     if a <= 0.0:
         return np.maximum(rigid, h0)
@@ -214,7 +207,7 @@ def auto_domain(scene: Scene, numerics: Numerics, delta0_estimate: float) -> flo
     """Mesh radius: the rigid gap r^2/2 - delta0 reaches ``tail_gap`` h0 at the edge."""
     h0 = units.h0_hat(scene.mu)
     r_tail = math.sqrt(2.0 * (max(delta0_estimate, 0.0) + numerics.tail_gap * h0))
-    a_est = jkr_radius_from_indentation(delta0_estimate) if scene.a0 is None else scene.a0
+    a_est = jkr_radius(delta0_estimate) if scene.a0 is None else scene.a0
     return max(r_tail, 1.3 * a_est + 0.5)
 
 
@@ -365,7 +358,7 @@ def _simulate(scene: Scene, numerics: Numerics, res: Result) -> None:
     res.steps = n - 1
     res.newton_iterations = int(stats[STAT_ITER])
     res.factorizations = int(stats[STAT_FACTOR])
-    _finish(res, scene, status, t, delta, P, a, a_inner, dr, h0)
+    _finish(res, scene, status, t, delta, P, a, a_inner, dr)
 
 
 def _past_pull_off(P) -> bool:
@@ -376,7 +369,7 @@ def _past_pull_off(P) -> bool:
             and P[-1] - P[i] > max(RECOVERY * abs(P[i]), RECOVERY_FLOOR))
 
 
-def _finish(res, scene, status, t, delta, P, a, a_inner, dr, h0):
+def _finish(res, scene, status, t, delta, P, a, a_inner, dr):
     i, t_star, P_star = refine_minimum(t, P)
     passed = _past_pull_off(P)
     if status == STATUS_DOMAIN:
@@ -474,8 +467,7 @@ def _unload_exact(A, dr, wP, h_init, delta0, scene, numerics, h0, c, material, s
         if a_new >= (N - 1) * dr:
             return STATUS_DOMAIN, n
         if stop_mode == 0:
-            if (P_min < 0 and n - 1 - i_min >= 5
-                    and P - P_min > max(RECOVERY * abs(P_min), RECOVERY_FLOOR)):
+            if _past_pull_off(P_out[:n]):
                 return STATUS_DONE, n
             if a_new == 0.0 and n - 1 - i_min >= 1:
                 return STATUS_DONE, n
