@@ -317,7 +317,8 @@ def bench_scene(repeat: int = 3, compile_: bool = True) -> dict:
     return report
 
 
-REFERENCE_YAML = ROOT.parent / "shared" / "reference" / "independent_solutions.yaml"
+#: the independent solver's values, kept with the tests (tests/data/README.md says where from)
+REFERENCE_YAML = ROOT / "tests" / "data" / "independent_solutions.yaml"
 
 
 def bench_presets(repeat: int = 1) -> dict:

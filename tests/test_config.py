@@ -6,15 +6,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
+from tests import reference
 from sweep.config import AXIS_DEFAULTS, config_from_dict, load_config, parse_config
 from sweep.errors import InputError
 from sweep.scene import Numerics, Scene, scene_id
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"
-PAPER = Path("/work/shared/reference/paper_values.yaml")
 
 
 def base(**over):
@@ -242,7 +241,7 @@ def test_v_vs_r_campaign():
 def test_fig3_matches_paper_panels():
     cfg = load_config(CONFIGS / "fig3.yaml")
     assert cfg.trajectories is True
-    fig3 = yaml.safe_load(PAPER.read_text())["fig3_trajectories"]
+    fig3 = reference.paper_values()["fig3_trajectories"]
     want = set()
     for panel in ("a", "b", "c"):
         p = fig3[panel]

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy import integrate, special
 
-import naive_materials as nv
+from tests import naive_materials as nv
 from sweep.errors import InputError
 from sweep.materials import (
     SLS,

@@ -2,34 +2,25 @@
 
 Against closed forms (uniform-disc and Hertz deflections, JKR, the LJ work of adhesion, the
 MPL compliance as a Gamma average, the SLS recursion) and against the independent solver's
-numbers in /work/shared/reference/independent_solutions.yaml. Quick suite ~30 s on one core;
+numbers in tests/data/independent_solutions.yaml. Quick suite ~30 s on one core;
 the fine-mesh comparisons are marked slow.
 """
 from __future__ import annotations
 
 import math
-import os
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from scipy import integrate
 
-sys.path.insert(0, os.path.dirname(__file__))
-import naive as nv  # noqa: E402
+from tests import naive as nv
 
-from sweep.errors import InputError  # noqa: E402
-
-REF_PATH = Path("/work/shared/reference/independent_solutions.yaml")
-
+from tests import reference
+from sweep.errors import InputError
 
 @pytest.fixture(scope="module")
 def ref():
-    if not REF_PATH.exists():
-        pytest.skip("independent_solutions.yaml not available")
-    return yaml.safe_load(REF_PATH.read_text())
+    return reference.independent_solutions()
 
 
 def _case(ref, name):

@@ -1,29 +1,23 @@
 """The single-scene BEM solver against independent values, limits and the paper's trends.
 
-Reference values: ../shared/reference/independent_solutions.yaml (an independent solver with
+Reference values: tests/data/independent_solutions.yaml (an independent solver with
 the exact hereditary integral, N = 1000..2000). Tolerances reflect OUR discretization
 (N = 500 on the automatic domain, spacing ~0.012): measured differences are < 0.1 %.
 """
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
+from tests import reference
 from sweep import Numerics, Scene, simulate
 from sweep.errors import InputError
 from sweep.theory import jkr_load
 
-REF = Path(__file__).resolve().parents[2] / "shared" / "reference" / "independent_solutions.yaml"
-
-
 def _ref():
-    if not REF.exists():
-        pytest.skip("shared/reference/independent_solutions.yaml not beside the checkout")
-    return yaml.safe_load(REF.read_text())
+    return reference.independent_solutions()
 
 
 def elastic(mu, a0=2.0, **num):

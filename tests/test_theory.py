@@ -5,16 +5,15 @@ integrand in the original variable, the paper's Appendix-B closed form, asymptot
 expansions derived by hand (docstrings of the tests), or a scalar brentq solve.
 """
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from scipy.integrate import quad
 from scipy.optimize import brentq
 from scipy.special import gamma as gamma_fn
 from scipy.special import roots_genlaguerre
 
+from tests import reference
 from sweep import theory
 from sweep.errors import InputError
 from sweep.theory import (
@@ -31,7 +30,6 @@ from sweep.theory import (
     pb_integral_closed_form,
 )
 
-PAPER = Path(__file__).resolve().parents[2] / "shared" / "reference" / "paper_values.yaml"
 
 
 # --------------------------------------------------------------------------------------------
@@ -349,12 +347,9 @@ def test_gent_schultz():
 
 
 def test_paper_v_vs_r_fit():
-    if PAPER.exists():
-        fit = yaml.safe_load(PAPER.read_text())["pb_theory"]["v_vs_r_fit"]
-        assert paper_v_vs_r_fit(1.0) == pytest.approx(fit["prefactor"])
-        assert paper_v_vs_r_fit(10.0) / paper_v_vs_r_fit(1.0) == pytest.approx(
-            10 ** fit["exponent"]
-        )
+    fit = reference.paper_values()["pb_theory"]["v_vs_r_fit"]
+    assert paper_v_vs_r_fit(1.0) == pytest.approx(fit["prefactor"])
+    assert paper_v_vs_r_fit(10.0) / paper_v_vs_r_fit(1.0) == pytest.approx(10 ** fit["exponent"])
     assert paper_v_vs_r_fit(2.0, prefactor=1.0, exponent=1.0) == 2.0
     with pytest.raises(InputError, match=r"^rhat_pb must be >= 0"):
         paper_v_vs_r_fit(-1.0)

@@ -1,22 +1,16 @@
 """Dimensionless <-> physical conversions (sweep.units), DESIGN.md section 2."""
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
+from tests import reference
 from sweep import units
 from sweep.errors import InputError
 from sweep.units import PhysicalScale
 
-PAPER = Path(__file__).resolve().parents[2] / "shared" / "reference" / "paper_values.yaml"
-
-
 def _paper():
-    if not PAPER.exists():
-        pytest.skip("shared/reference/paper_values.yaml not available")
-    return yaml.safe_load(PAPER.read_text())
+    return reference.paper_values()
 
 
 # the paper's PDMS (section "Experimental adhesion tests"), SI units; the expected values
