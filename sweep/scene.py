@@ -204,6 +204,21 @@ class Numerics:
         return cls(**d)
 
 
+#: Version of the id form below. Version 1: the JSON of ``{"scene": ..., "numerics": ...}``
+#: with every field of :data:`ID_V1_FIELDS` and, of fields added since, those not at their
+#: default. A change of the form itself (not the addition of a defaulted field, which keeps
+#: every id) must raise this number and teach :mod:`sweep.store` to migrate older files.
+SCENE_ID_VERSION = 1
+
+#: The fields of Scene and Numerics when ids were introduced (version 1). They are always
+#: part of the id, so that the ids of files written then stay what they were.
+ID_V1_FIELDS = {
+    "scene": ("n", "k", "mu", "rate", "a0", "delta0", "material", "stop"),
+    "numerics": ("nodes", "domain", "tail_gap", "step", "min_step", "da_max", "prony_rtol",
+                 "tol", "max_steps", "exact", "zone_nodes"),
+}
+
+
 def _canonical(obj) -> str:
     def norm(v):
         if isinstance(v, float):
@@ -214,13 +229,32 @@ def _canonical(obj) -> str:
     return json.dumps(norm(obj), sort_keys=True, separators=(",", ":"))
 
 
+def id_form(obj, always=()) -> dict:
+    """The fields of a Scene or Numerics that enter its id.
+
+    Every field named in ``always`` (the version-1 fields), and any other field whose value
+    differs from its declared default: a field added later with a default therefore leaves
+    the ids of all existing scenes unchanged. Never change such a field's default (the old
+    default would then be read as the new one); add a field instead.
+    """
+    out = {}
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if f.name in always or f.default is dataclasses.MISSING or value != f.default:
+            out[f.name] = value
+    return out
+
+
 def scene_id(scene: Scene, numerics: Numerics) -> str:
     """Stable id of a (scene, numerics) pair: 16 hex digits of the SHA-1 of canonical JSON.
 
     The same parameters always map to the same id (sorted keys, repr'd floats), which
-    makes resume and de-duplication of sweeps trivial.
+    makes resume and de-duplication of sweeps trivial. The hashed form is that of
+    :data:`SCENE_ID_VERSION` (see :func:`id_form`): adding a field with a default to Scene or
+    Numerics renames no scene, so existing results files keep resuming.
     """
-    text = _canonical({"scene": scene.to_dict(), "numerics": numerics.to_dict()})
+    text = _canonical({"scene": id_form(scene, ID_V1_FIELDS["scene"]),
+                       "numerics": id_form(numerics, ID_V1_FIELDS["numerics"])})
     return hashlib.sha1(text.encode()).hexdigest()[:16]
 
 

@@ -45,7 +45,10 @@ File contents (plain arrays and text only; no pickles):
   ``config_text``, ``config_source``, ``package_version``, ``git_commit``, ``numba_version``,
   ``numpy_version``, ``h5py_version``, ``python_version``, ``started_at``, ``updated_at``,
   ``finished_at`` (ISO 8601 UTC; ``finished_at`` is empty until every scene is done),
-  ``n_scenes`` (size of the grid), ``n_finished``, ``complete``, ``trajectories``.
+  ``n_scenes`` (size of the grid), ``n_finished``, ``complete``, ``trajectories``,
+  ``scene_id_version`` (:data:`sweep.scene.SCENE_ID_VERSION`; absent in files written before
+  it was recorded, which are version 1). A file of a newer id version is refused for resuming
+  (one-line error, file untouched); it still loads.
 """
 from __future__ import annotations
 
@@ -66,6 +69,7 @@ import h5py
 import numpy as np
 
 from .errors import InputError
+from .scene import SCENE_ID_VERSION
 
 try:
     import fcntl
@@ -390,7 +394,7 @@ class ResultStore:
             "config_name": config_name, "config_hash": config_hash,
             "config_text": config_text, "config_source": config_source,
             "n_scenes": int(n_scenes), "trajectories": bool(trajectories),
-            "started_at": now_iso(),
+            "scene_id_version": SCENE_ID_VERSION, "started_at": now_iso(),
         }
         self.trajectories = bool(trajectories)
         self.template = plain_row(template_row or {"scene_id": ""})
@@ -440,7 +444,11 @@ class ResultStore:
             self._lock_fd = None
 
     # -- checks -----------------------------------------------------------------
-    def _existing_hashes(self) -> list[tuple[str, str]]:
+    def _existing_hashes(self) -> list[tuple[str, str, int]]:
+        """(where, config hash, scene id version) of the main file and the journal's meta.
+
+        Files written before the id version was recorded are version 1.
+        """
         found = []
         if self.path.exists():
             if self.path.is_dir():
@@ -448,7 +456,8 @@ class ResultStore:
                                  f"such as {self.path}/results.h5")
             try:
                 with _open_main(self.path) as f:
-                    found.append((str(self.path), str(f.attrs.get("config_hash", ""))))
+                    found.append((str(self.path), str(f.attrs.get("config_hash", "")),
+                                  int(f.attrs.get("scene_id_version", 1))))
             except InputError as exc:
                 raise InputError(f"{exc}; refusing to overwrite it: use --out to write "
                                  f"elsewhere, or --fresh to move it aside to a .bak file") \
@@ -456,9 +465,11 @@ class ResultStore:
         meta = self.parts / META
         if meta.exists():
             try:
-                found.append((str(self.parts), json.loads(meta.read_text())["config_hash"]))
-            except (ValueError, KeyError, OSError):
-                found.append((str(self.parts), "?"))
+                m = json.loads(meta.read_text())
+                found.append((str(self.parts), m["config_hash"],
+                              int(m.get("scene_id_version", 1))))
+            except (ValueError, KeyError, OSError, TypeError):
+                found.append((str(self.parts), "?", 1))
         return found
 
     def prepare(self, resume: bool = True) -> None:
@@ -472,7 +483,12 @@ class ResultStore:
             hashes = self._existing_hashes() if resume else []
             if not resume and self.path.is_dir():
                 raise InputError(f"output {self.path} is a directory; give a file path")
-            for where, h in hashes:
+            for where, h, version in hashes:
+                if version > SCENE_ID_VERSION:
+                    raise InputError(
+                        f"{where} was written with scene id version {version}, newer than this "
+                        f"visco-sweep's {SCENE_ID_VERSION}: resume it with the version that "
+                        f"wrote it, or use --out to write elsewhere")
                 if h != self.config_hash:
                     raise InputError(
                         f"{where} holds results of a different config (config hash {h}, this "
