@@ -1,7 +1,7 @@
 """Linear viscoelastic materials: creep, relaxation, complex moduli and Prony fits.
 
-Conventions (DESIGN.md section 3; binding for every material here)
-------------------------------------------------------------------
+Conventions (docs/design.md section 3; binding for every material here)
+------------------------------------------------------------------------
 * ``E0`` is the RELAXED (long-time, rubbery) modulus and ``Einf`` the GLASSY (instantaneous)
   modulus, ``Einf >= E0 > 0``; ``k = E0 / Einf`` in (0, 1].  ``C0 = 1/E0`` and
   ``Cinf = 1/Einf`` are the relaxed and glassy compliances.  (Beware: some libraries call the
@@ -14,7 +14,7 @@ Conventions (DESIGN.md section 3; binding for every material here)
   normalized relaxation modulus is ``Rhat(that) = R(t) / E0``: ``Rhat(0) = 1/k``,
   ``Rhat(inf) = 1``.
 * Integrated compliance ``Psi(T) = int_0^T Chat(s) ds`` (``T`` in units of tau0), used by the
-  exact-convolution reference solver (DESIGN.md section 4).
+  exact-convolution reference solver (docs/design.md section 4).
 * Frequency domain (paper, appendix A): complex modulus ``E(omega) = E' + i E''`` and complex
   compliance ``C(omega) = C' - i C'' = 1 / E(omega)``, with ``E'' >= 0`` and ``C'' >= 0``
   (harmonic time factor ``exp(i omega t)``).
@@ -23,7 +23,7 @@ Models
 ------
 ``MPLRetardation``
     modified power law RETARDATION spectrum (paper eq. retspec; the model of the BEM, of the
-    Persson-Brener theory and of DESIGN.md): the retardation times, in units of tau0, are
+    Persson-Brener theory; docs/design.md section 3): the retardation times, in units of tau0, are
     Gamma(n, 1) distributed, ``Chat(t) = 1 - (1-k) 2 t^(n/2) K_n(2 sqrt t) / Gamma(n)``.
     Creep and complex compliance in closed form; relaxation modulus numerical.
 ``MPLRelaxation``
@@ -41,7 +41,7 @@ Models
 
 Every material has ``.prony(t_min, t_max, rtol)``, which returns the :class:`PronySeries` with
 the fewest terms found that approximates ``Chat`` on ``[t_min, t_max]`` (units of tau0) within
-the relative error ``rtol``; the series drives the O(N) hereditary recursion of DESIGN.md
+the relative error ``rtol``; the series drives the O(N) hereditary recursion of docs/design.md
 section 4.
 
 "Numerical" above means: the Gamma-distributed spectrum is discretized by the trapezoidal rule
@@ -657,7 +657,7 @@ class PronySeries:
     times : ndarray
         ``tau_i > 0`` in units of tau0, ascending.  ``inf`` marks the lumped glassy term: the
         modes slower than the window act as a constant ``c`` there (in the recursion of
-        DESIGN.md section 4 it has ``e_i = b_i = 1``).  Modes faster than the window are lumped
+        docs/design.md section 4 it has ``e_i = b_i = 1``).  Modes faster than the window are lumped
         as relaxed, i.e. dropped.
     max_rel_error : float
         Achieved ``max |series - Chat| / Chat`` over ``[t_min, t_max]``, measured on a log grid
@@ -874,7 +874,7 @@ class MPLRetardation(_MPL):
       ``C(omega) = Cinf + (C0 - Cinf)/(i w) exp(-i/w) E_n(-i/w)``, ``w = omega tau0``,
       with the generalized exponential integral of imaginary argument (:func:`expint`);
     * ``complex_modulus = 1/complex_compliance``;
-    * integrated compliance (DESIGN.md section 4), closed form.
+    * integrated compliance (docs/design.md section 3), closed form.
 
     The relaxation modulus has no closed form: it is computed NUMERICALLY (the Gamma
     retardation spectrum discretized on a log lattice and the Kelvin table converted exactly to
@@ -1007,9 +1007,8 @@ class SLS(_Material):
     ``R(t) = E0 + (Einf - E0) exp(-t/(k tau0))`` (relaxation time ``k tau0``),
     ``Psi(T) = k T + (1-k)(T - 1 + exp(-T))``.  All closed form.
 
-    Note: DESIGN.md section 2 calls tau0 the "SLS relaxation time" but section 3 and the
-    paper's dimensionless SLS use ``Chat = 1 - (1-k) exp(-t)``, i.e. tau0 is the retardation
-    (creep) time.  This class follows section 3.
+    tau0 is the retardation (creep) time, as in the paper's dimensionless SLS
+    ``Chat = 1 - (1-k) exp(-t)`` (docs/design.md section 3).
     """
 
     def __init__(self, E0, Einf, tau0):

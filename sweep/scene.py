@@ -1,6 +1,6 @@
 """Plain, serializable values that describe one simulation: ``Scene``, ``Numerics``, ``Result``.
 
-Units are those of DESIGN.md section 2 (see :mod:`sweep.units`):
+Units are those of docs/design.md section 2 (see :mod:`sweep.units`):
 
 * radii ``a0`` in ``a_ref = (pi R^2 dg / E0*)^(1/3)``;
 * indentation ``delta0`` in ``d_ref = a_ref^2 / R`` (the paper's delta-hat);
@@ -147,7 +147,7 @@ class Numerics:
         of the Prony recursion. For validation on small problems.
     zone_nodes : float
         Fewest node spacings across the cohesive (process) zone, l0 = 1.693/mu^2 a_ref
-        (DESIGN.md section 2). A coarser mesh traps the crack tip between nodes (jagged
+        (docs/design.md section 2). A coarser mesh traps the crack tip between nodes (jagged
         P(t), spurious minima, failed Newton solves), so such a scene is refused with a
         ``failed`` status that says how many nodes it needs.
     """

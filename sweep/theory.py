@@ -1,6 +1,6 @@
 r"""Analytic theory: Persson-Brener effective surface energy, JKR/Hertz, Gent-Schultz.
 
-All quantities are in the dimensionless units of DESIGN.md section 2 (see :mod:`sweep.units`):
+All quantities are in the dimensionless units of docs/design.md section 2 (see :mod:`sweep.units`):
 contact radius ``a`` in ``a_ref``, indentation in ``d_ref``, load in ``pi dg R``; the
 Persson-Brener crack speed is ``vhat = v tau0 / l0``.
 
@@ -358,7 +358,7 @@ def pb_integral_closed_form(n, vhat, gamma, rtol: float = 1e-8):
 
 
 # --------------------------------------------------------------------------------------------
-# JKR and Hertz (units of DESIGN.md section 2: a in a_ref, delta in d_ref, P in pi dg R)
+# JKR and Hertz (units of docs/design.md section 2: a in a_ref, delta in d_ref, P in pi dg R)
 # --------------------------------------------------------------------------------------------
 _SQRT2 = math.sqrt(2.0)
 #: contact radius at the force-controlled pull-off, dP/da = 0: a^(3/2) = 3 sqrt(2) / 4

@@ -151,7 +151,7 @@ def test_jkr_helpers():
 # ----------------------------------------------------------------------------- compliance
 @pytest.mark.parametrize("n,k", [(0.4, 0.1), (0.8, 0.1), (1.0, 0.3), (1.6, 0.1), (2.5, 0.01)])
 def test_mpl_creep_is_gamma_average(n, k):
-    """Chat(t) = 1 - (1-k) E[exp(-t/x)], x ~ Gamma(n, 1) (DESIGN.md section 3)."""
+    """Chat(t) = 1 - (1-k) E[exp(-t/x)], x ~ Gamma(n, 1) (docs/design.md section 3)."""
     for t in (1e-3, 0.1, 1.0, 7.0, 50.0):
         dens = lambda x: x ** (n - 1) * math.exp(-x - t / x) / math.gamma(n)  # noqa: E731
         avg = integrate.quad(dens, 0, np.inf, epsabs=0, epsrel=1e-12, limit=200)[0]
