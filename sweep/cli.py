@@ -51,7 +51,8 @@ def cli():
 
 
 # ----------------------------------------------------------------------------
-# Commands are added below, one section per concept. Edit with str_replace only.
+# Commands, one section per concept. A new command is a new section; shared option
+# parsing lives in the helpers above.
 # ----------------------------------------------------------------------------
 
 # == theory & materials commands (pb, material) ==

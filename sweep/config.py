@@ -49,6 +49,7 @@ import json
 import os
 import re
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -61,7 +62,6 @@ from .scene import MATERIALS, SCENE_LIMITS, STOPS, Numerics, Scene, scene_id
 TOP_KEYS = ("name", "description", "grid", "numerics", "store", "output")
 #: Grid axes, in the order the Cartesian product iterates them (last varies fastest).
 AXES = ("material", "stop", "n", "k", "mu", "a0", "delta0", "rate")
-NUMERIC_AXES = ("n", "k", "mu", "a0", "delta0", "rate")
 #: Defaults of axes left out of a grid.
 AXIS_DEFAULTS = {"k": 0.1, "mu": 3.24, "material": "mpl", "stop": "pulloff"}
 STORE_KEYS = ("trajectories",)
@@ -96,6 +96,11 @@ class SweepConfig:
 
     def tasks(self) -> list[tuple[str, Scene]]:
         """``(scene_id, scene)`` pairs of the sweep, de-duplicated, in grid order."""
+        return list(self._tasks)
+
+    @cached_property
+    def _tasks(self) -> tuple:
+        # the grid is expanded and hashed once per config object (a frozen value)
         seen: dict[str, Scene] = {}
         for grid in self.grids:
             names = [a for a in AXES if a in grid]
@@ -104,9 +109,9 @@ class SweepConfig:
                 sid = scene_id(scene, self.numerics)
                 if sid not in seen:
                     seen[sid] = scene
-        return list(seen.items())
+        return tuple(seen.items())
 
-    @property
+    @cached_property
     def config_hash(self) -> str:
         """Hash of what the results depend on: the scene ids and the trajectory flag.
 

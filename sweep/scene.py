@@ -268,9 +268,6 @@ RESULT_SCALARS = (
     "spacing", "domain_used", "wall_s",
 )
 
-TRAJECTORY_KEYS = ("t", "delta", "P", "a", "a_inner")
-
-
 @dataclass
 class Result:
     """Outcome of one scene. Scalars are NaN when a run failed before reaching them.

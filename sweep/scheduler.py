@@ -42,12 +42,10 @@ from .config import SweepConfig, as_config
 from .errors import InputError, check_int, check_range
 from .scene import Result
 from .store import ResultStore, StoreBusyError, plain_row
+from .threads import THREAD_VARS, limit_env, limit_loaded_pools
 
 BACKENDS = ("loky", "dask")
 PROGRESS_MODES = ("auto", "bar", "log", "none")
-THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
-               "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
-               "NUMBA_NUM_THREADS")
 
 
 class SweepRuntimeError(RuntimeError):
@@ -91,19 +89,12 @@ def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
     if _WORKER_READY:
         return
     if limit_threads:
-        for var in THREAD_VARS:
-            os.environ.setdefault(var, "1")
-        try:
-            from threadpoolctl import threadpool_limits
-
-            threadpool_limits(limits=1)
-        except Exception:  # pragma: no cover - threadpoolctl is a joblib dependency
-            pass
+        limit_env(THREAD_VARS)
+        limit_loaded_pools()
     if warm:
         from . import solver
 
-        if hasattr(solver, "warm_up"):
-            solver.warm_up()
+        solver.warm_up()
     _WORKER_READY = True
 
 
@@ -437,8 +428,7 @@ def _warm_parent() -> None:
         from . import solver
     except ImportError as exc:
         raise SweepRuntimeError(f"cannot import the solver ({exc})") from None
-    if hasattr(solver, "warm_up"):
-        solver.warm_up()
+    solver.warm_up()
 
 
 def _results(todo, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate):
@@ -448,11 +438,7 @@ def _results(todo, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate
     calls = (delayed(run_scene)(scene, cfg.numerics, cfg.trajectories, simulate)
              for _, scene in todo)
     if backend == "loky" and n_jobs == 1:
-        try:
-            from threadpoolctl import threadpool_limits
-            limits = threadpool_limits(limits=1)
-        except Exception:  # pragma: no cover
-            limits = None
+        limits = limit_loaded_pools()
         try:
             for _, scene in todo:
                 yield run_scene(scene, cfg.numerics, cfg.trajectories, simulate,

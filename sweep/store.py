@@ -401,7 +401,6 @@ class ResultStore:
         self.interval = float(interval)
         self.rows: list[dict] = []
         self._ids: dict[str, int] = {}
-        self._in_main: set[str] = set()
         self._lock_fd = None
         self._jfd = None
         self._dirty = False
@@ -516,7 +515,6 @@ class ResultStore:
                 self._main_complete = bool(f.attrs.get("complete", 0))
                 for row in _read_runs_rows(f):
                     self._add(row)
-                self._in_main = set(self._ids)
         meta = self.parts / META
         if meta.exists() and started is None:
             with contextlib.suppress(ValueError, OSError, KeyError):
@@ -548,10 +546,6 @@ class ResultStore:
     def _add(self, row: dict) -> None:
         self._ids[row["scene_id"]] = len(self.rows)
         self.rows.append(row)
-
-    @property
-    def finished(self) -> set[str]:
-        return set(self._ids)
 
     # -- appending --------------------------------------------------------------
     def append(self, row: dict, trajectory: dict | None = None) -> None:
@@ -643,7 +637,6 @@ class ResultStore:
         _fsync_path(tmp)
         os.replace(tmp, self.path)
         _fsync_path(self.path.parent, directory=True)
-        self._in_main = set(self._ids)
         self._dirty = False
         self._main_complete = bool(complete)
         self._last = time.monotonic()

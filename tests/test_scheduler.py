@@ -277,3 +277,13 @@ def test_consolidation_interval(tmp_path):
                   simulate=fake_simulate, progress=watch, consolidate_every=interval)
         assert (max(sizes) > 0) is expect_mid, sizes
         assert len(load(out)) == 6
+
+
+def test_grid_is_expanded_and_hashed_once_per_run(tmp_path, monkeypatch):
+    import sweep.config as config_module
+    calls = []
+    real = config_module.scene_id
+    monkeypatch.setattr(config_module, "scene_id", lambda s, n: calls.append(1) or real(s, n))
+    c = cfg()
+    rep = run_sweep(c, jobs=1, out=tmp_path / "r.h5", simulate=fake_simulate, progress="none")
+    assert rep.total == len(calls) == 4
