@@ -148,15 +148,13 @@ def template_row(config: SweepConfig) -> dict:
 
 
 # ----------------------------------------------------------------------------- progress
-def _fmt_eta(seconds: float) -> str:
-    if not math.isfinite(seconds):
-        return "--:--:--"
-    s = int(round(seconds))
-    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
-
-
 class Progress:
-    """Progress display: one updating line on a TTY ("bar"), one line per scene ("log")."""
+    """Progress display: a tqdm bar on a terminal ("bar"), one line per scene ("log").
+
+    "log" is the mode for files and CI logs (no carriage returns): each finished scene prints
+    ``[done/total] <scene_id> <status> pull_off=... wall=...s`` (and the reason of a failure).
+    A callable ``mode`` gets a dict (done, total, failed, eta, row) after each scene instead.
+    """
 
     def __init__(self, mode, total: int, already: int, stream=None):
         self.stream = stream if stream is not None else sys.stderr
@@ -172,14 +170,19 @@ class Progress:
         self.failed = 0
         self.t0 = time.monotonic()
         self.width = len(str(total))
+        self.bar = None
 
-    def _echo(self, text: str, nl: bool = True) -> None:
-        click.echo(text, file=self.stream, nl=nl)
+    def _echo(self, text: str) -> None:
+        if self.bar is not None:
+            self.bar.write(text, file=self.stream)
+            return
+        click.echo(text, file=self.stream)
         with_flush = getattr(self.stream, "flush", None)
         if with_flush:
             with_flush()
 
     def eta(self) -> float:
+        """Seconds left, from the mean time per scene run so far (inf before the first)."""
         ran = self.done - self.already
         if ran <= 0:
             return math.inf
@@ -189,13 +192,12 @@ class Progress:
         if self.mode != "none":
             self._echo(text)
 
-    def bar_text(self) -> str:
-        return (f"[{self.done:{self.width}d}/{self.total}] {self.failed} failed  "
-                f"ETA {_fmt_eta(self.eta())}")
-
     def start(self) -> None:
         if self.mode == "bar":
-            self._echo("\r" + self.bar_text(), nl=False)
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=self.total, initial=self.already, file=self.stream,
+                            unit="scene", dynamic_ncols=True, postfix="0 failed")
 
     def update(self, row: dict) -> None:
         self.done += 1
@@ -204,8 +206,9 @@ class Progress:
         if self.callback is not None:
             self.callback({"done": self.done, "total": self.total, "failed": self.failed,
                            "eta": self.eta(), "row": row})
-        if self.mode == "bar":
-            self._echo("\r" + self.bar_text() + "   ", nl=False)
+        if self.bar is not None:
+            self.bar.set_postfix_str(f"{self.failed} failed", refresh=False)
+            self.bar.update(1)
         elif self.mode == "log":
             po = row.get("pull_off")
             po = f"{po:.5g}" if isinstance(po, float) else str(po)
@@ -216,8 +219,9 @@ class Progress:
             self._echo(text)
 
     def close(self) -> None:
-        if self.mode == "bar":
-            self._echo("")
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
 
 
 # ----------------------------------------------------------------------------- helpers
