@@ -295,7 +295,7 @@ def main(argv=None) -> int:
     try:
         cli.main(args=argv, standalone_mode=False)
     except InputError as exc:
-        click.echo(f"error: {exc}", err=True)
+        click.echo("error: " + " ".join(str(exc).split()), err=True)   # always one line
         return 2
     except click.exceptions.Abort:
         click.echo("error: aborted", err=True)

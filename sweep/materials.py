@@ -82,6 +82,7 @@ __all__ = [
 ]
 
 N_MAX = 20.0          # largest MPL exponent accepted (tested up to 3; checked to 20)
+MAX_WINDOW_DECADES = 100   # widest Prony window (a scene needs < 25 decades; 50 take ~5 s)
 _EULER = 0.57721566490153286
 
 
@@ -831,6 +832,9 @@ class _Material:
         t_max = check_range("t_max", t_max, 0.0, lo_open=True)
         if not t_max > t_min:
             raise InputError(f"t_max must be > t_min = {t_min:.6g} (got {t_max:.6g})")
+        if math.log10(t_max) - math.log10(t_min) > MAX_WINDOW_DECADES:
+            raise InputError(f"t_max/t_min must be at most 1e{MAX_WINDOW_DECADES:g} (got the "
+                             f"window [{t_min:.3g}, {t_max:.3g}])")
         rtol = check_range("rtol", rtol, 1e-12, 0.5)
         max_terms = 120 if max_terms is None else check_int("max_terms", max_terms, 1, 120)
         return fit_prony(self._chat, t_min, t_max, rtol, self.k, exact=self._kelvin_exact(),

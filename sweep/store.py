@@ -213,10 +213,13 @@ def _read_journal(path: Path) -> list[dict]:
 
 
 def _open_main(path: Path):
+    if path.is_dir():
+        raise InputError(f"{path} is a directory, not a results file (give the .h5 file)")
     try:
         f = h5py.File(path, "r")
     except (OSError, ValueError) as exc:
-        raise InputError(f"{path}: not a readable HDF5 results file ({exc})") from None
+        raise InputError(f"{path}: not a readable HDF5 results file "
+                         f"({' '.join(str(exc).split())})") from None
     if f.attrs.get("format") != FORMAT:
         f.close()
         raise InputError(f"{path}: not a visco-sweep results file (no format attribute "

@@ -313,3 +313,10 @@ def test_sigkill_at_several_moments_then_resume(tmp_path):
             assert snapshot[sid] == fin
     assert not parts_dir(out).exists() and read_attrs(out)["complete"]
     assert f"{len(tasks) - len(final_ids)} already done" in final.stdout
+
+
+def test_info_on_a_directory_is_one_line(tmp_path, capsys):
+    # h5py's message for a directory spans two lines; the CLI prints one
+    assert main(["info", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is a directory" in err
