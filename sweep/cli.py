@@ -13,6 +13,7 @@ import click
 import numpy as np
 
 from .errors import InputError
+from .scene import AXES, PRESETS
 
 
 def parse_floats(name: str, text: str) -> list[float]:
@@ -159,18 +160,36 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
 
 # == single scene command (scene) ==
 
+def scene_options(func):
+    """One option per Scene field, from its metadata (sweep.scene.AXES): name, default,
+    allowed values and help are declared once, in sweep/scene.py."""
+    for a in reversed(list(AXES.values())):
+        if a.numeric:
+            default = a.cli_default if a.required else a.default
+            option = click.option(
+                f"--{a.name}", a.name, type=str,
+                default=None if default is None else format(default, "g"),
+                required=a.required and default is None, show_default=default is not None,
+                help=a.describe() + ".")
+        else:
+            option = click.option(f"--{a.name}", a.name, type=click.Choice(list(a.choices)),
+                                  default=a.default, show_default=True, help=a.describe() + ".")
+        func = option(func)
+    return func
+
+
+def scene_from_options(values: dict):
+    """A Scene from the option strings of :func:`scene_options` (numbers parsed, named)."""
+    from .errors import as_float
+    from .scene import Scene
+
+    return Scene(**{name: as_float(name, v) if AXES[name].numeric and v is not None else v
+                    for name, v in values.items()})
+
+
 @cli.command("scene")
-@click.option("--n", "n", type=str, default="0.8", show_default=True, help="MPL exponent n.")
-@click.option("--k", "k", type=str, default="0.1", show_default=True, help="E0/Einf.")
-@click.option("--mu", "mu", type=str, default="3.24", show_default=True, help="Tabor parameter.")
-@click.option("--a0", "a0", type=str, default=None, help="Initial contact radius (a_ref units).")
-@click.option("--delta0", "delta0", type=str, default=None,
-              help="Initial indentation (d_ref units); alternative to --a0.")
-@click.option("--rate", "rate", type=str, required=True, help="Unloading rate r-hat = r tau0/h0.")
-@click.option("--material", type=click.Choice(["mpl", "sls"]), default="mpl", show_default=True)
-@click.option("--stop", type=click.Choice(["pulloff", "separation"]), default="pulloff",
-              show_default=True)
-@click.option("--preset", type=click.Choice(["fast", "balanced", "accurate"]), default="balanced",
+@scene_options
+@click.option("--preset", type=click.Choice(list(PRESETS)), default="balanced",
               show_default=True)
 @click.option("--nodes", type=str, default=None, help="Override the preset's node count.")
 @click.option("--domain", type=str, default=None, help="Mesh radius (a_ref); default automatic.")
@@ -178,17 +197,13 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
 @click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
-def scene_command(n, k, mu, a0, delta0, rate, material, stop, preset, nodes, domain, step, exact,
-                  as_json, trajectory):
+def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, **axes):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .errors import as_float
-    from .scene import Numerics, Scene
+    from .scene import Numerics
     from .solver import simulate
 
-    sc = Scene(n=as_float("n", n), k=as_float("k", k), mu=as_float("mu", mu),
-               a0=None if a0 is None else as_float("a0", a0),
-               delta0=None if delta0 is None else as_float("delta0", delta0),
-               rate=as_float("rate", rate), material=material, stop=stop)
+    sc = scene_from_options(axes)
     overrides = {}
     if nodes is not None:
         try:

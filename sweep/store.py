@@ -69,7 +69,7 @@ import h5py
 import numpy as np
 
 from .errors import InputError
-from .scene import SCENE_ID_VERSION
+from .scene import SCENE_AXES, SCENE_ID_VERSION
 
 try:
     import fcntl
@@ -670,7 +670,8 @@ class ResultStore:
 
 
 # ----------------------------------------------------------------------------- summary
-SCENE_PARAMS = ("n", "k", "mu", "rate", "a0", "delta0", "material", "stop")
+#: Scene columns of the runs table that ``sweep info`` summarizes (the Scene fields).
+SCENE_PARAMS = SCENE_AXES
 
 
 def _g(x) -> str:

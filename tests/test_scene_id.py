@@ -18,7 +18,7 @@ from tests import reference
 from sweep import Numerics, Scene, scene_id
 from sweep.cli import main
 from sweep.config import parse_config
-from sweep.scene import SCENE_ID_VERSION
+from sweep.scene import SCENE_ID_VERSION, axis
 from sweep.scheduler import run_sweep
 from sweep.store import load, load_trajectory, read_attrs
 
@@ -38,7 +38,7 @@ def test_ids_stay_as_recorded():
 class GrownScene(Scene):
     """Scene with a field added later (as a new physical parameter would be)."""
 
-    adhesion_hysteresis: float = 0.0
+    adhesion_hysteresis: float = axis(0.0, help="a new parameter", limits=(0.0, 1.0), order=8)
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
