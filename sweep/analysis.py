@@ -51,6 +51,7 @@ __all__ = [
     "threshold_analysis",
     "vr_fit",
     "pb_gamma_eff_scene",
+    "pb_points",
     "pb_comparison",
     "best_alpha",
     "vr_analysis",
@@ -461,9 +462,21 @@ def _pb_of(d: pd.DataFrame, vhat: np.ndarray) -> np.ndarray:
     return out
 
 
+def pb_points(points: pd.DataFrame, prefactor: float, exponent: float) -> pd.DataFrame:
+    """``points`` (:func:`paper_variables` rows, any material) with the columns
+    ``vhat_predicted = prefactor rhat_PB^exponent``, ``gamma_pb_measured`` (PB at the
+    measured vhat) and ``gamma_pb_predicted`` (PB at the predicted one)."""
+    d = points.reset_index(drop=True).copy()
+    d["vhat_predicted"] = prefactor * d["rhat_pb"].to_numpy(dtype=float) ** exponent
+    d["gamma_pb_measured"] = _pb_of(d, d["vhat"].to_numpy(dtype=float))
+    d["gamma_pb_predicted"] = _pb_of(d, d["vhat_predicted"].to_numpy())
+    return d
+
+
 def _error_summary(bem: np.ndarray, pb: np.ndarray) -> dict:
     rel = bem / pb - 1.0
-    return {"share_within_15pct": float(np.mean(np.abs(rel) <= 0.15)),
+    return {"n_points": int(rel.size),
+            "share_within_15pct": float(np.mean(np.abs(rel) <= 0.15)),
             "median_abs_error": float(np.median(np.abs(rel))),
             "max_abs_error": float(np.max(np.abs(rel))),
             "rms_log_error": float(np.sqrt(np.mean(np.log(bem / pb) ** 2)))}
@@ -484,10 +497,7 @@ def pb_comparison(df: pd.DataFrame, prefactor: float, exponent: float,
         ``vhat_predicted`` and the scene keys) and, for each way, ``share_within_15pct``,
         ``median_abs_error``, ``max_abs_error``, ``rms_log_error``.
     """
-    d = _vr_points(df, alpha)
-    d["vhat_predicted"] = prefactor * d["rhat_pb"].to_numpy() ** exponent
-    d["gamma_pb_measured"] = _pb_of(d, d["vhat"].to_numpy())
-    d["gamma_pb_predicted"] = _pb_of(d, d["vhat_predicted"].to_numpy())
+    d = pb_points(_vr_points(df, alpha), prefactor, exponent)
     bem = d["gamma_eff"].to_numpy()
     return d, {"measured": _error_summary(bem, d["gamma_pb_measured"].to_numpy()),
                "predicted": _error_summary(bem, d["gamma_pb_predicted"].to_numpy()),

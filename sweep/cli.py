@@ -406,6 +406,16 @@ def fit_vr_cmd(results, saturation, boot, as_json):
                f"{a['rms_log_error_paper_alpha']:.4g})")
 
 
+def _add_reproduce() -> None:
+    """``sweep reproduce ...``: the paper's fits, figures and report (sweep/reproduce.py)."""
+    from .reproduce import cli as reproduce_group
+
+    cli.add_command(reproduce_group, "reproduce")
+
+
+_add_reproduce()
+
+
 def main(argv=None) -> int:
     """Entry point: run the click group, mapping errors to one line + exit code."""
     try:
