@@ -389,7 +389,8 @@ def threshold_analysis(df: pd.DataFrame, slope: float = THRESHOLD_SLOPE,
     table_rows = [
         {"n": r.n, "k": r.k, "mu": r.mu, "material": r.material, "rate": r.rate, "a0t": r.a0t,
          "P_at_a0t": r.pull_off_at_a0t, "P_plateau": r.pull_off_plateau,
-         "a0t_inner": r.a0t_inner, "status": r.status, "peak_a0": r.peak_a0,
+         "a0t_inner": r.a0t_inner, "saturation": r.saturation, "status": r.status,
+         "peak_a0": r.peak_a0,
          "peak_pull_off": r.peak_pull_off, "overshoot": r.overshoot,
          "in_fit": bool(r.status == "interior"
                         and r.pull_off_at_a0t < saturation_fraction * r.saturation)}

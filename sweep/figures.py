@@ -75,7 +75,8 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
     plt = _pyplot()
     ok = runs[runs["status"] == "ok"].sort_values("a0")
     table = pd.DataFrame(fit["table"])
-    fig, axes = plt.subplots(1, 3, figsize=(17, 5.2))
+    fig, axes = plt.subplots(2, 2, figsize=(14, 11))
+    axes = axes.ravel()
     ax = axes[0]
     for n, g in ok[np.isclose(ok["rate"], reference_rate)].groupby("n"):
         row = table[np.isclose(table["n"], n) & np.isclose(table["rate"], reference_rate)]
@@ -88,36 +89,43 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
     ax.legend(fontsize=8)
 
     ax = axes[1]
-    sat = float(table["saturation"].iloc[0]) if "saturation" in table else 15.0
+    sat = float(table["saturation"].iloc[0])
     k_val = float(table["k"].iloc[0])
-    for n, g in table[table["status"] == "interior"].groupby("n"):
+    interior = table[table["status"] == "interior"]
+    for n, g in interior.groupby("n"):
         inf = g[g["in_fit"]]
         ax.loglog(inf["a0t"], inf["P_at_a0t"], _marker(n), color=_color(n), ms=6,
                   label=f"n = {n:g}")
         rest = g[~g["in_fit"]]
         ax.loglog(rest["a0t"], rest["P_at_a0t"], _marker(n), mfc="none", mec=_color(n), ms=6)
-    x = np.linspace(max(0.8, table["a0t"].min() * 0.9), table["a0t"].max() * 1.1, 100)
+    used = table[table["in_fit"]]
+    x = np.linspace(used["a0t"].min(), used["a0t"].max(), 100)
     A, B = fit["prefactor"], fit["exponent"]
     ax.loglog(x, A * x**B, "k--",
               label=rf"fit $\hat P_{{po}} = {A:.3g}\,\hat a_{{0t}}^{{{B:.3g}}}$"
                     rf" (B 95 % CI {fit['exponent_ci'][0]:.2f}-{fit['exponent_ci'][1]:.2f})")
-    ax.loglog(x, paper[0] * x ** paper[1], ":", color="gray",
+    xp = np.linspace(1.0, interior["a0t"].max() * 1.05, 100)
+    ax.loglog(xp, paper[0] * xp ** paper[1], ":", color="gray",
               label=rf"paper $\hat P_{{po}} = {paper[0]}\,\hat a_{{0t}}^{{{paper[1]}}}$")
     ax.axhline(sat, color="tab:blue", lw=1, label=rf"saturation $1.5/k$ = {sat:g} (k = {k_val:g})")
     ax.set_ylim(1.0, sat * 1.6)
     _plain_log_ticks(ax, x=[1, 1.5, 2, 3, 4, 5, 6], y=[1, 2, 3, 5, 10, 15, 20])
     ax.set_xlabel(r"threshold contact radius $\hat a_{0t}$")
-    ax.set_ylabel(r"pull-off force $\hat P_{po}(\hat a_{0t})$")
-    ax.set_title("(b) collapse; open markers: not in the fit")
-    ax.legend(fontsize=7.5, loc="lower right")
-    ins = ax.inset_axes([0.09, 0.58, 0.36, 0.36])
-    for n, g in table[table["status"] == "interior"].groupby("n"):
-        ins.semilogx(g["rate"], g["a0t"], _marker(n), color=_color(n), ms=4, ls="-", lw=0.6)
-    ins.set_xlabel(r"$\hat r$", fontsize=8, labelpad=0)
-    ins.set_ylabel(r"$\hat a_{0t}$", fontsize=8, labelpad=0)
-    ins.tick_params(labelsize=7)
+    ax.set_ylabel(r"pull-off force at the threshold $\hat P_{po}(\hat a_{0t})$")
+    ax.set_title(rf"(b) collapse, every rate $10^0$-$10^6$; open: not fitted ($\geq$ "
+                 rf"{fit['saturation_fraction']:g} x 1.5/k)", fontsize=10)
+    ax.legend(fontsize=8, loc="lower right")
 
     ax = axes[2]
+    for n, g in interior.groupby("n"):
+        ax.semilogx(g["rate"], g["a0t"], _marker(n), color=_color(n), ms=6, ls="-", lw=0.8,
+                    label=f"n = {n:g}")
+    ax.set_xlabel(r"unloading rate $\hat r = r\tau_0/h_0$")
+    ax.set_ylabel(r"threshold contact radius $\hat a_{0t}$")
+    ax.set_title("(b, inset) threshold radius vs rate")
+    ax.legend(fontsize=8)
+
+    ax = axes[3]
     sel = ok[np.isclose(ok["n"], overshoot_n)]
     rates = sorted(sel["rate"].unique())
     cmap = plt.get_cmap("viridis")
@@ -131,7 +139,8 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
     ax.set_xlabel(r"initial contact radius $\hat a_0$")
     ax.set_ylabel(r"pull-off force $\hat P_{po}$")
     ax.set_title(rf"(c) n = {overshoot_n:g}, every rate: overshoot, first crossing taken")
-    ax.legend(fontsize=6.5, ncol=2, loc="lower right")
+    if rates:
+        ax.legend(fontsize=7, ncol=2, loc="lower right")
     fig.tight_layout()
     return _save(fig, out)
 

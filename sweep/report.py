@@ -183,7 +183,7 @@ def _vr_section(vr) -> list[str]:
 def _campaign_table(root: Path) -> list[str]:
     lines = ["## Campaigns: scenes, failures, times", "",
              "| make target | config | scenes | ok | failed | sweep elapsed (first start to "
-             "last scene) | sum of scene walls | last make invocation | engine commit of the runs |",
+             "last scene) | sum of scene walls | last `make` run (a resumed sweep counts only the rest) | engine commit of the runs |",
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     failures = []
     for d, target, cfg, _ in CAMPAIGNS:
