@@ -86,7 +86,7 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
     ax.set_xlabel(r"initial contact radius $\hat a_0$")
     ax.set_ylabel(r"pull-off force $\hat P_{po}$")
     ax.set_title(rf"(a) $\hat r = ${_rate_label(reference_rate)}, k = 0.1, $\mu$ = 3.24")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="center right")
 
     ax = axes[1]
     sat = float(table["saturation"].iloc[0])
