@@ -182,7 +182,7 @@ def _vr_section(vr) -> list[str]:
 
 def _campaign_table(root: Path) -> list[str]:
     lines = ["## Campaigns: scenes, failures, times", "",
-             "| make target | config | scenes | ok | failed | sweep elapsed (first start to "
+             "| make target | config | scenes run (of the grid) | ok | failed | sweep elapsed (first start to "
              "last scene) | sum of scene walls | last `make` run (a resumed sweep counts only the rest) | engine commit of the runs |",
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     failures = []
@@ -193,7 +193,11 @@ def _campaign_table(root: Path) -> list[str]:
             lines.append(f"| `{target}` | `{cfg}` | not run | | | | | | |")
             continue
         c, p = data["cost"], data["provenance"]
-        lines.append(f"| `{target}` | `{cfg}` | {c['scenes']} | {c['ok']} | {c['failed']} | "
+        grid = p.get("n_scenes")
+        done = f"{c['scenes']} of {grid}" if grid else str(c["scenes"])
+        if grid and c["scenes"] < grid:
+            done += " (incomplete)"
+        lines.append(f"| `{target}` | `{cfg}` | {done} | {c['ok']} | {c['failed']} | "
                      f"{_elapsed(p)} | {c['scene_wall_s_sum'] / 60:.1f} min | "
                      f"{_make_wall(root / d)} | `{p.get('git_commit', '-')}` |")
         failures += [f"- `{d}` {f['scene_id']}: {f['reason']}" for f in c["failures"]]
