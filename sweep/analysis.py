@@ -2,7 +2,7 @@ r"""Analysis of sweep results: the paper's variables and fits (pandas in, pandas
 
 Every function takes the runs table of :func:`sweep.load` (one row per scene) or arrays,
 and returns a :class:`pandas.DataFrame` or a plain dict (JSON-ready: floats, lists, str).
-No plotting here (see :mod:`sweep.figures`). Units are those of DESIGN.md section 2:
+No plotting here (see :mod:`sweep.figures`). Units are those of docs/design.md section 2:
 
 ==================  ===========================================================
 column              meaning
