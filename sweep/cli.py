@@ -288,6 +288,73 @@ def info_cmd(results, slowest):
     click.echo(text)
 
 
+# == DMA fitting (fit-dma) ==
+@cli.command("fit-dma")
+@click.argument("csv_file", metavar="FILE.csv")
+@click.option("--tref", "tref", type=str, default="20", show_default=True,
+              help="Reference temperature [C] of a temperature sweep.")
+@click.option("--wlf", "wlf", type=str, default="17.44,51.6,-115", show_default=True,
+              help="WLF constants C1,C2[K],Tg[C] (the paper's eq. aT).")
+@click.option("--maxwell", "arms", type=str, default="18", show_default=True,
+              help="Arms of the generalized Maxwell comparison fit (0: none).")
+@click.option("--plot", "plot_out", default=None, metavar="OUT.png",
+              help="Plot data and both fits (the paper's Fig. EE; needs matplotlib).")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object (SI units).")
+def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
+    """Fit the MPL constants (and a generalized Maxwell model) to DMA data.
+
+    FILE.csv holds a master curve (omega_rad_s,E_storage_Pa,E_loss_Pa) or a temperature
+    sweep (T_C,f_Hz,E_storage_Pa,E_loss_Pa), shifted to --tref with the WLF equation.
+    """
+    from .dma import fit_maxwell, fit_mpl, kramers_kronig_check, plot_dma, read_dma_csv
+    from .errors import as_float, check_int
+
+    c = parse_floats("wlf", wlf)
+    if len(c) != 3:
+        raise InputError(f"wlf must be three numbers C1,C2,Tg (got {wlf!r})")
+    try:
+        n_arms = check_int("maxwell", int(arms.strip()), 0, 200)
+    except ValueError:
+        raise InputError(f"maxwell must be an integer in [0, 200] (got {arms!r})") from None
+    data = read_dma_csv(csv_file, T_ref=as_float("tref", tref), wlf=tuple(c))
+    mpl = fit_mpl(data)
+    mx = fit_maxwell(data, n_arms) if n_arms > 0 else None
+    kk = kramers_kronig_check(data)
+    if plot_out is not None:
+        plot_dma(data, mpl, mx, plot_out)
+    if as_json:
+        out = {"source": csv_file, "kind": data.kind, "points": int(data.omega.size),
+               "omega_min_rad_s": float(data.omega.min()),
+               "omega_max_rad_s": float(data.omega.max()),
+               "T_ref_C": data.T_ref, "wlf": data.wlf,
+               "E0": mpl.E0, "Einf": mpl.Einf, "n": mpl.n, "tau0": mpl.tau0, "k": mpl.k,
+               "mpl": mpl.to_dict(), "maxwell": None if mx is None else mx.to_dict(),
+               "kramers_kronig": kk.to_dict(), "plot": plot_out}
+        echo_json(out)
+        return
+    click.echo(f"# {csv_file}: {data.kind}, {data.omega.size} points, omega "
+               f"{data.omega.min():.3g} .. {data.omega.max():.3g} rad/s"
+               + (f", shifted to {data.T_ref:g} C (WLF C1={c[0]:g}, C2={c[1]:g}, Tg={c[2]:g})"
+                  if data.kind == "temperature" else ""))
+    click.echo("MPL retardation fit (value +- one standard error):")
+    for name, unit in (("E0", "Pa"), ("Einf", "Pa"), ("n", ""), ("tau0", "s")):
+        click.echo(f"  {name:<5} = {getattr(mpl, name):.6g} +- {mpl.stderr[name]:.2g} {unit}")
+    q = mpl.quality
+    click.echo(f"  k = E0/Einf = {mpl.k:.4g}; rms relative residual E' {q['rms_rel_storage']:.3g},"
+               f" E'' {q['rms_rel_loss']:.3g}; converged {mpl.success}")
+    if mx is not None:
+        q = mx.quality
+        click.echo(f"Generalized Maxwell, {n_arms} arms ({q['active_arms']} non-zero): "
+                   f"E0 = {mx.E0:.6g} Pa, Einf = {mx.Einf:.6g} Pa; rms relative residual "
+                   f"E' {q['rms_rel_storage']:.3g}, E'' {q['rms_rel_loss']:.3g}")
+    click.echo(f"Kramers-Kronig: E'' implied by E' differs by {kk.rms_rel:.3g} rms "
+               f"({kk.max_rel:.3g} max) over {kk.interior_points} interior points: "
+               f"{'consistent' if kk.consistent else 'NOT consistent'} "
+               f"(threshold {kk.threshold:g})")
+    if plot_out is not None:
+        click.echo(f"plot: {plot_out}")
+
+
 
 def main(argv=None) -> int:
     """Entry point: run the click group, mapping errors to one line + exit code."""
