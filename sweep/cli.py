@@ -158,14 +158,40 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
 
 # == single scene command (scene) ==
 
+_SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", "indentation",
+               "speed")
+
+
 @cli.command("scene")
-@click.option("--n", "n", type=str, default="0.8", show_default=True, help="MPL exponent n.")
-@click.option("--k", "k", type=str, default="0.1", show_default=True, help="E0/Einf.")
-@click.option("--mu", "mu", type=str, default="3.24", show_default=True, help="Tabor parameter.")
+@click.option("--n", "n", type=str, default=None, help="MPL exponent n.  [default: 0.8]")
+@click.option("--k", "k", type=str, default=None, help="E0/Einf.  [default: 0.1]")
+@click.option("--mu", "mu", type=str, default=None, help="Tabor parameter.  [default: 3.24]")
 @click.option("--a0", "a0", type=str, default=None, help="Initial contact radius (a_ref units).")
 @click.option("--delta0", "delta0", type=str, default=None,
               help="Initial indentation (d_ref units); alternative to --a0.")
-@click.option("--rate", "rate", type=str, required=True, help="Unloading rate r-hat = r tau0/h0.")
+@click.option("--rate", "rate", type=str, default=None,
+              help="Unloading rate r-hat = r tau0/h0 (required without --si).")
+@click.option("--model", type=click.Choice(["bem", "crack", "pb"]), default="bem",
+              show_default=True,
+              help="bem: boundary elements; crack: crack-front model with the PB Gamma(v); "
+                   "pb: the paper's closed-form estimate.")
+@click.option("--si", "si", is_flag=True,
+              help="Give the scene in SI units: --n --R --E0 --Einf --nu --tau0 --dg --h0, one "
+                   "of --preload/--a0-si/--indentation, and --speed (instead of --k --mu --a0 "
+                   "--delta0 --rate).")
+@click.option("--R", "R", type=str, default=None, help="[--si] sphere radius [m].")
+@click.option("--E0", "E0", type=str, default=None, help="[--si] relaxed Young's modulus [Pa].")
+@click.option("--Einf", "Einf", type=str, default=None, help="[--si] glassy Young's modulus [Pa].")
+@click.option("--nu", "nu", type=str, default=None, help="[--si] Poisson's ratio.")
+@click.option("--tau0", "tau0", type=str, default=None, help="[--si] MPL time tau0 [s].")
+@click.option("--dg", "dg", type=str, default=None, help="[--si] work of adhesion [J/m^2].")
+@click.option("--h0", "h0", type=str, default=None, help="[--si] LJ equilibrium distance [m].")
+@click.option("--preload", "preload", type=str, default=None,
+              help="[--si] preload force [N] (relaxed JKR contact at that load).")
+@click.option("--a0-si", "a0_si", type=str, default=None, help="[--si] initial contact radius [m].")
+@click.option("--indentation", "indentation", type=str, default=None,
+              help="[--si] initial indentation [m].")
+@click.option("--speed", "speed", type=str, default=None, help="[--si] unloading speed [m/s].")
 @click.option("--material", type=click.Choice(["mpl", "sls"]), default="mpl", show_default=True)
 @click.option("--stop", type=click.Choice(["pulloff", "separation"]), default="pulloff",
               show_default=True)
@@ -177,14 +203,23 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
 @click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
-def scene_command(n, k, mu, a0, delta0, rate, material, stop, preset, nodes, domain, step, exact,
-                  as_json, trajectory):
+def scene_command(n, k, mu, a0, delta0, rate, model, si, material, stop, preset, nodes, domain,
+                  step, exact, as_json, trajectory, **si_values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .errors import as_float
+    from .models import simulate_model
     from .scene import Numerics, Scene
-    from .solver import simulate
 
-    sc = Scene(n=as_float("n", n), k=as_float("k", k), mu=as_float("mu", mu),
+    if si:
+        _scene_si(n, k, mu, a0, delta0, rate, model, material, as_json, si_values)
+        return
+    given = [f"--{name.replace('_', '-')}" for name, v in si_values.items() if v is not None]
+    if given:
+        raise InputError(f"{', '.join(given)}: SI options need --si")
+    if rate is None:
+        raise InputError("rate must be given (--rate, the unloading rate r-hat > 0)")
+    sc = Scene(n=as_float("n", "0.8" if n is None else n), k=as_float("k", "0.1" if k is None else k),
+               mu=as_float("mu", "3.24" if mu is None else mu),
                a0=None if a0 is None else as_float("a0", a0),
                delta0=None if delta0 is None else as_float("delta0", delta0),
                rate=as_float("rate", rate), material=material, stop=stop)
@@ -201,7 +236,7 @@ def scene_command(n, k, mu, a0, delta0, rate, material, stop, preset, nodes, dom
     if exact:
         overrides["exact"] = True
     num = Numerics.preset(preset, **overrides)
-    res = simulate(sc, num)
+    res = simulate_model(sc, model, num)
     if as_json:
         echo_json(res.to_dict(trajectory=trajectory))
     else:
@@ -221,6 +256,42 @@ def scene_command(n, k, mu, a0, delta0, rate, material, stop, preset, nodes, dom
         click.echo(f"cost       steps={res.steps} newton={res.newton_iterations} "
                    f"factorizations={res.factorizations} wall={res.wall_s:.3f} s")
     if not res.ok:
+        raise SystemExit(1)
+
+
+def _scene_si(n, k, mu, a0, delta0, rate, model, material, as_json, values):
+    """``sweep scene --si``: build an SIScene, run it, print both unit systems."""
+    from .errors import as_float
+    from .si import SIScene, run_si
+
+    dimless = {"k": k, "mu": mu, "a0": a0, "delta0": delta0, "rate": rate}
+    clash = [f"--{name}" for name, v in dimless.items() if v is not None]
+    if clash:
+        raise InputError(f"{', '.join(clash)}: dimensionless options cannot be combined with "
+                         f"--si (give --Einf, --h0, --preload/--a0-si/--indentation, --speed)")
+    required = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "speed")
+    missing = [f"--{name}" for name in required if values[name] is None]
+    if n is None:
+        missing.insert(0, "--n")
+    if missing:
+        raise InputError(f"{', '.join(missing)} must be given with --si")
+    kw = {name: as_float(name, v) for name, v in values.items() if v is not None}
+    if "a0_si" in kw:
+        kw["a0"] = kw.pop("a0_si")
+    out = run_si(SIScene(n=as_float("n", n), material=material, **kw), model)
+    if as_json:
+        echo_json(out)
+    else:
+        click.echo(f"scene      SI -> n={out['scene']['n']:g} k={out['k']:.4g} mu={out['mu']:.4g} "
+                   f"rate={out['rate']:.4g} l0={out['l0_m']:.4g} m a_ref={out['a_ref_m']:.4g} m")
+        click.echo(f"model      {out['model']}  status {out['status']}"
+                   f"{' (' + out['reason'] + ')' if out['reason'] else ''}")
+        if out["status"] == "ok":
+            click.echo(f"pull-off   {out['pull_off_N']:.6g} N = {out['pull_off']:.6g} pi dg R "
+                       f"(relaxed JKR {out['jkr_pull_off_N']:.6g} N)")
+            if out["crack_speed_m_s"] is not None:
+                click.echo(f"crack      v={out['crack_speed_m_s']:.6g} m/s  vhat={out['vhat']:.6g}")
+    if out["status"] != "ok":
         raise SystemExit(1)
 
 
