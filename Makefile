@@ -9,12 +9,13 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow bench bench-convergence clean
+.PHONY: help venv demo test test-slow bench bench-convergence pdms clean
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
 	@echo "make test   - create/update .venv and run the test suite"
 	@echo "make bench  - speed benchmarks (JSON in results/bench/)"
+	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -47,6 +48,9 @@ bench: $(STAMP)
 
 bench-convergence: $(STAMP)
 	$(BIN)/python -m sweep.benchmarks convergence --mu 6 --out results/bench/convergence_mu6.json
+
+pdms: $(STAMP)
+	$(BIN)/python -m sweep.pdms --out results/pdms
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
