@@ -171,10 +171,11 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
               help="Initial indentation (d_ref units); alternative to --a0.")
 @click.option("--rate", "rate", type=str, default=None,
               help="Unloading rate r-hat = r tau0/h0 (required without --si).")
-@click.option("--model", type=click.Choice(["bem", "crack", "pb"]), default="bem",
+@click.option("--model", type=click.Choice(["bem", "crack", "pb", "auto"]), default="bem",
               show_default=True,
               help="bem: boundary elements; crack: crack-front model with the PB Gamma(v); "
-                   "pb: the paper's closed-form estimate.")
+                   "pb: the paper's closed-form estimate; auto: bem if its mesh fits the "
+                   "node count, else crack.")
 @click.option("--si", "si", is_flag=True,
               help="Give the scene in SI units: --n --R --E0 --Einf --nu --tau0 --dg --h0, one "
                    "of --preload/--a0-si/--indentation, and --speed (instead of --k --mu --a0 "
@@ -207,7 +208,7 @@ def scene_command(n, k, mu, a0, delta0, rate, model, si, material, stop, preset,
                   step, exact, as_json, trajectory, **si_values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .errors import as_float
-    from .models import simulate_model
+    from .models import simulate_scene
     from .scene import Numerics, Scene
 
     if si:
@@ -222,7 +223,7 @@ def scene_command(n, k, mu, a0, delta0, rate, model, si, material, stop, preset,
                mu=as_float("mu", "3.24" if mu is None else mu),
                a0=None if a0 is None else as_float("a0", a0),
                delta0=None if delta0 is None else as_float("delta0", delta0),
-               rate=as_float("rate", rate), material=material, stop=stop)
+               rate=as_float("rate", rate), material=material, stop=stop, model=model)
     overrides = {}
     if nodes is not None:
         try:
@@ -236,7 +237,7 @@ def scene_command(n, k, mu, a0, delta0, rate, model, si, material, stop, preset,
     if exact:
         overrides["exact"] = True
     num = Numerics.preset(preset, **overrides)
-    res = simulate_model(sc, model, num)
+    res = simulate_scene(sc, num)
     if as_json:
         echo_json(res.to_dict(trajectory=trajectory))
     else:
@@ -246,6 +247,7 @@ def scene_command(n, k, mu, a0, delta0, rate, model, si, material, stop, preset,
         click.echo(f"numerics   preset={preset} nodes={num.nodes} spacing={res.spacing:.4g} "
                    f"domain={res.domain_used:.4g} prony_terms={res.prony_terms}")
         click.echo(f"status     {res.status}{' (' + res.reason + ')' if res.reason else ''}")
+        click.echo(f"model      {res.model_used}")
         click.echo(f"initial    a0={res.a0_result:.6g} a0_inner={res.a0_inner:.6g} "
                    f"delta0={res.delta0_result:.6g}")
         if res.ok:

@@ -26,6 +26,7 @@ k         0.1       E0/Einf, (0, 1]
 mu        3.24      Tabor parameter, [0.5, 20]
 material  mpl       "mpl" or "sls"
 stop      pulloff   "pulloff" or "separation"
+model     bem       "bem", "crack", "pb" or "auto" (sweep.models)
 ========  ========  =========================================================
 
 The scenes are the Cartesian product of the axes. ``grid`` may also be a *list* of such
@@ -55,7 +56,7 @@ import numpy as np
 import yaml
 
 from .errors import InputError, as_float, check_choice, check_int, check_range
-from .scene import MATERIALS, SCENE_LIMITS, STOPS, Numerics, Scene, scene_id
+from .scene import MATERIALS, MODEL_NAMES, SCENE_LIMITS, STOPS, Numerics, Scene, scene_id
 
 #: Top-level keys of a config file.
 TOP_KEYS = ("name", "description", "grid", "numerics", "store", "output")
@@ -70,6 +71,9 @@ MAX_SCENES = 200_000
 MAX_RANGE_NUM = 10_000
 _NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
 _OPEN_LOW = {"n", "k", "rate"}  # axes whose lower limit is excluded
+# the model axis (sweep.models): first, i.e. slowest-varying; "bem" when left out
+AXES = ("model",) + AXES
+AXIS_DEFAULTS["model"] = "bem"
 
 
 @dataclass(frozen=True)
@@ -199,8 +203,8 @@ def _fmt_choices(items) -> str:
 
 def _axis_values(where: str, axis: str, spec, problems: list[str]) -> tuple | None:
     """Expand one axis spec into a tuple of validated values (None on error)."""
-    if axis in ("material", "stop"):
-        allowed = MATERIALS if axis == "material" else STOPS
+    if axis in ("material", "stop", "model"):
+        allowed = {"material": MATERIALS, "stop": STOPS, "model": MODEL_NAMES}[axis]
         vals = spec if isinstance(spec, list) else [spec]
         if not vals:
             problems.append(f"{where}: must not be an empty list")

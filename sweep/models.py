@@ -11,6 +11,8 @@ crack    the crack-front model (:func:`sweep.crack_front.simulate_crack`): JKR c
 pb       the paper's closed-form estimate (:func:`pb_estimate`): the crack speed at pull-off
          from the paper's fit vhat = 2.887 rhat_PB^1.171, Gamma_PB at that speed, and the
          load-control JKR pull-off with it, P = 1.5 Gamma_PB
+auto     the cheapest model the scene allows (:func:`choose_model`): the BEM where the mesh that
+         resolves l0 fits the numerics' node count, the crack-front model otherwise
 =======  ======================================================================================
 
 Every simulate function takes ``(scene, numerics=None)`` and returns a :class:`sweep.Result`;
@@ -18,13 +20,15 @@ the store and the analysis do not care which ran.
 """
 from __future__ import annotations
 
+import math
 import time
 
 from . import units
 from .errors import check_choice, check_positive
 from .theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 
-__all__ = ["MODELS", "pb_estimate", "simulate_pb", "simulate_model"]
+__all__ = ["MODELS", "pb_estimate", "simulate_pb", "simulate_model", "simulate_scene",
+           "choose_model", "bem_nodes_needed"]
 
 
 def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171) -> dict:
@@ -99,11 +103,45 @@ def _crack(scene, numerics=None):
     return simulate_crack(scene, numerics)
 
 
+def bem_nodes_needed(scene, numerics=None) -> int:
+    """Nodes the BEM needs for ``scene``: its automatic (or given) domain over the spacing at
+    which the process zone ``l0 = 1.693/mu^2`` spans ``numerics.zone_nodes`` spacings."""
+    from .scene import Numerics
+    from .solver import auto_domain
+
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if scene.a0 is not None:
+        d_est = scene.a0**2 - math.sqrt(2.0 * scene.a0)
+    else:
+        d_est = scene.delta0
+    domain = numerics.domain if numerics.domain is not None else \
+        auto_domain(scene, numerics, d_est)
+    return int(math.ceil(domain * numerics.zone_nodes / units.l0_hat(scene.mu))) + 1
+
+
+def choose_model(scene, numerics=None) -> str:
+    """The model "auto" picks: "bem" if its mesh fits ``numerics.nodes``, else "crack"."""
+    from .scene import Numerics
+
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    return "bem" if bem_nodes_needed(scene, numerics) <= numerics.nodes else "crack"
+
+
 #: model name -> simulate(scene, numerics=None) -> Result
 MODELS = {"bem": _bem, "crack": _crack, "pb": simulate_pb}
 
 
 def simulate_model(scene, model: str = "bem", numerics=None):
-    """Run ``scene`` with the named model (one of :data:`MODELS`)."""
-    check_choice("model", model, MODELS)
-    return MODELS[model](scene, numerics)
+    """Run ``scene`` with the named model (one of :data:`MODELS` or "auto"); the result's
+    ``model_used`` says which ran."""
+    check_choice("model", model, (*MODELS, "auto"))
+    if model == "auto":
+        model = choose_model(scene, numerics)
+    res = MODELS[model](scene, numerics)
+    res.model_used = model
+    return res
+
+
+def simulate_scene(scene, numerics=None):
+    """Run ``scene`` with the model it asks for (``scene.model``); what sweeps call."""
+    return simulate_model(scene, scene.model, numerics)

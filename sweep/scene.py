@@ -26,6 +26,8 @@ from .errors import InputError, check_choice, check_int, check_range
 
 MATERIALS = ("mpl", "sls")
 STOPS = ("pulloff", "separation")
+#: Models a scene can ask for (sweep.models maps each to its simulate function).
+MODEL_NAMES = ("bem", "crack", "pb", "auto")
 
 #: Physical ranges accepted by :class:`Scene` (wider than the tested extremes).
 SCENE_LIMITS = {
@@ -65,6 +67,10 @@ class Scene:
     stop : {"pulloff", "separation"}
         Stop right after the load minimum has passed and recovered ("pulloff"), or follow
         the whole curve until the contact is lost ("separation").
+    model : {"bem", "crack", "pb", "auto"}
+        Which model runs the scene (:mod:`sweep.models`): the BEM (default), the crack-front
+        model, the paper's closed-form PB estimate, or "auto" (the BEM where its mesh fits the
+        numerics' node count, else the crack-front model); ``Result.model_used`` records it.
     """
 
     n: float
@@ -75,6 +81,7 @@ class Scene:
     delta0: float | None = None
     material: str = "mpl"
     stop: str = "pulloff"
+    model: str = "bem"
 
     def __post_init__(self):
         lim = SCENE_LIMITS
@@ -92,6 +99,7 @@ class Scene:
             set_("delta0", check_range("delta0", self.delta0, *lim["delta0"]))
         check_choice("material", self.material, MATERIALS)
         check_choice("stop", self.stop, STOPS)
+        check_choice("model", self.model, MODEL_NAMES)
 
     def to_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -232,6 +240,7 @@ RESULT_SCALARS = (
     "a0_result", "a0_inner", "delta0_result",
     "steps", "newton_iterations", "factorizations", "prony_terms", "prony_error",
     "spacing", "domain_used", "wall_s",
+    "model_used",
 )
 
 TRAJECTORY_KEYS = ("t", "delta", "P", "a", "a_inner")
@@ -270,6 +279,9 @@ class Result:
         Node spacing and mesh radius (a_ref units).
     wall_s : float
         Wall-clock time of the run in seconds.
+    model_used : str
+        The model that ran ("bem", "crack", "pb"; "" when a model's simulate function was
+        called directly rather than through :func:`sweep.models.simulate_scene`).
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
     final_gap : ndarray or None
@@ -299,6 +311,7 @@ class Result:
     spacing: float = math.nan
     domain_used: float = math.nan
     wall_s: float = 0.0
+    model_used: str = ""
     trajectory: dict = field(default_factory=dict)
     final_gap: np.ndarray | None = None
 

@@ -25,7 +25,7 @@ from .units import PhysicalScale
 
 __all__ = ["SIScene", "run_si", "SI_MODELS"]
 
-SI_MODELS = ("bem", "crack", "pb")
+SI_MODELS = ("bem", "crack", "pb", "auto")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -165,9 +165,10 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
     Parameters
     ----------
     si : SIScene
-    model : {"bem", "crack", "pb"}
+    model : {"bem", "crack", "pb", "auto"}
         "bem" needs a :class:`sweep.Scene` (its ranges, e.g. mu <= 20); "crack" and "pb" run
-        at any Tabor parameter.
+        at any Tabor parameter; "auto" is :func:`sweep.models.choose_model` within the Scene's
+        ranges and "crack" beyond them (``model`` in the output says which ran).
     numerics : sweep.Numerics, optional
         BEM discretization.
 
@@ -185,6 +186,12 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
 
     model = check_choice("model", model, SI_MODELS)
     d = si.dimensionless()
+    if model == "auto":
+        from .models import choose_model
+        from .scene import SCENE_LIMITS
+
+        lo, hi = SCENE_LIMITS["mu"]
+        model = choose_model(si.to_scene(), numerics) if lo <= d["mu"] <= hi else "crack"
     res = {"model": model}
     if model == "bem":
         try:

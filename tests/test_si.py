@@ -119,3 +119,44 @@ def test_cli_scene_si_errors(capsys, extra, message):
 def test_cli_scene_si_options_need_si(capsys):
     assert main(["scene", "--n", "0.8", "--a0", "2", "--rate", "1", "--R", "1e-3"]) == 2
     assert "--R: SI options need --si" in capsys.readouterr().err
+
+
+def test_scene_model_field_and_auto_choice():
+    from sweep.models import bem_nodes_needed, choose_model, simulate_scene
+    from sweep.scene import Numerics
+
+    assert Scene(n=0.8, a0=3.0, rate=1.0).model == "bem"
+    with pytest.raises(InputError, match="model must be one of bem, crack, pb, auto"):
+        Scene(n=0.8, a0=3.0, rate=1.0, model="fem")
+    small = Scene(n=0.8, k=0.1, mu=3.24, a0=3.0, rate=1.0, model="auto")
+    big = Scene(n=0.8, k=0.1, mu=20.0, a0=8.0, rate=1.0, model="auto")
+    num = Numerics.preset("balanced")
+    # l0 = 1.693/mu^2: 0.16 a_ref at mu = 3.24 (a few hundred nodes), 0.0042 at mu = 20
+    assert bem_nodes_needed(small, num) <= num.nodes < bem_nodes_needed(big, num)
+    assert choose_model(small, num) == "bem" and choose_model(big, num) == "crack"
+    res = simulate_scene(big, num)
+    assert res.ok and res.model_used == "crack" and res.to_row()["model"] == "auto"
+    assert simulate_scene(Scene(n=0.8, a0=3.0, rate=1.0, model="pb")).model_used == "pb"
+
+
+def test_config_model_axis(tmp_path):
+    from sweep.config import parse_config
+
+    cfg = parse_config("name: m\ngrid: {n: 0.8, a0: 3.0, rate: 1, model: [crack, pb]}\n")
+    assert [s.model for s in cfg.scenes()] == ["crack", "pb"]
+    assert parse_config("name: m\ngrid: {n: 0.8, a0: 3.0, rate: 1}\n").scenes()[0].model == "bem"
+    with pytest.raises(InputError, match="model must be one of"):
+        parse_config("name: m\ngrid: {n: 0.8, a0: 3.0, rate: 1, model: fem}\n")
+
+
+def test_sweep_runs_the_scene_models(tmp_path):
+    import sweep
+    from sweep.scheduler import run_sweep
+
+    p = tmp_path / "c.yaml"
+    p.write_text("name: c\ngrid: {n: 0.8, a0: 3.0, rate: [1, 100], model: [crack, pb]}\n"
+                 f"output: {tmp_path / 'c.h5'}\n")
+    run_sweep(str(p), jobs=1, progress="none")
+    df = sweep.load(tmp_path / "c.h5")
+    assert len(df) == 4 and set(df.model_used) == {"crack", "pb"}
+    assert (df.status == "ok").all()
