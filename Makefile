@@ -9,7 +9,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow bench bench-convergence pdms clean
+.PHONY: help venv demo test test-slow bench bench-convergence pdms agreement clean
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
@@ -51,6 +51,9 @@ bench-convergence: $(STAMP)
 
 pdms: $(STAMP)
 	$(BIN)/python -m sweep.pdms --out results/pdms
+
+agreement: $(STAMP)
+	$(BIN)/python -m sweep.agreement --out results/agreement/agreement.json
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
