@@ -172,6 +172,7 @@ def plot(res: dict, out) -> Path:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker  # noqa: F401 - used as matplotlib.ticker
 
     v = np.array(res["speeds_um_s"])
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
@@ -193,6 +194,9 @@ def plot(res: dict, out) -> Path:
     ax2.loglog(vc, g["gamma_gs"], "g--", label="(dg_eff)_GS = 1 + (v/v0)^xi")
     ax2.set_xlabel("crack speed v [um/s]")
     ax2.set_ylabel("dg_eff / dg")
+    ax2.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+    ax2.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax2.set_yticks([1, 1.5, 2, 3, 4, 5, 6])
     ax2.grid(True, which="both", alpha=0.3)
     ax3 = ax2.twinx()
     ax3.semilogx(vc, g["ratio"], "m-", label="ratio GS / lin")
