@@ -45,6 +45,7 @@ import os
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 from scipy.optimize import least_squares, nnls
 
 from .errors import InputError, check_int, check_range
@@ -507,7 +508,16 @@ def kramers_kronig_check(data, threshold: float = 0.1, per_decade: float = 4.0) 
     w = data.omega
     lo, hi = -math.log10(w.max()) - 1.0, -math.log10(w.min()) + 1.0
     times = np.logspace(lo, hi, max(int(round((hi - lo) * per_decade)) + 1, 2))
-    E0, Ei = _nnls_maxwell(w, times, data.E_storage, data.E_loss, loss=False)
+    # E' resampled (monotone cubic in log-log) at 2 per_decade points per decade besides the
+    # data, so that sparse data (a temperature sweep shifts unevenly) do not leave the arms
+    # undetermined
+    lw = np.log(w)
+    keep = np.concatenate([[True], np.diff(lw) > 0])
+    spline = PchipInterpolator(lw[keep], np.log(data.E_storage[keep]))
+    wr = np.union1d(w, np.logspace(math.log10(w.min()), math.log10(w.max()),
+                                   max(int(math.log10(w.max() / w.min()) * 2 * per_decade), 2)))
+    E1r = np.exp(spline(np.log(wr)))
+    E0, Ei = _nnls_maxwell(wr, times, E1r, np.ones_like(wr), loss=False)
     fit = MaxwellFit(E0=float(E0), moduli=Ei, times=times)
     pred = fit.complex_modulus(w).imag
     inner = (w >= 10.0 * w.min()) & (w <= w.max() / 10.0)

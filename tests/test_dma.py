@@ -206,3 +206,23 @@ def test_cli_bad_options(tmp_path, capsys):
     assert "maxwell must be an integer" in capsys.readouterr().err
     assert main(["fit-dma", str(tmp_path / "none.csv")]) == 2
     assert "cannot read the file" in capsys.readouterr().err
+
+
+def test_papers_protocol_sparse_temperature_sweep(tmp_path):
+    # the paper's DMA protocol: -130 .. 20 C in 10 C steps at 1 Hz (16 points over 20
+    # decades after the shift, up to 5 decades apart near Tg), 1 % noise
+    T = np.arange(-130.0, 20.5, 10.0)
+    mat = MPLRetardation(**TRUE)
+    w = 2 * math.pi * 10 ** (wlf_log_shift(T) - wlf_log_shift(20.0))
+    E1, E2 = noisy(mat.complex_modulus(w), 7)
+    p = tmp_path / "protocol.csv"
+    p.write_text("T_C,f_Hz,E_storage_Pa,E_loss_Pa\n" + "".join(
+        f"{float(t)!r},1.0,{float(a)!r},{float(b)!r}\n" for t, a, b in zip(T, E1, E2)))
+    data = read_dma_csv(p)
+    fit = fit_mpl(data)
+    for name, value in TRUE.items():
+        assert getattr(fit, name) == pytest.approx(value, rel=0.03), name
+    assert kramers_kronig_check(data).consistent
+    # the same sweep with the loss modulus of the cold half doubled is flagged
+    bad = DMAData(data.omega, data.E_storage, data.E_loss * np.where(data.omega > 1e6, 2.0, 1.0))
+    assert not kramers_kronig_check(bad).consistent
