@@ -222,11 +222,23 @@ def read_dma_csv(path, T_ref: float = 20.0, wlf=WLF_PAPER) -> DMAData:
 
 
 def _as_data(data) -> DMAData:
+    """A :class:`DMAData` as given, or one built from ``(omega, E', E'')`` arrays: checked
+    (finite, > 0, equal lengths, at least 3 points) and sorted by frequency."""
     if isinstance(data, DMAData):
         return data
-    omega, E1, E2 = data
-    return DMAData(np.asarray(omega, float), np.asarray(E1, float), np.asarray(E2, float),
-                   source="<arrays>")
+    omega, E1, E2 = (np.asarray(x, dtype=float).ravel() for x in data)
+    if not omega.size == E1.size == E2.size:
+        raise InputError(f"omega, E_storage and E_loss must have equal lengths "
+                         f"(got {omega.size}, {E1.size}, {E2.size})")
+    if omega.size < MIN_ROWS:
+        raise InputError(f"omega must hold at least {MIN_ROWS} points (got {omega.size})")
+    for name, x in (("omega", omega), ("E_storage", E1), ("E_loss", E2)):
+        bad = ~(np.isfinite(x) & (x > 0))
+        if bad.any():
+            i = int(np.nonzero(bad)[0][0])
+            raise InputError(f"{name}[{i}] must be a finite number > 0 (got {x[i]:g})")
+    order = np.argsort(omega, kind="stable")
+    return DMAData(omega[order], E1[order], E2[order], source="<arrays>")
 
 
 def _quality(data: DMAData, E_model: np.ndarray) -> dict:

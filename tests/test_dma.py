@@ -226,3 +226,15 @@ def test_papers_protocol_sparse_temperature_sweep(tmp_path):
     # the same sweep with the loss modulus of the cold half doubled is flagged
     bad = DMAData(data.omega, data.E_storage, data.E_loss * np.where(data.omega > 1e6, 2.0, 1.0))
     assert not kramers_kronig_check(bad).consistent
+
+
+def test_array_input_is_sorted_and_checked():
+    w = np.logspace(4, 0, 9)                       # descending, as a temperature sweep gives
+    E = MPLRetardation(1e6, 1e8, 0.4, 1e-2).complex_modulus(w)
+    fit = fit_mpl((w, E.real, E.imag))
+    assert fit.n == pytest.approx(0.4, rel=1e-5)
+    assert kramers_kronig_check((w, E.real, E.imag)).interior_points >= 2
+    with pytest.raises(InputError, match=r"E_loss\[2\] must be a finite number > 0"):
+        fit_mpl((w, E.real, np.where(np.arange(9) == 2, np.nan, E.imag)))
+    with pytest.raises(InputError, match="equal lengths"):
+        fit_maxwell((w, E.real, E.imag[:-1]))
