@@ -104,13 +104,18 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="results/agreement/agreement.json")
     ap.add_argument("--table-only", action="store_true",
                     help="Only rewrite the markdown tables from an existing JSON.")
+    ap.add_argument("--mus", default=None,
+                    help="Comma list of mu for the mu scan (default 3.24,6,10; mu = 15 needs "
+                         "1229 nodes and about half an hour).")
+    ap.add_argument("--no-a0-scan", action="store_true", help="Skip the a0 scan at mu = 3.24.")
     args = ap.parse_args(argv)
     out = Path(args.out)
     os.makedirs(out.parent, exist_ok=True)
     if args.table_only:
         res = json.loads(out.read_text())
     else:
-        res = run()
+        mus = MUS if args.mus is None else tuple(float(x) for x in args.mus.split(","))
+        res = run(a0s=() if args.no_a0_scan else A0S, mus=mus)
         tmp = out.with_suffix(".json.tmp")
         tmp.write_text(json.dumps(res, indent=1) + "\n")
         os.replace(tmp, out)
