@@ -10,7 +10,7 @@ export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-convergence clean \
-        threshold vr fig3 figures report reproduce
+        threshold vr fig3 figures report reproduce pdms agreement
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
@@ -19,6 +19,7 @@ help:
 	@echo "make coverage-kernels - kernel tests with NUMBA_DISABLE_JIT=1 under coverage"
 	@echo "make reproduce - the paper's campaigns, fits, figures and results/REPORT.md"
 	@echo "               (make threshold | vr | fig3 | figures | report; QUICK=1: thinned grids)"
+	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -101,6 +102,12 @@ report: $(STAMP)
 
 reproduce: threshold vr figures
 	@$(MAKE) --no-print-directory report
+
+pdms: $(STAMP)
+	$(BIN)/python -m sweep.pdms --out results/pdms
+
+agreement: $(STAMP)
+	$(BIN)/python -m sweep.agreement --out results/agreement/agreement.json
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache .coverage

@@ -169,7 +169,7 @@ def scene_options(func):
             option = click.option(
                 f"--{a.name}", a.name, type=str,
                 default=None if default is None else format(default, "g"),
-                required=a.required and default is None, show_default=default is not None,
+                show_default=default is not None,
                 help=a.describe() + ".")
         else:
             option = click.option(f"--{a.name}", a.name, type=click.Choice(list(a.choices)),
@@ -187,8 +187,29 @@ def scene_from_options(values: dict):
                     for name, v in values.items()})
 
 
+_SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", "indentation",
+               "speed")
+
+
 @cli.command("scene")
 @scene_options
+@click.option("--si", "si", is_flag=True,
+              help="Give the scene in SI units: --n --R --E0 --Einf --nu --tau0 --dg --h0, one "
+                   "of --preload/--a0-si/--indentation, and --speed (instead of --k --mu --a0 "
+                   "--delta0 --rate).")
+@click.option("--R", "R", type=str, default=None, help="[--si] sphere radius [m].")
+@click.option("--E0", "E0", type=str, default=None, help="[--si] relaxed Young's modulus [Pa].")
+@click.option("--Einf", "Einf", type=str, default=None, help="[--si] glassy Young's modulus [Pa].")
+@click.option("--nu", "nu", type=str, default=None, help="[--si] Poisson's ratio.")
+@click.option("--tau0", "tau0", type=str, default=None, help="[--si] MPL time tau0 [s].")
+@click.option("--dg", "dg", type=str, default=None, help="[--si] work of adhesion [J/m^2].")
+@click.option("--h0", "h0", type=str, default=None, help="[--si] LJ equilibrium distance [m].")
+@click.option("--preload", "preload", type=str, default=None,
+              help="[--si] preload force [N] (relaxed JKR contact at that load).")
+@click.option("--a0-si", "a0_si", type=str, default=None, help="[--si] initial contact radius [m].")
+@click.option("--indentation", "indentation", type=str, default=None,
+              help="[--si] initial indentation [m].")
+@click.option("--speed", "speed", type=str, default=None, help="[--si] unloading speed [m/s].")
 @click.option("--preset", type=click.Choice(list(PRESETS)), default="balanced",
               show_default=True)
 @click.option("--nodes", type=str, default=None, help="Override the preset's node count.")
@@ -197,12 +218,24 @@ def scene_from_options(values: dict):
 @click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
-def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, **axes):
+def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, **values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .errors import as_float
+    from .models import simulate_scene
     from .scene import Numerics
-    from .solver import simulate
 
+    si_values = {name: values.pop(name) for name in _SI_OPTIONS}
+    axes = values
+    if si:
+        _scene_si(axes, as_json, si_values)
+        return
+    given = [f"--{name.replace('_', '-')}" for name, v in si_values.items() if v is not None]
+    if given:
+        raise InputError(f"{', '.join(given)}: SI options need --si")
+    missing = [f"--{a.name}" for a in AXES.values()
+               if a.required and a.cli_default is None and axes[a.name] is None]
+    if missing:
+        raise InputError(f"{', '.join(missing)} must be given (or use --si)")
     sc = scene_from_options(axes)
     overrides = {}
     if nodes is not None:
@@ -217,7 +250,7 @@ def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, **axe
     if exact:
         overrides["exact"] = True
     num = Numerics.preset(preset, **overrides)
-    res = simulate(sc, num)
+    res = simulate_scene(sc, num)
     if as_json:
         echo_json(res.to_dict(trajectory=trajectory))
     else:
@@ -227,6 +260,7 @@ def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, **axe
         click.echo(f"numerics   preset={preset} nodes={num.nodes} spacing={res.spacing:.4g} "
                    f"domain={res.domain_used:.4g} prony_terms={res.prony_terms}")
         click.echo(f"status     {res.status}{' (' + res.reason + ')' if res.reason else ''}")
+        click.echo(f"model      {res.model_used}")
         click.echo(f"initial    a0={res.a0_result:.6g} a0_inner={res.a0_inner:.6g} "
                    f"delta0={res.delta0_result:.6g}")
         if res.ok:
@@ -237,6 +271,46 @@ def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, **axe
         click.echo(f"cost       steps={res.steps} newton={res.newton_iterations} "
                    f"factorizations={res.factorizations} wall={res.wall_s:.3f} s")
     if not res.ok:
+        raise SystemExit(1)
+
+
+def _scene_si(axes, as_json, values):
+    """``sweep scene --si``: build an SIScene, run it, print both unit systems."""
+    from click.core import ParameterSource
+
+    from .errors import as_float
+    from .si import SIScene, run_si
+
+    ctx = click.get_current_context()
+    clash = [f"--{name}" for name in ("k", "mu", "a0", "delta0", "rate")
+             if ctx.get_parameter_source(name) == ParameterSource.COMMANDLINE]
+    if clash:
+        raise InputError(f"{', '.join(clash)}: dimensionless options cannot be combined with "
+                         f"--si (give --Einf, --h0, --preload/--a0-si/--indentation, --speed)")
+    n, material, model = axes["n"], axes["material"], axes["model"]
+    required = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "speed")
+    missing = [f"--{name}" for name in required if values[name] is None]
+    if n is None:
+        missing.insert(0, "--n")
+    if missing:
+        raise InputError(f"{', '.join(missing)} must be given with --si")
+    kw = {name: as_float(name, v) for name, v in values.items() if v is not None}
+    if "a0_si" in kw:
+        kw["a0"] = kw.pop("a0_si")
+    out = run_si(SIScene(n=as_float("n", n), material=material, **kw), model)
+    if as_json:
+        echo_json(out)
+    else:
+        click.echo(f"scene      SI -> n={out['scene']['n']:g} k={out['k']:.4g} mu={out['mu']:.4g} "
+                   f"rate={out['rate']:.4g} l0={out['l0_m']:.4g} m a_ref={out['a_ref_m']:.4g} m")
+        click.echo(f"model      {out['model']}  status {out['status']}"
+                   f"{' (' + out['reason'] + ')' if out['reason'] else ''}")
+        if out["status"] == "ok":
+            click.echo(f"pull-off   {out['pull_off_N']:.6g} N = {out['pull_off']:.6g} pi dg R "
+                       f"(relaxed JKR {out['jkr_pull_off_N']:.6g} N)")
+            if out["crack_speed_m_s"] is not None:
+                click.echo(f"crack      v={out['crack_speed_m_s']:.6g} m/s  vhat={out['vhat']:.6g}")
+    if out["status"] != "ok":
         raise SystemExit(1)
 
 
@@ -302,6 +376,73 @@ def info_cmd(results, slowest):
     except FileNotFoundError:
         raise InputError(f"no results at {results}") from None
     click.echo(text)
+
+
+# == DMA fitting (fit-dma) ==
+@cli.command("fit-dma")
+@click.argument("csv_file", metavar="FILE.csv")
+@click.option("--tref", "tref", type=str, default="20", show_default=True,
+              help="Reference temperature [C] of a temperature sweep.")
+@click.option("--wlf", "wlf", type=str, default="17.44,51.6,-115", show_default=True,
+              help="WLF constants C1,C2[K],Tg[C] (the paper's eq. aT).")
+@click.option("--maxwell", "arms", type=str, default="18", show_default=True,
+              help="Arms of the generalized Maxwell comparison fit (0: none).")
+@click.option("--plot", "plot_out", default=None, metavar="OUT.png",
+              help="Plot data and both fits (the paper's Fig. EE; needs matplotlib).")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object (SI units).")
+def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
+    """Fit the MPL constants (and a generalized Maxwell model) to DMA data.
+
+    FILE.csv holds a master curve (omega_rad_s,E_storage_Pa,E_loss_Pa) or a temperature
+    sweep (T_C,f_Hz,E_storage_Pa,E_loss_Pa), shifted to --tref with the WLF equation.
+    """
+    from .dma import fit_maxwell, fit_mpl, kramers_kronig_check, plot_dma, read_dma_csv
+    from .errors import as_float, check_int
+
+    c = parse_floats("wlf", wlf)
+    if len(c) != 3:
+        raise InputError(f"wlf must be three numbers C1,C2,Tg (got {wlf!r})")
+    try:
+        n_arms = check_int("maxwell", int(arms.strip()), 0, 200)
+    except ValueError:
+        raise InputError(f"maxwell must be an integer in [0, 200] (got {arms!r})") from None
+    data = read_dma_csv(csv_file, T_ref=as_float("tref", tref), wlf=tuple(c))
+    mpl = fit_mpl(data)
+    mx = fit_maxwell(data, n_arms) if n_arms > 0 else None
+    kk = kramers_kronig_check(data)
+    if plot_out is not None:
+        plot_dma(data, mpl, mx, plot_out)
+    if as_json:
+        out = {"source": csv_file, "kind": data.kind, "points": int(data.omega.size),
+               "omega_min_rad_s": float(data.omega.min()),
+               "omega_max_rad_s": float(data.omega.max()),
+               "T_ref_C": data.T_ref, "wlf": data.wlf,
+               "E0": mpl.E0, "Einf": mpl.Einf, "n": mpl.n, "tau0": mpl.tau0, "k": mpl.k,
+               "mpl": mpl.to_dict(), "maxwell": None if mx is None else mx.to_dict(),
+               "kramers_kronig": kk.to_dict(), "plot": plot_out}
+        echo_json(out)
+        return
+    click.echo(f"# {csv_file}: {data.kind}, {data.omega.size} points, omega "
+               f"{data.omega.min():.3g} .. {data.omega.max():.3g} rad/s"
+               + (f", shifted to {data.T_ref:g} C (WLF C1={c[0]:g}, C2={c[1]:g}, Tg={c[2]:g})"
+                  if data.kind == "temperature" else ""))
+    click.echo("MPL retardation fit (value +- one standard error):")
+    for name, unit in (("E0", "Pa"), ("Einf", "Pa"), ("n", ""), ("tau0", "s")):
+        click.echo(f"  {name:<5} = {getattr(mpl, name):.6g} +- {mpl.stderr[name]:.2g} {unit}")
+    q = mpl.quality
+    click.echo(f"  k = E0/Einf = {mpl.k:.4g}; rms relative residual E' {q['rms_rel_storage']:.3g},"
+               f" E'' {q['rms_rel_loss']:.3g}; converged {mpl.success}")
+    if mx is not None:
+        q = mx.quality
+        click.echo(f"Generalized Maxwell, {n_arms} arms ({q['active_arms']} non-zero): "
+                   f"E0 = {mx.E0:.6g} Pa, Einf = {mx.Einf:.6g} Pa; rms relative residual "
+                   f"E' {q['rms_rel_storage']:.3g}, E'' {q['rms_rel_loss']:.3g}")
+    click.echo(f"Kramers-Kronig: E'' implied by E' differs by {kk.rms_rel:.3g} rms "
+               f"({kk.max_rel:.3g} max) over {kk.interior_points} interior points: "
+               f"{'consistent' if kk.consistent else 'NOT consistent'} "
+               f"(threshold {kk.threshold:g})")
+    if plot_out is not None:
+        click.echo(f"plot: {plot_out}")
 
 
 

@@ -27,6 +27,8 @@ from .errors import InputError, check_choice, check_int, check_range
 
 MATERIALS = ("mpl", "sls")
 STOPS = ("pulloff", "separation")
+#: Models a scene can ask for (sweep.models maps each to its simulate function).
+MODEL_NAMES = ("bem", "crack", "pb", "auto")
 
 
 def axis(default=dataclasses.MISSING, *, help: str, unit: str = "", limits=None,
@@ -88,6 +90,10 @@ class Scene:
     stop : {"pulloff", "separation"}
         Stop right after the load minimum has passed and recovered ("pulloff"), or follow
         the whole curve until the contact is lost ("separation").
+    model : {"bem", "crack", "pb", "auto"}
+        Which model runs the scene (:mod:`sweep.models`): the BEM (default), the crack-front
+        model, the paper's closed-form PB estimate, or "auto" (the BEM where its mesh fits the
+        numerics' node count, else the crack-front model); ``Result.model_used`` records it.
     """
 
     n: float = axis(help="MPL exponent (spectrum broadness); unused by sls", limits=(0.0, 5.0),
@@ -108,6 +114,9 @@ class Scene:
                          choices=MATERIALS, order=0)
     stop: str = axis("pulloff", help="stop after the pull-off, or follow the curve to "
                      "separation", choices=STOPS, order=1, plot_group=False)
+    model: str = axis("bem", help="model that runs the scene (sweep.models): the BEM, the "
+                      "crack-front model, the closed-form PB estimate, or auto",
+                      choices=MODEL_NAMES, order=-1)
 
     def __post_init__(self):
         info = _axes_of(type(self))
@@ -381,6 +390,9 @@ class Result:
         Node spacing and mesh radius (a_ref units).
     wall_s : float
         Wall-clock time of the run in seconds.
+    model_used : str
+        The model that ran ("bem", "crack", "pb"; "" when a model's simulate function was
+        called directly rather than through :func:`sweep.models.simulate_scene`).
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
     final_gap : ndarray or None
@@ -410,6 +422,7 @@ class Result:
     spacing: float = math.nan
     domain_used: float = math.nan
     wall_s: float = 0.0
+    model_used: str = ""
     trajectory: dict = field(default_factory=dict)
     final_gap: np.ndarray | None = None
 

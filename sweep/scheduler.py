@@ -114,7 +114,7 @@ def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | 
     if in_worker:
         _prepare_worker(warm=simulate is None)
     if simulate is None:
-        from .solver import simulate
+        from .models import simulate_scene as simulate   # dispatches on scene.model
     t0 = time.perf_counter()
     c0 = time.process_time()
     try:

@@ -1,0 +1,147 @@
+r"""Models of one scene and the registry that maps a model name to its simulate function.
+
+=======  ======================================================================================
+name     model
+=======  ======================================================================================
+bem      the boundary-element model (:func:`sweep.solver.simulate`): LJ interface, hereditary
+         integral; the reference, affordable while the process zone l0 = 1.693/mu^2 spans a
+         few nodes
+crack    the crack-front model (:func:`sweep.crack_front.simulate_crack`): JKR contact whose
+         edge opens with the Persson-Brener Gamma(v) of the scene's spectrum
+pb       the paper's closed-form estimate (:func:`pb_estimate`): the crack speed at pull-off
+         from the paper's fit vhat = 2.887 rhat_PB^1.171, Gamma_PB at that speed, and the
+         load-control JKR pull-off with it, P = 1.5 Gamma_PB
+auto     the cheapest model the scene allows (:func:`choose_model`): the BEM where the mesh that
+         resolves l0 fits the numerics' node count, the crack-front model otherwise
+=======  ======================================================================================
+
+Every simulate function takes ``(scene, numerics=None)`` and returns a :class:`sweep.Result`;
+the store and the analysis do not care which ran.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+from . import units
+from .errors import check_choice, check_positive
+from .theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
+
+__all__ = ["MODELS", "pb_estimate", "simulate_pb", "simulate_model", "simulate_scene",
+           "choose_model", "bem_nodes_needed"]
+
+
+def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171) -> dict:
+    r"""The paper's closed-form pull-off estimate from Persson-Brener theory.
+
+    .. math::
+        \hat v = 2.887\,\hat r_{PB}^{1.171},\quad \hat r_{PB} = \widehat{rate}\,\hat h_0(\mu),
+        \qquad \hat P_{po} = 1.5\,\hat\Gamma_{PB}(\hat v)
+
+    (the paper's v-r fit, eq. Vvsr, with ``rhat_PB = r tau0/d_ref`` as in
+    :func:`sweep.units.rhat_pb`; the fit constants may be replaced by the project's own).
+
+    Parameters
+    ----------
+    n, k, mu : float
+        Material exponent, ``E0/Einf``, Tabor parameter.
+    rate : float or array_like
+        The paper's r-hat ``r tau0 / h0`` (> 0).
+    material : {"mpl", "sls"}
+    prefactor, exponent : float
+        Constants of the v-r fit.
+
+    Returns
+    -------
+    dict
+        ``pull_off`` (pi dg R), ``vhat`` (v tau0/l0), ``crack_speed`` (a_ref/tau0),
+        ``gamma`` (Gamma/dg), ``rhat_pb``.
+    """
+    material = check_choice("material", material, ("mpl", "sls"))
+    rhat = units.rhat_pb(rate, mu)
+    vhat = paper_v_vs_r_fit(rhat, prefactor, exponent)
+    if material == "mpl":
+        gamma = pb_gamma_eff(n, k, vhat)
+    else:
+        gamma = pb_gamma_eff_spectrum([1.0], [1.0], k, vhat)
+    return {"pull_off": 1.5 * gamma, "vhat": vhat,
+            "crack_speed": units.crack_speed_from_vhat(vhat, mu), "gamma": gamma,
+            "rhat_pb": rhat}
+
+
+def simulate_pb(scene, numerics=None):
+    """:func:`pb_estimate` of a :class:`sweep.Scene` as a :class:`sweep.Result` row.
+
+    Only ``pull_off``, ``crack_speed``, ``vhat``, ``rhat_pb`` are set (no trajectory, no
+    state at pull-off; the initial state does not enter the estimate).
+    """
+    from .scene import Numerics, Result
+
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    t0 = time.perf_counter()
+    res = Result(scene=scene, numerics=numerics)
+    check_positive("rate", scene.rate)
+    est = pb_estimate(scene.n, scene.k, scene.mu, scene.rate, scene.material)
+    res.status = "ok"
+    res.pull_off = float(est["pull_off"])
+    res.crack_speed, res.vhat = float(est["crack_speed"]), float(est["vhat"])
+    res.rhat_pb = float(est["rhat_pb"])
+    res.prony_terms, res.prony_error = 0, 0.0
+    res.wall_s = time.perf_counter() - t0
+    return res
+
+
+def _bem(scene, numerics=None):
+    from .solver import simulate
+
+    return simulate(scene, numerics)
+
+
+def _crack(scene, numerics=None):
+    from .crack_front import simulate_crack
+
+    return simulate_crack(scene, numerics)
+
+
+def bem_nodes_needed(scene, numerics=None) -> int:
+    """Nodes the BEM needs for ``scene``: its automatic (or given) domain over the spacing at
+    which the process zone ``l0 = 1.693/mu^2`` spans ``numerics.zone_nodes`` spacings."""
+    from .scene import Numerics
+    from .solver import auto_domain
+
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if scene.a0 is not None:
+        d_est = scene.a0**2 - math.sqrt(2.0 * scene.a0)
+    else:
+        d_est = scene.delta0
+    domain = numerics.domain if numerics.domain is not None else \
+        auto_domain(scene, numerics, d_est)
+    return int(math.ceil(domain * numerics.zone_nodes / units.l0_hat(scene.mu))) + 1
+
+
+def choose_model(scene, numerics=None) -> str:
+    """The model "auto" picks: "bem" if its mesh fits ``numerics.nodes``, else "crack"."""
+    from .scene import Numerics
+
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    return "bem" if bem_nodes_needed(scene, numerics) <= numerics.nodes else "crack"
+
+
+#: model name -> simulate(scene, numerics=None) -> Result
+MODELS = {"bem": _bem, "crack": _crack, "pb": simulate_pb}
+
+
+def simulate_model(scene, model: str = "bem", numerics=None):
+    """Run ``scene`` with the named model (one of :data:`MODELS` or "auto"); the result's
+    ``model_used`` says which ran."""
+    check_choice("model", model, (*MODELS, "auto"))
+    if model == "auto":
+        model = choose_model(scene, numerics)
+    res = MODELS[model](scene, numerics)
+    res.model_used = model
+    return res
+
+
+def simulate_scene(scene, numerics=None):
+    """Run ``scene`` with the model it asks for (``scene.model``); what sweeps call."""
+    return simulate_model(scene, scene.model, numerics)

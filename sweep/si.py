@@ -1,0 +1,224 @@
+r"""Scenes in SI units: a sphere, a material, an interface, an initial state and an unloading
+speed, converted to the dimensionless scene (docs/design.md section 2, via :mod:`sweep.units`) and
+results converted back.
+
+Inputs (SI): sphere radius ``R`` [m]; relaxed and glassy Young's moduli ``E0``, ``Einf`` [Pa];
+Poisson's ratio ``nu``; MPL exponent ``n`` and time ``tau0`` [s]; work of adhesion ``dg``
+[J/m^2]; LJ equilibrium distance ``h0`` [m]; the initial state as exactly one of a preload
+force ``preload`` [N] (compressive, reached after full relaxation: the relaxed JKR contact at
+that load), a contact radius ``a0`` [m] or an indentation ``indentation`` [m]; the unloading
+speed ``speed`` [m/s].
+
+Derived: ``k = E0/Einf``, ``mu`` (Tabor), ``rate = speed tau0 / h0`` (the paper's r-hat), the
+initial ``a0_hat`` (a_ref) or ``delta0_hat`` (d_ref). The dimensionless scene holds everything
+a model needs; a :class:`sweep.Scene` is built when its parameters are within the Scene's
+ranges (the BEM's), the crack-front and pb models run on the plain parameters at any ``mu``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from .errors import InputError, check_choice, check_positive, check_range
+from .theory import jkr_contact_radius, jkr_pull_off
+from .units import PhysicalScale
+
+__all__ = ["SIScene", "run_si", "SI_MODELS"]
+
+SI_MODELS = ("bem", "crack", "pb", "auto")
+
+
+@dataclass(frozen=True, kw_only=True)
+class SIScene:
+    """One unloading experiment in SI units (module docstring for the fields)."""
+
+    R: float
+    E0: float
+    Einf: float
+    nu: float
+    n: float
+    tau0: float
+    dg: float
+    h0: float
+    speed: float
+    preload: float | None = None
+    a0: float | None = None
+    indentation: float | None = None
+    material: str = "mpl"
+
+    def __post_init__(self):
+        set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
+        for name in ("R", "E0", "Einf", "n", "tau0", "dg", "h0", "speed"):
+            set_(name, check_positive(name, getattr(self, name)))
+        set_("nu", check_range("nu", self.nu, 0.0, 0.5))
+        if self.Einf < self.E0:
+            raise InputError(f"Einf must be >= E0 = {self.E0:.6g} Pa (got {self.Einf:.6g})")
+        given = [f for f in ("preload", "a0", "indentation") if getattr(self, f) is not None]
+        if len(given) != 1:
+            raise InputError("preload/a0/indentation: give exactly one initial state (a preload "
+                             f"force [N], a contact radius [m] or an indentation [m]; got "
+                             f"{', '.join(given) or 'none'})")
+        if self.preload is not None:
+            set_("preload", check_range("preload", self.preload, lo=0.0))
+        if self.a0 is not None:
+            set_("a0", check_positive("a0", self.a0))
+        if self.indentation is not None:
+            set_("indentation", check_range("indentation", self.indentation))
+        check_choice("material", self.material, ("mpl", "sls"))
+
+    # ---- scales ------------------------------------------------------------------------------
+    @property
+    def scale(self) -> PhysicalScale:
+        return PhysicalScale.from_moduli(self.R, self.dg, self.E0, self.nu, self.h0)
+
+    @property
+    def k(self) -> float:
+        return self.E0 / self.Einf
+
+    @property
+    def mu(self) -> float:
+        return self.scale.mu
+
+    @property
+    def rate(self) -> float:
+        """The paper's r-hat, ``speed tau0 / h0``."""
+        return float(self.scale.rate_hat(self.speed, self.tau0))
+
+    def dimensionless(self) -> dict:
+        """``n, k, mu, rate, material`` and ``a0`` (a_ref) or ``delta0`` (d_ref).
+
+        A preload becomes the relaxed JKR contact radius at that load.
+        """
+        sc = self.scale
+        d = {"n": self.n, "k": self.k, "mu": sc.mu, "rate": self.rate, "material": self.material,
+             "a0": None, "delta0": None}
+        if self.preload is not None:
+            d["a0"] = float(jkr_contact_radius(load=float(sc.load_hat(self.preload))))
+        elif self.a0 is not None:
+            d["a0"] = float(sc.radius_hat(self.a0))
+        else:
+            d["delta0"] = float(sc.normal_hat(self.indentation))
+        return d
+
+    def to_scene(self, **extra):
+        """The :class:`sweep.Scene` (raises InputError outside the Scene's ranges, e.g. mu)."""
+        from .scene import Scene
+
+        d = self.dimensionless()
+        if d["a0"] is None:
+            d.pop("a0")
+        else:
+            d.pop("delta0")
+        return Scene(**d, **extra)
+
+    @classmethod
+    def from_dimensionless(cls, *, n, k, mu, rate, R, E0, nu, tau0, dg, a0=None, delta0=None,
+                           material="mpl") -> "SIScene":
+        """The SI scene of a dimensionless one for a chosen sphere and material.
+
+        ``h0`` follows from ``mu`` (``mu^3 = R dg^2 / (E0*^2 h0^3)``), the speed from ``rate``,
+        the initial state from ``a0`` (-> contact radius [m]) or ``delta0`` (-> indentation).
+        """
+        E0s = check_positive("E0", E0) / (1.0 - check_range("nu", nu, 0.0, 0.5) ** 2)
+        h0 = (check_positive("R", R) * check_positive("dg", dg) ** 2 / E0s**2) ** (1.0 / 3.0) \
+            / check_positive("mu", mu)
+        sc = PhysicalScale(R=R, dg=dg, E0_star=E0s, h0=h0)
+        kw = {}
+        if (a0 is None) == (delta0 is None):
+            raise InputError("a0/delta0: give exactly one of a0 and delta0")
+        if a0 is not None:
+            kw["a0"] = float(sc.radius_physical(a0))
+        else:
+            kw["indentation"] = float(sc.normal_physical(delta0))
+        return cls(R=R, E0=E0, Einf=E0 / check_range("k", k, 0.0, 1.0, lo_open=True), nu=nu,
+                   n=n, tau0=tau0, dg=dg, h0=h0,
+                   speed=float(sc.rate_physical(rate, tau0)), material=material, **kw)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def _si_of(si: SIScene, dimless: dict) -> dict:
+    """SI values of a dimensionless result (pull-off, radii, speeds) and the scales."""
+    sc = si.scale
+    out = {
+        "mu": sc.mu, "k": si.k, "rate": si.rate, "l0_m": sc.l0, "a_ref_m": sc.a_ref,
+        "d_ref_m": sc.d_ref, "load_ref_N": sc.load_ref,
+        "jkr_pull_off_N": float(sc.load_physical(jkr_pull_off())),
+    }
+    conv = {"pull_off": ("pull_off_N", sc.load_physical),
+            "a_pulloff": ("a_pulloff_m", sc.radius_physical),
+            "a0": ("a0_m", sc.radius_physical),
+            "delta_pulloff": ("delta_pulloff_m", sc.normal_physical),
+            "delta0": ("delta0_m", sc.normal_physical),
+            "crack_speed": ("crack_speed_m_s", lambda v: sc.crack_speed_physical(v, si.tau0)),
+            "t_pulloff": ("t_pulloff_s", lambda t: sc.time_physical(t, si.tau0))}
+    for key, (name, f) in conv.items():
+        v = dimless.get(key)
+        out[name] = None if v is None or (isinstance(v, float) and math.isnan(v)) else float(f(v))
+    return out
+
+
+def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
+    """Run an SI scene with a model and return the results in both systems.
+
+    Parameters
+    ----------
+    si : SIScene
+    model : {"bem", "crack", "pb", "auto"}
+        "bem" needs a :class:`sweep.Scene` (its ranges, e.g. mu <= 20); "crack" and "pb" run
+        at any Tabor parameter; "auto" is :func:`sweep.models.choose_model` within the Scene's
+        ranges and "crack" beyond them (``model`` in the output says which ran).
+    numerics : sweep.Numerics, optional
+        BEM discretization.
+
+    Returns
+    -------
+    dict
+        ``model``, ``status``, ``reason``, the SI inputs (``si``), the dimensionless scene
+        (``scene``), the dimensionless results (``pull_off``, ``a_pulloff``, ``crack_speed``,
+        ``vhat``, ``a0``, ``delta0`` ...) and their SI values (``pull_off_N``, ``a_pulloff_m``,
+        ``crack_speed_m_s``, ...) with ``mu``, ``l0_m``, ``jkr_pull_off_N``.
+    """
+    from . import units
+    from .crack_front import pb_law_for_scene, unload
+    from .models import pb_estimate, simulate_model
+
+    model = check_choice("model", model, SI_MODELS)
+    d = si.dimensionless()
+    if model == "auto":
+        from .models import choose_model
+        from .scene import SCENE_LIMITS
+
+        lo, hi = SCENE_LIMITS["mu"]
+        model = choose_model(si.to_scene(), numerics) if lo <= d["mu"] <= hi else "crack"
+    res = {"model": model}
+    if model == "bem":
+        try:
+            scene = si.to_scene()
+        except InputError as exc:
+            raise InputError(f"{exc}: outside the BEM's scene ranges; use model crack or pb") \
+                from None
+        r = simulate_model(scene, "bem", numerics)
+        dim = {"status": r.status, "reason": r.reason, "pull_off": r.pull_off,
+               "a_pulloff": r.a_pulloff, "delta_pulloff": r.delta_pulloff,
+               "t_pulloff": r.t_pulloff, "crack_speed": r.crack_speed, "vhat": r.vhat,
+               "a0": r.a0_result, "delta0": r.delta0_result}
+    elif model == "crack":
+        law = pb_law_for_scene(d["n"], d["k"], d["mu"], d["material"])
+        s = unload(law, rate=d["rate"], mu=d["mu"], a0=d["a0"], delta0=d["delta0"])
+        dim = {"status": s.status, "reason": s.reason, "pull_off": s.pull_off,
+               "a_pulloff": s.a_pulloff, "delta_pulloff": s.delta_pulloff,
+               "t_pulloff": s.t_pulloff, "crack_speed": s.crack_speed,
+               "vhat": float(units.vhat_from_crack_speed(s.crack_speed, d["mu"])),
+               "gamma_pulloff": s.gamma_pulloff, "a0": s.a0, "delta0": s.delta0}
+    else:
+        e = pb_estimate(d["n"], d["k"], d["mu"], d["rate"], d["material"])
+        dim = {"status": "ok", "reason": "", "pull_off": float(e["pull_off"]),
+               "crack_speed": float(e["crack_speed"]), "vhat": float(e["vhat"]),
+               "gamma_pulloff": float(e["gamma"]), "a0": d["a0"], "delta0": d["delta0"]}
+    res.update(dim)
+    res["scene"] = d
+    res["si"] = si.to_dict()
+    res.update(_si_of(si, dim))
+    return res

@@ -1,0 +1,131 @@
+"""Crack-front model: JKR limits in closed form, pinned-edge closed form, rate laws, growth
+with the unloading rate, the Result row."""
+import math
+
+import numpy as np
+import pytest
+
+from sweep import Scene
+from sweep.crack_front import (
+    GentSchultzLaw, constant_gamma_pull_off, crack_front_load, energy_release_rate,
+    pb_law_for_scene, simulate_crack, unload,
+)
+from sweep.errors import InputError
+from sweep.theory import jkr_indentation, jkr_load, jkr_pull_off_point, pb_gamma_eff
+
+XI = 0.4154
+
+
+def test_elastic_field_is_jkr_on_g_equal_one():
+    a = np.linspace(0.5, 6.0, 12)
+    d = jkr_indentation(a)
+    np.testing.assert_allclose(energy_release_rate(a, d), 1.0, rtol=1e-13)
+    np.testing.assert_allclose(crack_front_load(a, d), jkr_load(a), rtol=1e-12, atol=1e-14)
+
+
+@pytest.fixture(scope="module")
+def elastic_run():
+    # Gamma(v) = dg (1 + (v/v0)^xi) with v0 = 1e8 a_ref/tau0: rate independent in practice
+    return unload(GentSchultzLaw(1e8, XI), rate=10.0, mu=3.24, a0=3.0, stop="separation")
+
+
+def test_elastic_limit_pull_off_is_jkr_1_5_under_displacement_control(elastic_run):
+    s = elastic_run
+    assert s.ok
+    a_f, p_f, _ = jkr_pull_off_point("force")
+    # the load minimum is the load-control JKR point, reached while still stable under grips;
+    # the residual rate effect is Gamma - 1 ~ (v/v0)^xi ~ 5e-4
+    assert abs(s.gamma_pulloff - 1.0) < 1e-3
+    assert s.pull_off == pytest.approx(-p_f * s.gamma_pulloff, rel=1e-5)
+    assert s.pull_off == pytest.approx(1.5, abs=1e-3)
+    assert s.a_pulloff == pytest.approx(a_f * s.gamma_pulloff ** (1 / 3), rel=1e-4)
+
+
+def test_elastic_limit_fixed_grip_instability_at_minus_5_6(elastic_run):
+    tr = elastic_run.trajectory
+    # the contact jumps off where d delta/da = 0, i.e. delta = -3 a^2: a = 1/2, P = -5/6
+    s = tr["delta"] + 3.0 * tr["a"] ** 2
+    i = int(np.nonzero(s < 0)[0][0])
+    f = s[i - 1] / (s[i - 1] - s[i])
+    a_i = tr["a"][i - 1] + f * (tr["a"][i] - tr["a"][i - 1])
+    p_i = tr["P"][i - 1] + f * (tr["P"][i] - tr["P"][i - 1])
+    a_g, p_g, d_g = jkr_pull_off_point("displacement")
+    assert (a_g, p_g) == (0.5, pytest.approx(-5.0 / 6.0))
+    assert a_i == pytest.approx(a_g, rel=3e-3)
+    assert p_i == pytest.approx(p_g, rel=3e-3)
+    # the pull-off (largest tension) is NOT this load: 1.5 > 5/6
+    assert elastic_run.pull_off > -p_g + 0.6
+
+
+@pytest.mark.parametrize("c, a0", [(2.0, 2.0), (2.0, 1.0), (1.0, 0.8), (5.0, 0.9)])
+def test_constant_gamma_closed_form(c, a0):
+    # Gamma = c dg at any speed (v0 -> inf): pinned until g = c, then the JKR curve of c dg
+    s = unload(GentSchultzLaw(1e9, XI, c=c), rate=10.0, mu=3.24, a0=a0)
+    assert s.ok
+    assert s.pull_off == pytest.approx(constant_gamma_pull_off(a0, c), rel=2e-3)
+
+
+def test_constant_gamma_closed_form_branches():
+    c = 3.0
+    a_star = 1.0400419115259522 * c ** (1 / 3)
+    assert constant_gamma_pull_off(2 * a_star, c) == 4.5
+    # continuous at the switch (the depinning load equals 1.5 c there)
+    assert constant_gamma_pull_off(a_star * (1 - 1e-9), c) == pytest.approx(4.5, rel=1e-9)
+    with pytest.raises(InputError, match="c must be >= 1"):
+        constant_gamma_pull_off(1.0, 0.5)
+
+
+def test_integration_converges_with_tolerance():
+    law = GentSchultzLaw(1.0, XI)
+    p = [unload(law, rate=100.0, mu=3.24, a0=3.0, rtol=r).pull_off for r in (1e-6, 1e-10)]
+    assert p[0] == pytest.approx(p[1], rel=1e-5)
+
+
+def test_pb_law_inverts_gamma():
+    law = pb_law_for_scene(0.8, 0.1, 3.24)
+    g = np.array([1.0 + 1e-9, 1.0001, 1.01, 1.5, 3.0, 9.0, 9.99])
+    v, dv = law.speed(g)
+    np.testing.assert_allclose(law.gamma(v), g, rtol=1e-6)
+    # slope: dV/dg against a centred difference of the same interpolant
+    h = 1e-6 * g
+    vp, vm = law.speed(g + h)[0], law.speed(g - h)[0]
+    np.testing.assert_allclose(dv[1:], ((vp - vm) / (2 * h))[1:], rtol=1e-3)
+    assert law.speed(0.9)[0] == 0.0
+
+
+def test_pull_off_grows_with_rate_between_the_limits():
+    law = pb_law_for_scene(0.8, 0.1, 3.24)
+    rates = np.logspace(-3, 7, 11)
+    p = np.array([unload(law, rate=r, mu=3.24, a0=3.61).pull_off for r in rates])
+    assert np.all(np.diff(p) > 0)
+    assert p[0] == pytest.approx(1.5, rel=5e-3)         # relaxed JKR
+    assert p[-1] == pytest.approx(1.5 / 0.1, rel=5e-3)  # glassy: 1.5/k (a0 > 1.04 k^(-1/3))
+
+
+def test_pull_off_at_pb_speed_matches_jkr_with_that_gamma():
+    # a large contact is quasi-steady: P_po = 1.5 Gamma(v_po) (load-control JKR with Gamma)
+    law = pb_law_for_scene(0.8, 0.1, 3.24)
+    s = unload(law, rate=100.0, mu=3.24, a0=8.0)
+    assert s.gamma_pulloff == pytest.approx(float(law.gamma(s.crack_speed)), rel=1e-6)
+    assert s.pull_off == pytest.approx(1.5 * s.gamma_pulloff, rel=0.05)
+
+
+def test_simulate_crack_gives_a_result_row():
+    sc = Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=316.227766)
+    res = simulate_crack(sc)
+    assert res.ok and res.reason == ""
+    assert res.pull_off > 1.5
+    assert res.vhat == pytest.approx(res.crack_speed / (1.693 / 3.24**2), rel=2e-3)
+    row = res.to_row()
+    assert row["scene_id"] == res.scene_id and math.isnan(row["a_inner_pulloff"])
+    assert set(res.trajectory) == {"t", "delta", "P", "a", "a_inner"}
+    assert float(pb_gamma_eff(0.8, 0.1, res.vhat)) > 1.0
+
+
+def test_bad_input():
+    with pytest.raises(InputError, match="a0 must be >= 0.5"):
+        unload(GentSchultzLaw(1.0, XI), rate=1.0, mu=3.0, a0=0.3)
+    with pytest.raises(InputError, match="give exactly one of a0"):
+        unload(GentSchultzLaw(1.0, XI), rate=1.0, mu=3.0)
+    with pytest.raises(InputError, match="v0 must be > 0"):
+        GentSchultzLaw(0.0, XI)

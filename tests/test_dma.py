@@ -1,0 +1,240 @@
+"""DMA fitting: MPL and generalized Maxwell recovery from synthetic master curves, WLF shift,
+Kramers-Kronig check, the `sweep fit-dma` command and its one-line errors on bad files."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from sweep.cli import main
+from sweep.dma import (
+    DMAData, fit_maxwell, fit_mpl, kramers_kronig_check, read_dma_csv, wlf_log_shift,
+)
+from sweep.errors import InputError
+from sweep.materials import MPLRetardation, Prony
+from tests.reference import paper_values
+
+PDMS = paper_values()["pdms_experiment"]
+TRUE = dict(E0=PDMS["E0_MPa"] * 1e6, Einf=PDMS["Einf_MPa"] * 1e6, n=PDMS["n"],
+            tau0=PDMS["tau0_s"])
+NOISE = 0.01
+
+
+def noisy(E, seed):
+    rng = np.random.default_rng(seed)
+    return (E.real * (1.0 + NOISE * rng.standard_normal(E.size)),
+            E.imag * (1.0 + NOISE * rng.standard_normal(E.size)))
+
+
+@pytest.fixture(scope="module")
+def mpl_data():
+    # 21 decades, as the paper's temperature sweep -130 .. 20 C at 1 Hz gives after the shift
+    w = np.logspace(-2, 19, 85)
+    E = MPLRetardation(**TRUE).complex_modulus(w)
+    return DMAData(w, *noisy(E, 1))
+
+
+def test_mpl_recovers_known_constants(mpl_data):
+    fit = fit_mpl(mpl_data)
+    assert fit.success
+    for name, value in TRUE.items():
+        got, se = getattr(fit, name), fit.stderr[name]
+        # the reported standard error is honest (within 4 sigma) and small (1 % noise)
+        assert abs(got - value) <= 4.0 * se, (name, got, value, se)
+        assert abs(got / value - 1.0) < 0.01, (name, got, value)
+    # residuals at the noise level: nothing systematic left
+    assert 0.5 * NOISE < fit.quality["rms_rel_storage"] < 1.5 * NOISE
+    assert 0.5 * NOISE < fit.quality["rms_rel_loss"] < 1.5 * NOISE
+
+
+def test_mpl_exact_data_recovered_to_optimizer_precision():
+    w = np.logspace(-1, 18, 40)
+    truth = dict(E0=2.0e6, Einf=1.0e9, n=0.5, tau0=1e-3)
+    E = MPLRetardation(**truth).complex_modulus(w)
+    fit = fit_mpl((w, E.real, E.imag))
+    for name, value in truth.items():
+        assert getattr(fit, name) == pytest.approx(value, rel=1e-6)
+
+
+def test_maxwell_recovers_an_18_arm_model():
+    # a known 18-arm Wiechert model with its times where the fit puts them (the data's decades)
+    w = np.logspace(-3, 9, 73)
+    times = np.logspace(-9, 3, 18)
+    E0 = 1.0e6
+    moduli = E0 * 3.0 * (times / 1e-9) ** -0.25          # a broad, smooth spectrum
+    truth = Prony(moduli, times, E0=E0, kind="maxwell")
+    E = truth.complex_modulus(w)
+    fit = fit_maxwell(DMAData(w, *noisy(E, 2)), arms=18)
+    np.testing.assert_allclose(fit.times, times, rtol=1e-12)
+    assert fit.E0 == pytest.approx(E0, rel=0.02)
+    assert fit.Einf == pytest.approx(truth.Einf, rel=0.02)
+    # the relaxation modulus over the data's window (individual arms are ill-conditioned)
+    t = np.logspace(-8, 2, 30)
+    np.testing.assert_allclose(fit.material.relaxation_modulus(t), truth.relaxation_modulus(t),
+                               rtol=0.03)
+    assert fit.quality["rms_rel_storage"] < 1.5 * NOISE
+    assert fit.quality["rms_rel_loss"] < 1.5 * NOISE
+
+
+def test_maxwell_of_noise_free_data_is_exact():
+    w = np.logspace(-2, 4, 30)
+    times = np.logspace(-4, 2, 6)
+    truth = Prony(np.linspace(1.0, 6.0, 6) * 1e5, times, E0=1e5, kind="maxwell")
+    E = truth.complex_modulus(w)
+    fit = fit_maxwell((w, E.real, E.imag), arms=6)
+    np.testing.assert_allclose(fit.moduli, truth.maxwell_moduli, rtol=1e-8)
+    assert fit.E0 == pytest.approx(1e5, rel=1e-8)
+
+
+def test_kramers_kronig_flags_inconsistent_loss(mpl_data):
+    ok = kramers_kronig_check(mpl_data)
+    assert ok.consistent and ok.rms_rel < 0.06
+    # a loss modulus distorted by 40 % over the upper half of the data violates KK
+    w = mpl_data.omega
+    bad = DMAData(w, mpl_data.E_storage, mpl_data.E_loss * np.where(w > 1e8, 1.4, 1.0))
+    chk = kramers_kronig_check(bad)
+    assert not chk.consistent and chk.rms_rel > 0.15
+
+
+def test_wlf_shift_is_the_papers_equation():
+    C1, C2, Tg = (PDMS["wlf"][k] for k in ("C1", "C2_K", "Tg_C"))
+    assert wlf_log_shift(Tg) == 0.0
+    T = -100.0
+    assert wlf_log_shift(T) == pytest.approx(-C1 * (T - Tg) / (C2 + T - Tg), rel=1e-15)
+    with pytest.raises(InputError, match="T_C must be > Tg - C2"):
+        wlf_log_shift(Tg - C2 - 1.0)
+
+
+def write_sweep(path, mat, temps, f=1.0, T_ref=20.0):
+    """A temperature sweep at fixed frequency that shifts onto ``mat``'s master curve."""
+    shift = wlf_log_shift(temps) - wlf_log_shift(T_ref)
+    E = mat.complex_modulus(2.0 * math.pi * f * 10.0 ** shift)
+    lines = ["T_C,f_Hz,E_storage_Pa,E_loss_Pa"]
+    lines += [f"{float(T)!r},{float(f)!r},{float(e.real)!r},{float(e.imag)!r}" for T, e in zip(temps, E)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_temperature_sweep_is_shifted_and_fitted(tmp_path):
+    mat = MPLRetardation(**TRUE)
+    temps = np.arange(-130.0, 20.5, 2.5)          # the paper's range, finer steps
+    p = tmp_path / "sweep.csv"
+    write_sweep(p, mat, temps)
+    data = read_dma_csv(p)
+    assert data.kind == "temperature" and data.T_ref == 20.0
+    # the coldest point lands highest: -130 C -> 10^(log aT(-130) - log aT(20)) * 2 pi
+    top = 2 * math.pi * 10 ** (wlf_log_shift(-130.0) - wlf_log_shift(20.0))
+    assert data.omega.max() == pytest.approx(top, rel=1e-12)
+    fit = fit_mpl(data)
+    for name, value in TRUE.items():
+        assert getattr(fit, name) == pytest.approx(value, rel=1e-4)
+
+
+def write_master(path, w, E):
+    lines = ["omega_rad_s,E_storage_Pa,E_loss_Pa"]
+    lines += [f"{float(wi)!r},{float(e.real)!r},{float(e.imag)!r}" for wi, e in zip(w, E)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_cli_fit_dma_json(tmp_path, capsys):
+    w = np.logspace(-2, 19, 43)
+    E = MPLRetardation(**TRUE).complex_modulus(w)
+    p = tmp_path / "master.csv"
+    write_master(p, w, E)
+    code = main(["fit-dma", str(p), "--maxwell", "18", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0 and err == ""
+    d = json.loads(out)
+    for name, value in TRUE.items():
+        assert d[name] == pytest.approx(value, rel=1e-5)
+    assert d["kind"] == "master" and d["points"] == 43
+    assert len(d["maxwell"]["moduli"]) == 18
+    assert d["kramers_kronig"]["consistent"] is True
+
+
+def test_cli_fit_dma_text_and_plot(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    w = np.logspace(0, 12, 25)
+    E = MPLRetardation(1e6, 1e8, 0.4, 1e-3).complex_modulus(w)
+    p = tmp_path / "m.csv"
+    write_master(p, w, E)
+    png = tmp_path / "fig.png"
+    code = main(["fit-dma", str(p), "--maxwell", "8", "--plot", str(png)])
+    out, _ = capsys.readouterr()
+    assert code == 0
+    assert "E0    = 1e+06" in out and "Generalized Maxwell, 8 arms" in out
+    assert png.stat().st_size > 1000
+
+
+BAD = {
+    "missing_column": ("omega_rad_s,E_storage_Pa\n1,2\n2,3\n3,4\n",
+                       "missing column(s) E_loss_Pa"),
+    "negative_omega": ("omega_rad_s,E_storage_Pa,E_loss_Pa\n1,2,3\n-2,3,4\n3,4,5\n",
+                       "line 3 (data row 2), column omega_rad_s: must be > 0 (got -2)"),
+    "zero_frequency": ("T_C,f_Hz,E_storage_Pa,E_loss_Pa\n0,1,2,3\n10,0,3,4\n20,1,4,5\n",
+                       "line 3 (data row 2), column f_Hz: must be > 0 (got 0)"),
+    "nan": ("omega_rad_s,E_storage_Pa,E_loss_Pa\n1,2,3\n2,3,4\n3,nan,5\n",
+            "line 4 (data row 3), column E_storage_Pa: must be a finite number (got nan)"),
+    "text": ("omega_rad_s,E_storage_Pa,E_loss_Pa\n1,2,3\n2,x,4\n3,4,5\n",
+             "line 3 (data row 2), column E_storage_Pa: must be a number (got 'x')"),
+    "one_row": ("omega_rad_s,E_storage_Pa,E_loss_Pa\n1,2,3\n",
+                "needs at least 3 data rows for a 4-parameter fit (got 1)"),
+    "empty_cell": ("omega_rad_s,E_storage_Pa,E_loss_Pa\n1,2,3\n2,,4\n3,4,5\n",
+                   "line 3 (data row 2), column E_storage_Pa: missing value"),
+    "below_wlf_pole": ("T_C,f_Hz,E_storage_Pa,E_loss_Pa\n-170,1,2,3\n10,1,3,4\n20,1,4,5\n",
+                       "line 2 (data row 1), column T_C: must be > Tg - C2"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_cli_bad_files_one_line_exit_2(tmp_path, capsys, case):
+    text, message = BAD[case]
+    p = tmp_path / f"{case}.csv"
+    p.write_text(text)
+    code = main(["fit-dma", str(p)])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and err.startswith("error: ")
+    assert message in err and str(p) in err
+
+
+def test_cli_bad_options(tmp_path, capsys):
+    p = tmp_path / "m.csv"
+    p.write_text("omega_rad_s,E_storage_Pa,E_loss_Pa\n1,2,3\n2,3,4\n3,4,5\n")
+    assert main(["fit-dma", str(p), "--wlf", "1,2"]) == 2
+    assert "wlf must be three numbers" in capsys.readouterr().err
+    assert main(["fit-dma", str(p), "--maxwell", "x"]) == 2
+    assert "maxwell must be an integer" in capsys.readouterr().err
+    assert main(["fit-dma", str(tmp_path / "none.csv")]) == 2
+    assert "cannot read the file" in capsys.readouterr().err
+
+
+def test_papers_protocol_sparse_temperature_sweep(tmp_path):
+    # the paper's DMA protocol: -130 .. 20 C in 10 C steps at 1 Hz (16 points over 20
+    # decades after the shift, up to 5 decades apart near Tg), 1 % noise
+    T = np.arange(-130.0, 20.5, 10.0)
+    mat = MPLRetardation(**TRUE)
+    w = 2 * math.pi * 10 ** (wlf_log_shift(T) - wlf_log_shift(20.0))
+    E1, E2 = noisy(mat.complex_modulus(w), 7)
+    p = tmp_path / "protocol.csv"
+    p.write_text("T_C,f_Hz,E_storage_Pa,E_loss_Pa\n" + "".join(
+        f"{float(t)!r},1.0,{float(a)!r},{float(b)!r}\n" for t, a, b in zip(T, E1, E2)))
+    data = read_dma_csv(p)
+    fit = fit_mpl(data)
+    for name, value in TRUE.items():
+        assert getattr(fit, name) == pytest.approx(value, rel=0.03), name
+    assert kramers_kronig_check(data).consistent
+    # the same sweep with the loss modulus of the cold half doubled is flagged
+    bad = DMAData(data.omega, data.E_storage, data.E_loss * np.where(data.omega > 1e6, 2.0, 1.0))
+    assert not kramers_kronig_check(bad).consistent
+
+
+def test_array_input_is_sorted_and_checked():
+    w = np.logspace(4, 0, 9)                       # descending, as a temperature sweep gives
+    E = MPLRetardation(1e6, 1e8, 0.4, 1e-2).complex_modulus(w)
+    fit = fit_mpl((w, E.real, E.imag))
+    assert fit.n == pytest.approx(0.4, rel=1e-5)
+    assert kramers_kronig_check((w, E.real, E.imag)).interior_points >= 2
+    with pytest.raises(InputError, match=r"E_loss\[2\] must be a finite number > 0"):
+        fit_mpl((w, E.real, np.where(np.arange(9) == 2, np.nan, E.imag)))
+    with pytest.raises(InputError, match="equal lengths"):
+        fit_maxwell((w, E.real, E.imag[:-1]))

@@ -1,0 +1,162 @@
+"""SI scenes: the paper's PDMS constants, round trips both ways, the models' SI results and
+`sweep scene --si`."""
+import json
+import math
+
+import pytest
+
+from sweep import Scene
+from sweep.cli import main
+from sweep.errors import InputError
+from sweep.models import MODELS, pb_estimate, simulate_model
+from sweep.si import SIScene, run_si
+from sweep.theory import jkr_load
+from tests.reference import paper_values
+
+P = paper_values()["pdms_experiment"]
+PDMS = dict(R=P["sphere_radius_mm"] * 1e-3, E0=P["E0_MPa"] * 1e6, Einf=P["Einf_MPa"] * 1e6,
+            nu=P["nu"], n=P["n"], tau0=P["tau0_s"], dg=P["work_of_adhesion_mJ_m2"] * 1e-3,
+            h0=P["h0_fit_nm"] * 1e-9)
+
+
+def pdms(**kw):
+    return SIScene(**PDMS, **{"preload": P["preload_mN"] * 1e-3, "speed": 1e-6, **kw})
+
+
+def test_paper_constants_give_mu_103_and_l0_30nm():
+    si = pdms()
+    assert si.mu == pytest.approx(103, abs=0.5)             # paper: "about 103"
+    assert si.scale.l0 * 1e9 == pytest.approx(P["l0_nm"], abs=0.05)
+    assert si.k == pytest.approx(P["k"], rel=5e-3)
+    assert si.scale.E0_star / 1e6 == pytest.approx(P["E0_star_MPa"], abs=0.005)
+    # the relaxed JKR pull-off 1.5 pi dg R = 3.725 mN
+    assert 1.5 * si.scale.load_ref == pytest.approx(3.725e-3, abs=5e-7)
+
+
+def test_preload_is_the_relaxed_jkr_state():
+    si = pdms()
+    d = si.dimensionless()
+    assert float(jkr_load(d["a0"])) == pytest.approx(si.scale.load_hat(1.5e-3), rel=1e-12)
+    assert d["rate"] == pytest.approx(1e-6 * PDMS["tau0"] / PDMS["h0"], rel=1e-14)
+
+
+@pytest.mark.parametrize("state", [{"a0": 2.5e-4}, {"indentation": 3.0e-6}])
+def test_si_round_trip(state):
+    si = SIScene(**PDMS, speed=3e-5, **state)
+    d = si.dimensionless()
+    back = SIScene.from_dimensionless(
+        n=d["n"], k=d["k"], mu=d["mu"], rate=d["rate"], a0=d["a0"], delta0=d["delta0"],
+        R=si.R, E0=si.E0, nu=si.nu, tau0=si.tau0, dg=si.dg)
+    for name in ("Einf", "h0", "speed", *state):
+        assert getattr(back, name) == pytest.approx(getattr(si, name), rel=1e-12), name
+
+
+def test_dimensionless_round_trip():
+    want = Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=316.2).to_dict()
+    si = SIScene.from_dimensionless(n=0.8, k=0.1, mu=3.24, rate=316.2, a0=3.61, R=1e-3,
+                                    E0=2e6, nu=0.45, tau0=0.3, dg=0.05)
+    got = si.to_scene().to_dict()
+    assert got.keys() == want.keys()
+    for name, value in want.items():
+        if isinstance(value, float):
+            assert got[name] == pytest.approx(value, rel=1e-12), name
+        else:
+            assert got[name] == value, name
+
+
+def test_run_si_crack_and_pb_in_both_unit_systems():
+    si = pdms()
+    out = run_si(si, "crack")
+    assert out["status"] == "ok"
+    assert out["pull_off_N"] == pytest.approx(out["pull_off"] * si.scale.load_ref, rel=1e-14)
+    assert out["crack_speed_m_s"] == pytest.approx(
+        out["crack_speed"] * si.scale.a_ref / si.tau0, rel=1e-14)
+    assert out["jkr_pull_off_N"] == pytest.approx(1.5 * math.pi * si.dg * si.R, rel=1e-14)
+    assert out["pull_off_N"] > out["jkr_pull_off_N"]
+    e = pb_estimate(si.n, si.k, si.mu, si.rate)
+    assert run_si(si, "pb")["pull_off"] == pytest.approx(e["pull_off"], rel=1e-14)
+    with pytest.raises(InputError, match="outside the BEM's scene ranges"):
+        run_si(si, "bem")
+
+
+def test_registry_maps_names_to_models():
+    assert set(MODELS) == {"bem", "crack", "pb"}
+    sc = Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=100.0)
+    r = simulate_model(sc, "pb")
+    assert r.ok and r.pull_off == pytest.approx(pb_estimate(0.8, 0.1, 3.24, 100.0)["pull_off"])
+    assert simulate_model(sc, "crack").ok
+    with pytest.raises(InputError, match="model must be one of"):
+        simulate_model(sc, "fem")
+
+
+SI_ARGS = ["scene", "--si", "--n", "0.2207", "--R", "5.19e-3", "--E0", "1.458e6", "--Einf",
+           "3.089e9", "--nu", "0.5", "--tau0", "0.01876", "--dg", "0.1523", "--h0", "30.8e-9",
+           "--preload", "1.5e-3", "--speed", "1e-6"]
+
+
+def test_cli_scene_si_json(capsys):
+    code = main(SI_ARGS + ["--model", "crack", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0 and err == ""
+    d = json.loads(out)
+    assert d["mu"] == pytest.approx(102.92, abs=0.01)
+    assert d["l0_m"] == pytest.approx(30.0e-9, abs=0.05e-9)
+    assert d["jkr_pull_off_N"] == pytest.approx(3.7248e-3, rel=1e-4)
+    assert d["pull_off_N"] == pytest.approx(d["pull_off"] * d["load_ref_N"], rel=1e-14)
+    assert d["scene"]["rate"] == pytest.approx(0.60909, rel=1e-4)
+
+
+@pytest.mark.parametrize("extra, message", [
+    ([], "mu must be in"),                                   # bem at mu = 103
+    (["--model", "crack", "--rate", "1"], "--rate: dimensionless options cannot"),
+    (["--model", "crack", "--a0-si", "1e-4"], "give exactly one initial state"),
+])
+def test_cli_scene_si_errors(capsys, extra, message):
+    assert main(SI_ARGS + extra) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_cli_scene_si_options_need_si(capsys):
+    assert main(["scene", "--n", "0.8", "--a0", "2", "--rate", "1", "--R", "1e-3"]) == 2
+    assert "--R: SI options need --si" in capsys.readouterr().err
+
+
+def test_scene_model_field_and_auto_choice():
+    from sweep.models import bem_nodes_needed, choose_model, simulate_scene
+    from sweep.scene import Numerics
+
+    assert Scene(n=0.8, a0=3.0, rate=1.0).model == "bem"
+    with pytest.raises(InputError, match="model must be one of bem, crack, pb, auto"):
+        Scene(n=0.8, a0=3.0, rate=1.0, model="fem")
+    small = Scene(n=0.8, k=0.1, mu=3.24, a0=3.0, rate=1.0, model="auto")
+    big = Scene(n=0.8, k=0.1, mu=20.0, a0=8.0, rate=1.0, model="auto")
+    num = Numerics.preset("balanced")
+    # l0 = 1.693/mu^2: 0.16 a_ref at mu = 3.24 (a few hundred nodes), 0.0042 at mu = 20
+    assert bem_nodes_needed(small, num) <= num.nodes < bem_nodes_needed(big, num)
+    assert choose_model(small, num) == "bem" and choose_model(big, num) == "crack"
+    res = simulate_scene(big, num)
+    assert res.ok and res.model_used == "crack" and res.to_row()["model"] == "auto"
+    assert simulate_scene(Scene(n=0.8, a0=3.0, rate=1.0, model="pb")).model_used == "pb"
+
+
+def test_config_model_axis(tmp_path):
+    from sweep.config import parse_config
+
+    cfg = parse_config("name: m\ngrid: {n: 0.8, a0: 3.0, rate: 1, model: [crack, pb]}\n")
+    assert [s.model for s in cfg.scenes()] == ["crack", "pb"]
+    assert parse_config("name: m\ngrid: {n: 0.8, a0: 3.0, rate: 1}\n").scenes()[0].model == "bem"
+    with pytest.raises(InputError, match="model must be one of"):
+        parse_config("name: m\ngrid: {n: 0.8, a0: 3.0, rate: 1, model: fem}\n")
+
+
+def test_sweep_runs_the_scene_models(tmp_path):
+    import sweep
+    from sweep.scheduler import run_sweep
+
+    p = tmp_path / "c.yaml"
+    p.write_text("name: c\ngrid: {n: 0.8, a0: 3.0, rate: [1, 100], model: [crack, pb]}\n"
+                 f"output: {tmp_path / 'c.h5'}\n")
+    run_sweep(str(p), jobs=1, progress="none")
+    df = sweep.load(tmp_path / "c.h5")
+    assert len(df) == 4 and set(df.model_used) == {"crack", "pb"}
+    assert (df.status == "ok").all()
