@@ -9,12 +9,13 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow bench bench-convergence pdms agreement clean
+.PHONY: help venv demo test test-slow coverage-kernels bench bench-convergence pdms agreement clean
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
 	@echo "make test   - create/update .venv and run the test suite"
 	@echo "make bench  - speed benchmarks (JSON in results/bench/)"
+	@echo "make coverage-kernels - kernel tests with NUMBA_DISABLE_JIT=1 under coverage"
 	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/)"
 
 $(BIN)/python:
@@ -40,6 +41,13 @@ test: $(STAMP)
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow tests
 
+# The kernels run as plain Python (NUMBA_DISABLE_JIT=1) so that coverage sees their lines:
+# the kernel-by-kernel tests and the engine against tests/naive.py on small meshes (~30 s).
+KERNEL_TESTS := tests/test_history.py tests/test_fast_vs_naive.py tests/test_influence.py
+coverage-kernels: $(STAMP)
+	NUMBA_DISABLE_JIT=1 $(BIN)/python -m pytest -q -p no:cacheprovider --cov=kernels \
+	  --cov-report=term-missing $(KERNEL_TESTS) -k "not uniform_pressure and not hertz"
+
 bench: $(STAMP)
 	$(BIN)/python -m sweep.benchmarks scene --out results/bench/scene.json
 	$(BIN)/python -m sweep.benchmarks presets --out results/bench/presets.json
@@ -56,4 +64,4 @@ agreement: $(STAMP)
 	$(BIN)/python -m sweep.agreement --out results/agreement/agreement.json
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache
+	rm -rf $(VENV) build *.egg-info .pytest_cache .coverage

@@ -1,18 +1,17 @@
 """visco-sweep: viscoelastic adhesive contact of a rigid sphere, as a parameter-sweep engine.
 
-Public API (units and conventions: see ``sweep.units`` and DESIGN.md section 2)::
+Public API (units and conventions: see ``sweep.units`` and docs/design.md section 2)::
 
     from sweep import Scene, Numerics, simulate
     result = simulate(Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=316.2), Numerics.preset("balanced"))
 """
-import os as _os
+from . import threads as _threads
 
 __version__ = "0.1.0"
 
-# One BLAS thread per process unless the user says otherwise: a dense BEM step is a
-# matrix-vector product, and sweeps run one scene per core (no oversubscription).
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    _os.environ.setdefault(_var, "1")
+# One BLAS thread per process unless the user says otherwise (see sweep.threads); before
+# numpy is imported by the modules below.
+_threads.limit_env(_threads.BLAS_VARS)
 
 from .errors import InputError  # noqa: E402
 from .scene import PRESETS, Numerics, Result, Scene, scene_id  # noqa: E402

@@ -83,8 +83,7 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
     tmp = Path(workdir or tempfile.mkdtemp(prefix="bench-sched-"))
     tmp.mkdir(parents=True, exist_ok=True)
     load_before = os.getloadavg()
-    if hasattr(solver, "warm_up"):
-        solver.warm_up()
+    solver.warm_up()
     simulate = solver.simulate
     simulate(tasks[0][1], cfg.numerics)   # first-call costs (caches) outside the timing
 

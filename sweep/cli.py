@@ -13,6 +13,7 @@ import click
 import numpy as np
 
 from .errors import InputError
+from .scene import AXES, PRESETS
 
 
 def parse_floats(name: str, text: str) -> list[float]:
@@ -51,7 +52,8 @@ def cli():
 
 
 # ----------------------------------------------------------------------------
-# Commands are added below, one section per concept. Edit with str_replace only.
+# Commands, one section per concept. A new command is a new section; shared option
+# parsing lives in the helpers above.
 # ----------------------------------------------------------------------------
 
 # == theory & materials commands (pb, material) ==
@@ -158,45 +160,67 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
 
 # == single scene command (scene) ==
 
+def scene_options(func):
+    """One option per Scene field, from its metadata (sweep.scene.AXES): name, default,
+    allowed values and help are declared once, in sweep/scene.py."""
+    for a in reversed(list(AXES.values())):
+        if a.numeric:
+            default = a.cli_default if a.required else a.default
+            option = click.option(
+                f"--{a.name}", a.name, type=str,
+                default=None if default is None else format(default, "g"),
+                required=False, show_default=default is not None,
+                help=a.describe() + ".")
+        else:
+            option = click.option(f"--{a.name}", a.name, type=click.Choice(list(a.choices)),
+                                  default=a.default, show_default=True, help=a.describe() + ".")
+        func = option(func)
+    return func
+
+
+def scene_from_options(values: dict):
+    """A Scene from the option strings of :func:`scene_options` (numbers parsed, named)."""
+    from .errors import as_float
+    from .scene import Scene
+
+    return Scene(**{name: as_float(name, v) if AXES[name].numeric and v is not None else v
+                    for name, v in values.items()})
+
+
 _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", "indentation",
                "speed")
 
 
+def si_options(func):
+    """The options of an SI scene (``sweep scene --si``; :class:`sweep.si.SIScene`)."""
+    opts = [
+        ("--si", dict(is_flag=True, help="Give the scene in SI units: --n --R --E0 --Einf --nu "
+                      "--tau0 --dg --h0, one of --preload/--a0-si/--indentation, and --speed "
+                      "(instead of --k --mu --a0 --delta0 --rate).")),
+        ("--R", dict(help="[--si] sphere radius [m].")),
+        ("--E0", dict(help="[--si] relaxed Young's modulus [Pa].")),
+        ("--Einf", dict(help="[--si] glassy Young's modulus [Pa].")),
+        ("--nu", dict(help="[--si] Poisson's ratio.")),
+        ("--tau0", dict(help="[--si] MPL time tau0 [s].")),
+        ("--dg", dict(help="[--si] work of adhesion [J/m^2].")),
+        ("--h0", dict(help="[--si] LJ equilibrium distance [m].")),
+        ("--preload", dict(help="[--si] preload force [N] (relaxed JKR contact at that load).")),
+        ("--a0-si", dict(help="[--si] initial contact radius [m].")),
+        ("--indentation", dict(help="[--si] initial indentation [m].")),
+        ("--speed", dict(help="[--si] unloading speed [m/s].")),
+    ]
+    for name, kw in reversed(opts):
+        dest = name[2:].replace("-", "_")
+        if not kw.get("is_flag"):
+            kw = {"type": str, "default": None, **kw}
+        func = click.option(name, dest, **kw)(func)
+    return func
+
+
 @cli.command("scene")
-@click.option("--n", "n", type=str, default=None, help="MPL exponent n.  [default: 0.8]")
-@click.option("--k", "k", type=str, default=None, help="E0/Einf.  [default: 0.1]")
-@click.option("--mu", "mu", type=str, default=None, help="Tabor parameter.  [default: 3.24]")
-@click.option("--a0", "a0", type=str, default=None, help="Initial contact radius (a_ref units).")
-@click.option("--delta0", "delta0", type=str, default=None,
-              help="Initial indentation (d_ref units); alternative to --a0.")
-@click.option("--rate", "rate", type=str, default=None,
-              help="Unloading rate r-hat = r tau0/h0 (required without --si).")
-@click.option("--model", type=click.Choice(["bem", "crack", "pb", "auto"]), default="bem",
-              show_default=True,
-              help="bem: boundary elements; crack: crack-front model with the PB Gamma(v); "
-                   "pb: the paper's closed-form estimate; auto: bem if its mesh fits the "
-                   "node count, else crack.")
-@click.option("--si", "si", is_flag=True,
-              help="Give the scene in SI units: --n --R --E0 --Einf --nu --tau0 --dg --h0, one "
-                   "of --preload/--a0-si/--indentation, and --speed (instead of --k --mu --a0 "
-                   "--delta0 --rate).")
-@click.option("--R", "R", type=str, default=None, help="[--si] sphere radius [m].")
-@click.option("--E0", "E0", type=str, default=None, help="[--si] relaxed Young's modulus [Pa].")
-@click.option("--Einf", "Einf", type=str, default=None, help="[--si] glassy Young's modulus [Pa].")
-@click.option("--nu", "nu", type=str, default=None, help="[--si] Poisson's ratio.")
-@click.option("--tau0", "tau0", type=str, default=None, help="[--si] MPL time tau0 [s].")
-@click.option("--dg", "dg", type=str, default=None, help="[--si] work of adhesion [J/m^2].")
-@click.option("--h0", "h0", type=str, default=None, help="[--si] LJ equilibrium distance [m].")
-@click.option("--preload", "preload", type=str, default=None,
-              help="[--si] preload force [N] (relaxed JKR contact at that load).")
-@click.option("--a0-si", "a0_si", type=str, default=None, help="[--si] initial contact radius [m].")
-@click.option("--indentation", "indentation", type=str, default=None,
-              help="[--si] initial indentation [m].")
-@click.option("--speed", "speed", type=str, default=None, help="[--si] unloading speed [m/s].")
-@click.option("--material", type=click.Choice(["mpl", "sls"]), default="mpl", show_default=True)
-@click.option("--stop", type=click.Choice(["pulloff", "separation"]), default="pulloff",
-              show_default=True)
-@click.option("--preset", type=click.Choice(["fast", "balanced", "accurate"]), default="balanced",
+@scene_options
+@si_options
+@click.option("--preset", type=click.Choice(list(PRESETS)), default="balanced",
               show_default=True)
 @click.option("--nodes", type=str, default=None, help="Override the preset's node count.")
 @click.option("--domain", type=str, default=None, help="Mesh radius (a_ref); default automatic.")
@@ -204,26 +228,22 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
 @click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
-def scene_command(n, k, mu, a0, delta0, rate, model, si, material, stop, preset, nodes, domain,
-                  step, exact, as_json, trajectory, **si_values):
+def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, **axes):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .errors import as_float
     from .models import simulate_scene
-    from .scene import Numerics, Scene
+    from .scene import Numerics
 
+    si_values = {name: axes.pop(name) for name in _SI_OPTIONS}
     if si:
-        _scene_si(n, k, mu, a0, delta0, rate, model, material, as_json, si_values)
+        _scene_si(axes, as_json, si_values)
         return
     given = [f"--{name.replace('_', '-')}" for name, v in si_values.items() if v is not None]
     if given:
         raise InputError(f"{', '.join(given)}: SI options need --si")
-    if rate is None:
+    if axes["rate"] is None:
         raise InputError("rate must be given (--rate, the unloading rate r-hat > 0)")
-    sc = Scene(n=as_float("n", "0.8" if n is None else n), k=as_float("k", "0.1" if k is None else k),
-               mu=as_float("mu", "3.24" if mu is None else mu),
-               a0=None if a0 is None else as_float("a0", a0),
-               delta0=None if delta0 is None else as_float("delta0", delta0),
-               rate=as_float("rate", rate), material=material, stop=stop, model=model)
+    sc = scene_from_options(axes)
     overrides = {}
     if nodes is not None:
         try:
@@ -261,26 +281,27 @@ def scene_command(n, k, mu, a0, delta0, rate, model, si, material, stop, preset,
         raise SystemExit(1)
 
 
-def _scene_si(n, k, mu, a0, delta0, rate, model, material, as_json, values):
+def _scene_si(axes, as_json, values):
     """``sweep scene --si``: build an SIScene, run it, print both unit systems."""
     from .errors import as_float
     from .si import SIScene, run_si
 
-    dimless = {"k": k, "mu": mu, "a0": a0, "delta0": delta0, "rate": rate}
-    clash = [f"--{name}" for name, v in dimless.items() if v is not None]
+    dimless = {name: axes[name] for name in ("k", "mu", "a0", "delta0", "rate")}
+    defaults = {name: (None if AXES[name].default is None else format(AXES[name].default, "g"))
+                for name in dimless}
+    clash = [f"--{name}" for name, v in dimless.items() if v is not None and v != defaults[name]]
     if clash:
         raise InputError(f"{', '.join(clash)}: dimensionless options cannot be combined with "
                          f"--si (give --Einf, --h0, --preload/--a0-si/--indentation, --speed)")
     required = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "speed")
     missing = [f"--{name}" for name in required if values[name] is None]
-    if n is None:
-        missing.insert(0, "--n")
     if missing:
         raise InputError(f"{', '.join(missing)} must be given with --si")
     kw = {name: as_float(name, v) for name, v in values.items() if v is not None}
     if "a0_si" in kw:
         kw["a0"] = kw.pop("a0_si")
-    out = run_si(SIScene(n=as_float("n", n), material=material, **kw), model)
+    out = run_si(SIScene(n=as_float("n", axes["n"]), material=axes["material"], **kw),
+                 axes["model"])
     if as_json:
         echo_json(out)
     else:
@@ -428,13 +449,12 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
         click.echo(f"plot: {plot_out}")
 
 
-
 def main(argv=None) -> int:
     """Entry point: run the click group, mapping errors to one line + exit code."""
     try:
         cli.main(args=argv, standalone_mode=False)
     except InputError as exc:
-        click.echo(f"error: {exc}", err=True)
+        click.echo("error: " + " ".join(str(exc).split()), err=True)   # always one line
         return 2
     except click.exceptions.Abort:
         click.echo("error: aborted", err=True)

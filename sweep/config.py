@@ -13,21 +13,10 @@ Format (all keys; unknown keys are errors)::
     store: {trajectories: false}    # optional: also keep t, delta, P, a, a_inner per scene
     output: results/threshold.h5    # optional: HDF5 file; relative to the working directory
 
-Grid axes (the fields of :class:`sweep.scene.Scene`; units as there):
-
-========  ========  =========================================================
-axis      default   meaning
-========  ========  =========================================================
-n         required  MPL exponent, (0, 5]
-rate      required  unloading rate r-hat = r tau0 / h0, (0, 1e12]
-a0        --        initial contact radius (a_ref); give exactly one of a0, delta0
-delta0    --        initial indentation (d_ref)
-k         0.1       E0/Einf, (0, 1]
-mu        3.24      Tabor parameter, [0.5, 20]
-material  mpl       "mpl" or "sls"
-stop      pulloff   "pulloff" or "separation"
-model     bem       "bem", "crack", "pb" or "auto" (sweep.models)
-========  ========  =========================================================
+Grid axes: the fields of :class:`sweep.scene.Scene`, with the defaults, limits, units and
+meaning declared there once (:data:`sweep.scene.AXES`; listed in docs/configs.md and by
+``sweep scene --help``). ``n`` and ``rate`` are required, and exactly one of ``a0`` and
+``delta0``.
 
 The scenes are the Cartesian product of the axes. ``grid`` may also be a *list* of such
 mappings (e.g. the three panels of the paper's Fig. 3): the sweep is then the union of the
@@ -50,30 +39,29 @@ import json
 import os
 import re
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 import yaml
 
 from .errors import InputError, as_float, check_choice, check_int, check_range
-from .scene import MATERIALS, MODEL_NAMES, SCENE_LIMITS, STOPS, Numerics, Scene, scene_id
+from .scene import AXES as SCENE_AXIS_INFO
+from .scene import Numerics, Scene, scene_id
 
 #: Top-level keys of a config file.
 TOP_KEYS = ("name", "description", "grid", "numerics", "store", "output")
 #: Grid axes, in the order the Cartesian product iterates them (last varies fastest).
-AXES = ("material", "stop", "n", "k", "mu", "a0", "delta0", "rate")
-NUMERIC_AXES = ("n", "k", "mu", "a0", "delta0", "rate")
+#: Grid axes in the order of expansion (the last varies fastest): the Scene fields by their
+#: ``order`` metadata.
+AXES = tuple(sorted(SCENE_AXIS_INFO, key=lambda a: SCENE_AXIS_INFO[a].order))
 #: Defaults of axes left out of a grid.
-AXIS_DEFAULTS = {"k": 0.1, "mu": 3.24, "material": "mpl", "stop": "pulloff"}
+AXIS_DEFAULTS = {a.name: a.default for a in SCENE_AXIS_INFO.values() if a.default is not None}
 STORE_KEYS = ("trajectories",)
 RANGE_KINDS = ("log10", "linspace")
 MAX_SCENES = 200_000
 MAX_RANGE_NUM = 10_000
 _NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
-_OPEN_LOW = {"n", "k", "rate"}  # axes whose lower limit is excluded
-# the model axis (sweep.models): first, i.e. slowest-varying; "bem" when left out
-AXES = ("model",) + AXES
-AXIS_DEFAULTS["model"] = "bem"
 
 
 @dataclass(frozen=True)
@@ -100,6 +88,11 @@ class SweepConfig:
 
     def tasks(self) -> list[tuple[str, Scene]]:
         """``(scene_id, scene)`` pairs of the sweep, de-duplicated, in grid order."""
+        return list(self._tasks)
+
+    @cached_property
+    def _tasks(self) -> tuple:
+        # the grid is expanded and hashed once per config object (a frozen value)
         seen: dict[str, Scene] = {}
         for grid in self.grids:
             names = [a for a in AXES if a in grid]
@@ -108,9 +101,9 @@ class SweepConfig:
                 sid = scene_id(scene, self.numerics)
                 if sid not in seen:
                     seen[sid] = scene
-        return list(seen.items())
+        return tuple(seen.items())
 
-    @property
+    @cached_property
     def config_hash(self) -> str:
         """Hash of what the results depend on: the scene ids and the trajectory flag.
 
@@ -203,8 +196,9 @@ def _fmt_choices(items) -> str:
 
 def _axis_values(where: str, axis: str, spec, problems: list[str]) -> tuple | None:
     """Expand one axis spec into a tuple of validated values (None on error)."""
-    if axis in ("material", "stop", "model"):
-        allowed = {"material": MATERIALS, "stop": STOPS, "model": MODEL_NAMES}[axis]
+    info = SCENE_AXIS_INFO[axis]
+    if not info.numeric:
+        allowed = info.choices
         vals = spec if isinstance(spec, list) else [spec]
         if not vals:
             problems.append(f"{where}: must not be an empty list")
@@ -218,8 +212,8 @@ def _axis_values(where: str, axis: str, spec, problems: list[str]) -> tuple | No
                 problems.append(str(exc))
         return tuple(out) if len(out) == len(vals) else None
 
-    lo, hi = SCENE_LIMITS[axis]
-    lo_open = axis in _OPEN_LOW
+    lo, hi = info.limits
+    lo_open = info.lo_open
     if isinstance(spec, dict):
         kinds = [k for k in spec if k in RANGE_KINDS]
         unknown = [str(k) for k in spec if k not in RANGE_KINDS]
@@ -284,8 +278,8 @@ def _check_grid(where: str, grid, problems: list[str]) -> dict | None:
     for key in grid:
         if key not in AXES:
             problems.append(f"{where}.{key}: unknown axis (allowed: {_fmt_choices(AXES)})")
-    for axis in ("n", "rate"):
-        if axis not in grid:
+    for axis in AXES:
+        if SCENE_AXIS_INFO[axis].required and axis not in grid:
             problems.append(f"{where}.{axis}: required axis is missing")
     if ("a0" in grid) == ("delta0" in grid):
         problems.append(f"{where}: give exactly one of the axes a0 (initial contact radius) "

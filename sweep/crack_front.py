@@ -5,7 +5,7 @@ For contacts much larger than the process zone ``l0`` (large Tabor parameter, e.
 experiment at mu ~ 100) the BEM mesh is unaffordable; the classical alternative (Greenwood &
 Johnson, Barquins & Maugis) treats the contact edge as a crack in a relaxed elastic half-space
 whose energy release rate ``G`` must equal a rate-dependent fracture energy ``Gamma(v)``.
-Units of DESIGN.md section 2 (:mod:`sweep.units`): ``a`` in ``a_ref``, ``delta`` in ``d_ref``,
+Units of docs/design.md section 2 (:mod:`sweep.units`): ``a`` in ``a_ref``, ``delta`` in ``d_ref``,
 ``P`` in ``pi dg R`` (positive compressive), ``t`` in ``tau0``, crack speed
 ``v = -da/dt`` in ``a_ref / tau0``; ``g = G / dg`` and ``Gamma`` normalized by ``dg``.
 

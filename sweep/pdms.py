@@ -16,7 +16,7 @@ Models (all in :mod:`sweep.crack_front` / :mod:`sweep.models`):
 * ``crack_gs`` -- crack-front model, Gamma(v) = dg (1 + (v/v0)^xi) with the paper's fit of the
   experiments, v0 = 213.5 um/s, xi = 0.4154 (the analogue of the paper's green dashed line);
 * ``pb_estimate`` -- the paper's closed-form chain: crack speed from its v-r fit
-  vhat = 2.887 rhat^1.171 and P = 1.5 Gamma_PB(vhat), with rhat = r tau0/d_ref (DESIGN.md);
+  vhat = 2.887 rhat^1.171 and P = 1.5 Gamma_PB(vhat), with rhat = r tau0/d_ref (docs/design.md section 2);
 * ``pb_estimate_l0`` -- the same with rhat = r tau0/l0, the convention the paper uses in its
   PDMS discussion (it turns vhat = 1e9 into 31.4 m/s).
 
@@ -123,7 +123,7 @@ def compute(case=PDMS_CASE) -> dict:
                                 math.log(1e-3), math.log(1e24), xtol=1e-10))
     rhat_full = (vhat_full / 2.887) ** (1.0 / 1.171)
     speed_full_l0 = rhat_full * sc.l0 / tau0                 # paper's convention r tau0/l0
-    speed_full_dref = rhat_full * sc.d_ref / tau0            # DESIGN's r tau0/d_ref
+    speed_full_dref = rhat_full * sc.d_ref / tau0            # the project's r tau0/d_ref
     # the crack-front model's own answer: unloading speed for f * 1.5/k with a0 = 2 a0t_cf
     a_big = 2.0 * a0t_cf_hat
 

@@ -33,6 +33,8 @@ def plot_sweep(path, out=None) -> Path:
     out : str or Path, optional
         Output PNG; default: the results file with the suffix ``.png``.
     """
+    from .config import AXES
+    from .scene import AXES as AXIS_INFO
     from .store import load, load_trajectory
     from .theory import jkr_load
 
@@ -52,7 +54,8 @@ def plot_sweep(path, out=None) -> Path:
     ncols = 2 if has_traj else 1
     fig, axes = plt.subplots(1, ncols, figsize=(6.0 * ncols, 4.5), squeeze=False)
     ax = axes[0, 0]
-    keys = [c for c in ("material", "n", "k", "mu", "a0", "delta0") if c in ok and ok[c].nunique() > 1]
+    # one line per combination of the scene axes that vary (rate is the abscissa)
+    keys = [c for c in AXES if AXIS_INFO[c].plot_group and c in ok and ok[c].nunique() > 1]
     groups = ok.groupby(keys, dropna=False) if keys else [((), ok)]
     for key, g in groups:
         g = g.sort_values("rate")
@@ -61,7 +64,7 @@ def plot_sweep(path, out=None) -> Path:
         ax.plot(g["rate"], g["pull_off"], "o-", label=label or None)
     ax.axhline(1.5, color="0.6", ls=":", lw=1, label="JKR elastic, 1.5")
     ax.set_xscale("log")
-    ax.set_xlabel(r"unloading rate $\hat r = r\tau_0/h_0$")
+    ax.set_xlabel(AXIS_INFO["rate"].label)
     ax.set_ylabel(r"pull-off force $\hat P_{po}$  ($\pi\Delta\gamma_0 R$)")
     ax.set_title(f"{path.name}: {len(ok)} ok, {len(df) - len(ok)} failed")
     ax.legend(fontsize=7)

@@ -1,6 +1,6 @@
 """Plain, serializable values that describe one simulation: ``Scene``, ``Numerics``, ``Result``.
 
-Units are those of DESIGN.md section 2 (see :mod:`sweep.units`):
+Units are those of docs/design.md section 2 (see :mod:`sweep.units`):
 
 * radii ``a0`` in ``a_ref = (pi R^2 dg / E0*)^(1/3)``;
 * indentation ``delta0`` in ``d_ref = a_ref^2 / R`` (the paper's delta-hat);
@@ -19,6 +19,7 @@ import hashlib
 import json
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -29,15 +30,37 @@ STOPS = ("pulloff", "separation")
 #: Models a scene can ask for (sweep.models maps each to its simulate function).
 MODEL_NAMES = ("bem", "crack", "pb", "auto")
 
-#: Physical ranges accepted by :class:`Scene` (wider than the tested extremes).
-SCENE_LIMITS = {
-    "n": (0.0, 5.0),        # MPL exponent, open at 0
-    "k": (0.0, 1.0),        # E0/Einf, open at 0, closed at 1 (k = 1 is elastic)
-    "mu": (0.5, 20.0),      # Tabor parameter
-    "rate": (0.0, 1e12),    # r-hat, open at 0
-    "a0": (0.3, 50.0),      # initial (max-tension) contact radius, a_ref units
-    "delta0": (-5.0, 2500.0),  # initial indentation, d_ref units
-}
+
+def axis(default=dataclasses.MISSING, *, help: str, unit: str = "", limits=None,
+         lo_open: bool = False, choices=None, label: str = "", order: int,
+         plot_group: bool = True, cli_default=None):
+    """A Scene field with the metadata every other part of the package derives from.
+
+    Parameters
+    ----------
+    default : optional
+        The field's default (none: required; ``None``: optional, absent unless given).
+    help : str
+        One-line meaning (CLI help, docs).
+    unit : str
+        Unit of the value (docs/design.md section 2), "" if dimensionless.
+    limits : (lo, hi), optional
+        Accepted interval; ``lo_open`` excludes the lower end.
+    choices : tuple of str, optional
+        Accepted values of a categorical field.
+    label : str
+        Axis label for figures (matplotlib mathtext); default the name.
+    order : int
+        Position of the axis in the expansion of a config grid (the last one varies fastest).
+    plot_group : bool
+        Whether figures draw one line per value of this axis.
+    cli_default : optional
+        Default of ``sweep scene --<name>`` for a required field (a convenience of the CLI).
+    """
+    meta = {"help": help, "unit": unit, "limits": limits, "lo_open": lo_open,
+            "choices": choices, "label": label, "order": order, "plot_group": plot_group,
+            "cli_default": cli_default}
+    return field(default=default, metadata={"axis": meta})
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -73,33 +96,35 @@ class Scene:
         numerics' node count, else the crack-front model); ``Result.model_used`` records it.
     """
 
-    n: float
-    k: float = 0.1
-    mu: float = 3.24
-    rate: float
-    a0: float | None = None
-    delta0: float | None = None
-    material: str = "mpl"
-    stop: str = "pulloff"
-    model: str = "bem"
+    n: float = axis(help="MPL exponent (spectrum broadness); unused by sls", limits=(0.0, 5.0),
+                    lo_open=True, label="$n$", order=2, cli_default=0.8)
+    k: float = axis(0.1, help="E0/Einf, relaxed over glassy modulus; 1 is elastic",
+                    limits=(0.0, 1.0), lo_open=True, label="$k$", order=3)
+    mu: float = axis(3.24, help="Tabor parameter", limits=(0.5, 20.0), label=r"$\mu$", order=4)
+    rate: float = axis(help="unloading rate r-hat = r tau0 / h0", limits=(0.0, 1e12),
+                       lo_open=True, label=r"unloading rate $\hat r = r\tau_0/h_0$", order=7,
+                       plot_group=False)
+    a0: float | None = axis(None, help="initial contact radius (max-tension radius); give a0 "
+                            "or delta0", unit="a_ref", limits=(0.3, 50.0), label=r"$\hat a_0$",
+                            order=5)
+    delta0: float | None = axis(None, help="initial indentation; alternative to a0",
+                                unit="d_ref", limits=(-5.0, 2500.0), label=r"$\hat\delta_0$",
+                                order=6)
+    material: str = axis("mpl", help="creep compliance: MPL retardation spectrum or SLS",
+                         choices=MATERIALS, order=0)
+    stop: str = axis("pulloff", help="stop after the pull-off, or follow the curve to "
+                     "separation", choices=STOPS, order=1, plot_group=False)
+    model: str = axis("bem", help="model that runs the scene (sweep.models): boundary "
+                      "elements, crack-front model, PB estimate, or auto", choices=MODEL_NAMES,
+                      order=-1)
 
     def __post_init__(self):
-        lim = SCENE_LIMITS
-        set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
-        set_("n", check_range("n", self.n, lim["n"][0], lim["n"][1], lo_open=True))
-        set_("k", check_range("k", self.k, lim["k"][0], lim["k"][1], lo_open=True))
-        set_("mu", check_range("mu", self.mu, *lim["mu"]))
-        set_("rate", check_range("rate", self.rate, lim["rate"][0], lim["rate"][1], lo_open=True))
-        if (self.a0 is None) == (self.delta0 is None):
-            raise InputError("a0/delta0: give exactly one of a0 (initial contact radius) "
-                             "and delta0 (initial indentation)")
-        if self.a0 is not None:
-            set_("a0", check_range("a0", self.a0, *lim["a0"]))
-        if self.delta0 is not None:
-            set_("delta0", check_range("delta0", self.delta0, *lim["delta0"]))
-        check_choice("material", self.material, MATERIALS)
-        check_choice("stop", self.stop, STOPS)
-        check_choice("model", self.model, MODEL_NAMES)
+        info = _axes_of(type(self))
+        for f in dataclasses.fields(self):
+            if f.name == "a0" and (self.a0 is None) == (self.delta0 is None):
+                raise InputError("a0/delta0: give exactly one of a0 (initial contact radius) "
+                                 "and delta0 (initial indentation)")
+            object.__setattr__(self, f.name, info[f.name].check(getattr(self, f.name)))
 
     def to_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -112,6 +137,72 @@ class Scene:
             raise InputError(f"scene: unknown key(s) {', '.join(sorted(unknown))} "
                              f"(allowed: {', '.join(sorted(names))})")
         return cls(**d)
+
+
+@dataclass(frozen=True)
+class Axis:
+    """What a Scene field is, read from its :func:`axis` metadata (see there)."""
+
+    name: str
+    default: object
+    required: bool
+    help: str
+    unit: str
+    limits: tuple | None
+    lo_open: bool
+    choices: tuple | None
+    label: str
+    order: int
+    plot_group: bool
+    cli_default: object
+
+    @property
+    def numeric(self) -> bool:
+        return self.choices is None
+
+    def check(self, value):
+        """The validated value (float for numeric axes; None passes for optional ones)."""
+        if self.choices is not None:
+            return check_choice(self.name, value, self.choices)
+        if value is None and not self.required:
+            return None
+        lo, hi = self.limits if self.limits else (None, None)
+        return check_range(self.name, value, lo, hi, lo_open=self.lo_open)
+
+    def allowed(self) -> str:
+        """The accepted values in words: ``(0, 5]``, ``mpl, sls``."""
+        if self.choices is not None:
+            return ", ".join(self.choices)
+        lo, hi = self.limits
+        return f"{'(' if self.lo_open else '['}{lo:g}, {hi:g}]"
+
+    def describe(self) -> str:
+        """``help (unit); allowed`` (CLI help and docs)."""
+        unit = f" ({self.unit} units)" if self.unit else ""
+        return f"{self.help}{unit}; {self.allowed()}"
+
+
+@lru_cache(maxsize=None)
+def _axes_of(cls) -> dict:
+    out = {}
+    for f in dataclasses.fields(cls):
+        m = f.metadata["axis"]
+        required = f.default is dataclasses.MISSING
+        out[f.name] = Axis(name=f.name, default=None if required else f.default,
+                           required=required, help=m["help"], unit=m["unit"],
+                           limits=m["limits"], lo_open=m["lo_open"], choices=m["choices"],
+                           label=m["label"] or f.name, order=m["order"],
+                           plot_group=m["plot_group"], cli_default=m["cli_default"])
+    return out
+
+
+#: The scene parameters, in field order (n, k, mu, rate, a0, delta0, material, stop): the
+#: grid axes of a config, the scene columns of a results file, the options of `sweep scene`.
+AXES: dict[str, Axis] = _axes_of(Scene)
+#: Their names, in field order.
+SCENE_AXES = tuple(AXES)
+#: Physical ranges accepted by :class:`Scene` (derived from the field metadata).
+SCENE_LIMITS = {a.name: a.limits for a in AXES.values() if a.limits}
 
 
 #: Named numerical presets. Each is a complete set of :class:`Numerics` fields.
@@ -155,7 +246,7 @@ class Numerics:
         of the Prony recursion. For validation on small problems.
     zone_nodes : float
         Fewest node spacings across the cohesive (process) zone, l0 = 1.693/mu^2 a_ref
-        (DESIGN.md section 2). A coarser mesh traps the crack tip between nodes (jagged
+        (docs/design.md section 2). A coarser mesh traps the crack tip between nodes (jagged
         P(t), spurious minima, failed Newton solves), so such a scene is refused with a
         ``failed`` status that says how many nodes it needs.
     """
@@ -212,6 +303,21 @@ class Numerics:
         return cls(**d)
 
 
+#: Version of the id form below. Version 1: the JSON of ``{"scene": ..., "numerics": ...}``
+#: with every field of :data:`ID_V1_FIELDS` and, of fields added since, those not at their
+#: default. A change of the form itself (not the addition of a defaulted field, which keeps
+#: every id) must raise this number and teach :mod:`sweep.store` to migrate older files.
+SCENE_ID_VERSION = 1
+
+#: The fields of Scene and Numerics when ids were introduced (version 1). They are always
+#: part of the id, so that the ids of files written then stay what they were.
+ID_V1_FIELDS = {
+    "scene": ("n", "k", "mu", "rate", "a0", "delta0", "material", "stop"),
+    "numerics": ("nodes", "domain", "tail_gap", "step", "min_step", "da_max", "prony_rtol",
+                 "tol", "max_steps", "exact", "zone_nodes"),
+}
+
+
 def _canonical(obj) -> str:
     def norm(v):
         if isinstance(v, float):
@@ -222,28 +328,33 @@ def _canonical(obj) -> str:
     return json.dumps(norm(obj), sort_keys=True, separators=(",", ":"))
 
 
+def id_form(obj, always=()) -> dict:
+    """The fields of a Scene or Numerics that enter its id.
+
+    Every field named in ``always`` (the version-1 fields), and any other field whose value
+    differs from its declared default: a field added later with a default therefore leaves
+    the ids of all existing scenes unchanged. Never change such a field's default (the old
+    default would then be read as the new one); add a field instead.
+    """
+    out = {}
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if f.name in always or f.default is dataclasses.MISSING or value != f.default:
+            out[f.name] = value
+    return out
+
+
 def scene_id(scene: Scene, numerics: Numerics) -> str:
     """Stable id of a (scene, numerics) pair: 16 hex digits of the SHA-1 of canonical JSON.
 
     The same parameters always map to the same id (sorted keys, repr'd floats), which
-    makes resume and de-duplication of sweeps trivial.
+    makes resume and de-duplication of sweeps trivial. The hashed form is that of
+    :data:`SCENE_ID_VERSION` (see :func:`id_form`): adding a field with a default to Scene or
+    Numerics renames no scene, so existing results files keep resuming.
     """
-    text = _canonical({"scene": scene.to_dict(), "numerics": numerics.to_dict()})
+    text = _canonical({"scene": id_form(scene, ID_V1_FIELDS["scene"]),
+                       "numerics": id_form(numerics, ID_V1_FIELDS["numerics"])})
     return hashlib.sha1(text.encode()).hexdigest()[:16]
-
-
-#: Scalar result fields, in the order they are stored (HDF5 ``runs`` table columns).
-RESULT_SCALARS = (
-    "status", "reason",
-    "pull_off", "a_pulloff", "a_inner_pulloff", "delta_pulloff", "t_pulloff",
-    "crack_speed", "vhat", "rhat_pb",
-    "a0_result", "a0_inner", "delta0_result",
-    "steps", "newton_iterations", "factorizations", "prony_terms", "prony_error",
-    "spacing", "domain_used", "wall_s",
-    "model_used",
-)
-
-TRAJECTORY_KEYS = ("t", "delta", "P", "a", "a_inner")
 
 
 @dataclass
@@ -340,3 +451,10 @@ class Result:
         if trajectory:
             d["trajectory"] = {k: np.asarray(v).tolist() for k, v in self.trajectory.items()}
         return d
+
+
+#: Scalar result fields, in the order they are stored (HDF5 ``runs`` table columns): every
+#: field of :class:`Result` with a number or string default (not the scene, numerics,
+#: trajectory or arrays), so a new result field is a new column.
+RESULT_SCALARS = tuple(f.name for f in dataclasses.fields(Result)
+                       if isinstance(f.default, (int, float, str)))

@@ -42,12 +42,10 @@ from .config import SweepConfig, as_config
 from .errors import InputError, check_int, check_range
 from .scene import Result
 from .store import ResultStore, StoreBusyError, plain_row
+from .threads import THREAD_VARS, limit_env, limit_loaded_pools
 
 BACKENDS = ("loky", "dask")
 PROGRESS_MODES = ("auto", "bar", "log", "none")
-THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
-               "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
-               "NUMBA_NUM_THREADS")
 
 
 class SweepRuntimeError(RuntimeError):
@@ -91,19 +89,12 @@ def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
     if _WORKER_READY:
         return
     if limit_threads:
-        for var in THREAD_VARS:
-            os.environ.setdefault(var, "1")
-        try:
-            from threadpoolctl import threadpool_limits
-
-            threadpool_limits(limits=1)
-        except Exception:  # pragma: no cover - threadpoolctl is a joblib dependency
-            pass
+        limit_env(THREAD_VARS)
+        limit_loaded_pools()
     if warm:
         from . import solver
 
-        if hasattr(solver, "warm_up"):
-            solver.warm_up()
+        solver.warm_up()
     _WORKER_READY = True
 
 
@@ -157,15 +148,13 @@ def template_row(config: SweepConfig) -> dict:
 
 
 # ----------------------------------------------------------------------------- progress
-def _fmt_eta(seconds: float) -> str:
-    if not math.isfinite(seconds):
-        return "--:--:--"
-    s = int(round(seconds))
-    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
-
-
 class Progress:
-    """Progress display: one updating line on a TTY ("bar"), one line per scene ("log")."""
+    """Progress display: a tqdm bar on a terminal ("bar"), one line per scene ("log").
+
+    "log" is the mode for files and CI logs (no carriage returns): each finished scene prints
+    ``[done/total] <scene_id> <status> pull_off=... wall=...s`` (and the reason of a failure).
+    A callable ``mode`` gets a dict (done, total, failed, eta, row) after each scene instead.
+    """
 
     def __init__(self, mode, total: int, already: int, stream=None):
         self.stream = stream if stream is not None else sys.stderr
@@ -181,14 +170,19 @@ class Progress:
         self.failed = 0
         self.t0 = time.monotonic()
         self.width = len(str(total))
+        self.bar = None
 
-    def _echo(self, text: str, nl: bool = True) -> None:
-        click.echo(text, file=self.stream, nl=nl)
+    def _echo(self, text: str) -> None:
+        if self.bar is not None:
+            self.bar.write(text, file=self.stream)
+            return
+        click.echo(text, file=self.stream)
         with_flush = getattr(self.stream, "flush", None)
         if with_flush:
             with_flush()
 
     def eta(self) -> float:
+        """Seconds left, from the mean time per scene run so far (inf before the first)."""
         ran = self.done - self.already
         if ran <= 0:
             return math.inf
@@ -198,13 +192,12 @@ class Progress:
         if self.mode != "none":
             self._echo(text)
 
-    def bar_text(self) -> str:
-        return (f"[{self.done:{self.width}d}/{self.total}] {self.failed} failed  "
-                f"ETA {_fmt_eta(self.eta())}")
-
     def start(self) -> None:
         if self.mode == "bar":
-            self._echo("\r" + self.bar_text(), nl=False)
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=self.total, initial=self.already, file=self.stream,
+                            unit="scene", dynamic_ncols=True, postfix="0 failed")
 
     def update(self, row: dict) -> None:
         self.done += 1
@@ -213,8 +206,9 @@ class Progress:
         if self.callback is not None:
             self.callback({"done": self.done, "total": self.total, "failed": self.failed,
                            "eta": self.eta(), "row": row})
-        if self.mode == "bar":
-            self._echo("\r" + self.bar_text() + "   ", nl=False)
+        if self.bar is not None:
+            self.bar.set_postfix_str(f"{self.failed} failed", refresh=False)
+            self.bar.update(1)
         elif self.mode == "log":
             po = row.get("pull_off")
             po = f"{po:.5g}" if isinstance(po, float) else str(po)
@@ -225,8 +219,9 @@ class Progress:
             self._echo(text)
 
     def close(self) -> None:
-        if self.mode == "bar":
-            self._echo("")
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -437,8 +432,7 @@ def _warm_parent() -> None:
         from . import solver
     except ImportError as exc:
         raise SweepRuntimeError(f"cannot import the solver ({exc})") from None
-    if hasattr(solver, "warm_up"):
-        solver.warm_up()
+    solver.warm_up()
 
 
 def _results(todo, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate):
@@ -448,11 +442,7 @@ def _results(todo, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate
     calls = (delayed(run_scene)(scene, cfg.numerics, cfg.trajectories, simulate)
              for _, scene in todo)
     if backend == "loky" and n_jobs == 1:
-        try:
-            from threadpoolctl import threadpool_limits
-            limits = threadpool_limits(limits=1)
-        except Exception:  # pragma: no cover
-            limits = None
+        limits = limit_loaded_pools()
         try:
             for _, scene in todo:
                 yield run_scene(scene, cfg.numerics, cfg.trajectories, simulate,

@@ -1,5 +1,5 @@
 r"""Scenes in SI units: a sphere, a material, an interface, an initial state and an unloading
-speed, converted to the dimensionless scene (DESIGN.md section 2, via :mod:`sweep.units`) and
+speed, converted to the dimensionless scene (docs/design.md section 2, via :mod:`sweep.units`) and
 results converted back.
 
 Inputs (SI): sphere radius ``R`` [m]; relaxed and glassy Young's moduli ``E0``, ``Einf`` [Pa];

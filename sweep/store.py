@@ -45,7 +45,10 @@ File contents (plain arrays and text only; no pickles):
   ``config_text``, ``config_source``, ``package_version``, ``git_commit``, ``numba_version``,
   ``numpy_version``, ``h5py_version``, ``python_version``, ``started_at``, ``updated_at``,
   ``finished_at`` (ISO 8601 UTC; ``finished_at`` is empty until every scene is done),
-  ``n_scenes`` (size of the grid), ``n_finished``, ``complete``, ``trajectories``.
+  ``n_scenes`` (size of the grid), ``n_finished``, ``complete``, ``trajectories``,
+  ``scene_id_version`` (:data:`sweep.scene.SCENE_ID_VERSION`; absent in files written before
+  it was recorded, which are version 1). A file of a newer id version is refused for resuming
+  (one-line error, file untouched); it still loads.
 """
 from __future__ import annotations
 
@@ -66,6 +69,7 @@ import h5py
 import numpy as np
 
 from .errors import InputError
+from .scene import SCENE_AXES, SCENE_ID_VERSION
 
 try:
     import fcntl
@@ -209,10 +213,13 @@ def _read_journal(path: Path) -> list[dict]:
 
 
 def _open_main(path: Path):
+    if path.is_dir():
+        raise InputError(f"{path} is a directory, not a results file (give the .h5 file)")
     try:
         f = h5py.File(path, "r")
     except (OSError, ValueError) as exc:
-        raise InputError(f"{path}: not a readable HDF5 results file ({exc})") from None
+        raise InputError(f"{path}: not a readable HDF5 results file "
+                         f"({' '.join(str(exc).split())})") from None
     if f.attrs.get("format") != FORMAT:
         f.close()
         raise InputError(f"{path}: not a visco-sweep results file (no format attribute "
@@ -390,14 +397,13 @@ class ResultStore:
             "config_name": config_name, "config_hash": config_hash,
             "config_text": config_text, "config_source": config_source,
             "n_scenes": int(n_scenes), "trajectories": bool(trajectories),
-            "started_at": now_iso(),
+            "scene_id_version": SCENE_ID_VERSION, "started_at": now_iso(),
         }
         self.trajectories = bool(trajectories)
         self.template = plain_row(template_row or {"scene_id": ""})
         self.interval = float(interval)
         self.rows: list[dict] = []
         self._ids: dict[str, int] = {}
-        self._in_main: set[str] = set()
         self._lock_fd = None
         self._jfd = None
         self._dirty = False
@@ -440,7 +446,11 @@ class ResultStore:
             self._lock_fd = None
 
     # -- checks -----------------------------------------------------------------
-    def _existing_hashes(self) -> list[tuple[str, str]]:
+    def _existing_hashes(self) -> list[tuple[str, str, int]]:
+        """(where, config hash, scene id version) of the main file and the journal's meta.
+
+        Files written before the id version was recorded are version 1.
+        """
         found = []
         if self.path.exists():
             if self.path.is_dir():
@@ -448,7 +458,8 @@ class ResultStore:
                                  f"such as {self.path}/results.h5")
             try:
                 with _open_main(self.path) as f:
-                    found.append((str(self.path), str(f.attrs.get("config_hash", ""))))
+                    found.append((str(self.path), str(f.attrs.get("config_hash", "")),
+                                  int(f.attrs.get("scene_id_version", 1))))
             except InputError as exc:
                 raise InputError(f"{exc}; refusing to overwrite it: use --out to write "
                                  f"elsewhere, or --fresh to move it aside to a .bak file") \
@@ -456,9 +467,11 @@ class ResultStore:
         meta = self.parts / META
         if meta.exists():
             try:
-                found.append((str(self.parts), json.loads(meta.read_text())["config_hash"]))
-            except (ValueError, KeyError, OSError):
-                found.append((str(self.parts), "?"))
+                m = json.loads(meta.read_text())
+                found.append((str(self.parts), m["config_hash"],
+                              int(m.get("scene_id_version", 1))))
+            except (ValueError, KeyError, OSError, TypeError):
+                found.append((str(self.parts), "?", 1))
         return found
 
     def prepare(self, resume: bool = True) -> None:
@@ -472,7 +485,12 @@ class ResultStore:
             hashes = self._existing_hashes() if resume else []
             if not resume and self.path.is_dir():
                 raise InputError(f"output {self.path} is a directory; give a file path")
-            for where, h in hashes:
+            for where, h, version in hashes:
+                if version > SCENE_ID_VERSION:
+                    raise InputError(
+                        f"{where} was written with scene id version {version}, newer than this "
+                        f"visco-sweep's {SCENE_ID_VERSION}: resume it with the version that "
+                        f"wrote it, or use --out to write elsewhere")
                 if h != self.config_hash:
                     raise InputError(
                         f"{where} holds results of a different config (config hash {h}, this "
@@ -500,7 +518,6 @@ class ResultStore:
                 self._main_complete = bool(f.attrs.get("complete", 0))
                 for row in _read_runs_rows(f):
                     self._add(row)
-                self._in_main = set(self._ids)
         meta = self.parts / META
         if meta.exists() and started is None:
             with contextlib.suppress(ValueError, OSError, KeyError):
@@ -532,10 +549,6 @@ class ResultStore:
     def _add(self, row: dict) -> None:
         self._ids[row["scene_id"]] = len(self.rows)
         self.rows.append(row)
-
-    @property
-    def finished(self) -> set[str]:
-        return set(self._ids)
 
     # -- appending --------------------------------------------------------------
     def append(self, row: dict, trajectory: dict | None = None) -> None:
@@ -627,7 +640,6 @@ class ResultStore:
         _fsync_path(tmp)
         os.replace(tmp, self.path)
         _fsync_path(self.path.parent, directory=True)
-        self._in_main = set(self._ids)
         self._dirty = False
         self._main_complete = bool(complete)
         self._last = time.monotonic()
@@ -658,7 +670,8 @@ class ResultStore:
 
 
 # ----------------------------------------------------------------------------- summary
-SCENE_PARAMS = ("n", "k", "mu", "rate", "a0", "delta0", "material", "stop")
+#: Scene columns of the runs table that ``sweep info`` summarizes (the Scene fields).
+SCENE_PARAMS = SCENE_AXES
 
 
 def _g(x) -> str:

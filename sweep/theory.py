@@ -1,6 +1,6 @@
 r"""Analytic theory: Persson-Brener effective surface energy, JKR/Hertz, Gent-Schultz.
 
-All quantities are in the dimensionless units of DESIGN.md section 2 (see :mod:`sweep.units`):
+All quantities are in the dimensionless units of docs/design.md section 2 (see :mod:`sweep.units`):
 contact radius ``a`` in ``a_ref``, indentation in ``d_ref``, load in ``pi dg R``; the
 Persson-Brener crack speed is ``vhat = v tau0 / l0``.
 
@@ -62,6 +62,9 @@ __all__ = [
 
 #: Largest MPL exponent accepted by the PB routines (the quadrature step is tuned up to it).
 N_MAX = 10.0
+#: Largest crack speed vhat accepted: Gamma_eff equals 1/k to 1e-16 from vhat ~ 1e50 on, and
+#: the quadrature in log time overflows near 1e300.
+VHAT_MAX = 1e100
 _STEP = 0.2  # trapezoid step in s = ln(x / c)
 _TAIL = 36.0  # half-width of the s-window around both 0 and ln(1/c): e^-36 ~ 2e-16
 
@@ -71,6 +74,13 @@ _TAIL = 36.0  # half-width of the s-window around both 0 and ln(1/c): e^-36 ~ 2e
 # --------------------------------------------------------------------------------------------
 def _check_n(n) -> float:
     return check_range("n", n, lo=0.0, hi=N_MAX, lo_open=True)
+
+
+def _check_vhat(vhat, lo_open: bool = False) -> np.ndarray:
+    v = check_array("vhat", vhat, lo=0.0, lo_open=lo_open)
+    if v.size and np.max(v) > VHAT_MAX:
+        raise InputError(f"vhat must be <= {VHAT_MAX:g} (got {np.max(v):g})")
+    return v
 
 
 def _check_k(k) -> float:
@@ -172,7 +182,7 @@ def pb_integral(n, vhat, gamma):
         ``I`` in (0, 1), relative accuracy about 1e-13.
     """
     n = _check_n(n)
-    vhat = check_array("vhat", vhat, lo=0.0, lo_open=True)
+    vhat = _check_vhat(vhat, lo_open=True)
     gamma = check_array("gamma", gamma, lo=0.0, lo_open=True)
     v, g = np.broadcast_arrays(vhat, gamma)
     c = (g / (2.0 * np.pi * v)).ravel()
@@ -212,7 +222,7 @@ def pb_gamma_eff(n, k, vhat):
     """
     n = _check_n(n)
     k = _check_k(k)
-    v = check_array("vhat", vhat, lo=0.0)
+    v = _check_vhat(vhat)
     out = _solve_gamma(v.ravel(), k, lambda c: _mpl_integrals(n, c))
     return _scalar_or_array(out.reshape(v.shape), v)
 
@@ -262,7 +272,7 @@ def pb_gamma_eff_spectrum(weights, times, k, vhat):
         raise InputError("weights must have a positive sum (got 0)")
     w = w / total
     k = _check_k(k)
-    v = check_array("vhat", vhat, lo=0.0)
+    v = _check_vhat(vhat)
     out = _solve_gamma(v.ravel(), k, lambda c: _spectrum_integrals(w, t, c))
     return _scalar_or_array(out.reshape(v.shape), v)
 
@@ -347,7 +357,7 @@ def pb_integral_closed_form(n, vhat, gamma, rtol: float = 1e-8):
             f"n must not be an integer for the closed form (got {n:g}); use pb_integral"
         )
     rtol = check_positive("rtol", rtol)
-    vhat = check_array("vhat", vhat, lo=0.0, lo_open=True)
+    vhat = _check_vhat(vhat, lo_open=True)
     gamma = check_array("gamma", gamma, lo=0.0, lo_open=True)
     v, g = np.broadcast_arrays(vhat, gamma)
     out = np.array(
@@ -358,7 +368,7 @@ def pb_integral_closed_form(n, vhat, gamma, rtol: float = 1e-8):
 
 
 # --------------------------------------------------------------------------------------------
-# JKR and Hertz (units of DESIGN.md section 2: a in a_ref, delta in d_ref, P in pi dg R)
+# JKR and Hertz (units of docs/design.md section 2: a in a_ref, delta in d_ref, P in pi dg R)
 # --------------------------------------------------------------------------------------------
 _SQRT2 = math.sqrt(2.0)
 #: contact radius at the force-controlled pull-off, dP/da = 0: a^(3/2) = 3 sqrt(2) / 4

@@ -1,4 +1,4 @@
-"""Dimensionless <-> physical conversions (DESIGN.md section 2): the one place that owns them.
+"""Dimensionless <-> physical conversions (docs/design.md section 2): the one place that owns them.
 
 Units of the dimensionless problem ("hats"), for a sphere of radius ``R`` on a half-space of
 relaxed plane-strain modulus ``E0* = E0 / (1 - nu^2)`` with work of adhesion ``dg``:
@@ -10,7 +10,7 @@ in-plane length (r, a, l0)    ``a_ref = (pi R^2 dg / E0*)^(1/3)``
 normal length (h, u, delta)   ``d_ref = (pi^2 dg^2 R / E0*^2)^(1/3) = a_ref^2/R``
 traction                      ``p_ref = E0* d_ref / a_ref``
 load                          ``load_ref = pi dg R``
-time                          ``tau0`` (MPL characteristic / SLS relaxation time)
+time                          ``tau0`` (MPL characteristic / SLS retardation time)
 ============================  ==================================================
 
 Tabor parameter ``mu = (R dg^2 / (E0*^2 h0^3))^(1/3)``; everything dimensionless that depends
@@ -22,7 +22,7 @@ Rates and speeds (three different normalisations, never mix them):
 * ``rate`` (the paper's r-hat): indenter speed ``r tau0 / h0``; in the dimensionless scene
   ``d delta / dt = -rate * h0_hat``.
 * ``rhat_pb``: ``r tau0 / d_ref = rate * h0_hat``, the abscissa of the paper's fit
-  ``vhat = 2.887 rhat_PB^1.171`` (DESIGN.md section 2 explains the choice).
+  ``vhat = 2.887 rhat_PB^1.171`` (docs/design.md section 2 explains the choice).
 * crack speed ``v_a = -da/dt`` in ``a_ref / tau0`` (BEM output) versus the Persson-Brener
   ``vhat = v tau0 / l0 = v_a / l0_hat``.
 """
@@ -139,7 +139,7 @@ def rhat_pb(rate, mu):
 
     The paper writes ``r tau / l0``, but ``r tau0 / l0`` is not fixed by the dimensionless
     scene; the first author's scripts use ``rate * h0_hat`` i.e. ``r tau0 / d_ref`` (the
-    indenter speed in normal units), which is the definition used here (DESIGN.md section 2).
+    indenter speed in normal units), which is the definition used here (docs/design.md section 2).
 
     Parameters
     ----------

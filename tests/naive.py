@@ -4,7 +4,7 @@ Plain numpy/scipy (no Numba), written independently of ``kernels/`` and ``sweep/
 only ``sweep.errors`` may be imported from the package. Used by the tests to check the fast
 solver on small problems (N ~ 60..200 nodes, coarse indentation steps).
 
-Units and conventions: DESIGN.md sections 1, 2, 4 (dimensionless, hats dropped, E* = 1, R = 1).
+Units and conventions: docs/design.md sections 1, 2, 4 (dimensionless, hats dropped, E* = 1, R = 1).
 
 * lengths in the plane (r, a): a_ref; normal lengths (h, u, delta, h0): d_ref;
   traction sigma: p_ref (positive = compressive); load P: pi dg R; time t: tau0.
@@ -43,7 +43,7 @@ time between steps, substrate fully relaxed at t = 0 under the traction sigma_0:
 
     u(t_n) = A [ sigma_0 + sum_{m=1..n} (sigma_m - sigma_{m-1})/dt_m (Psi(t_n - t_{m-1}) - Psi(t_n - t_m)) ]
 
-Psi(T) = int_0^T Chat, closed form for the MPL retardation compliance (DESIGN.md section 4) and
+Psi(T) = int_0^T Chat, closed form for the MPL retardation compliance (docs/design.md section 3) and
 for the SLS. The unknown sigma_n enters with weight c = Psi(dt_n)/dt_n.
 
 Folds: on a coarse mesh (process zone ~ one element: at mu = 3.24 dr >~ 0.02, at mu = 6

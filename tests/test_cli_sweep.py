@@ -16,6 +16,7 @@ import h5py
 import numpy as np
 import pytest
 
+from sweep import simulate
 from sweep.cli import main
 from sweep.config import load_config
 from sweep.scheduler import run_sweep
@@ -71,7 +72,15 @@ def test_run_then_info_real_solver(tmp_path):
     assert len(logged) == 4                             # not a TTY: one line per scene
     df = load(out)
     assert sorted(df.scene_id) == sorted(logged)
-    assert set(df.status) <= {"ok", "failed"}
+    # every stored row is what simulate() gives for that scene in this process (second path:
+    # no scheduler, no worker, no store); the solver is deterministic, so equal to 1e-12
+    direct = {sid: simulate(scene, load_config(cfg).numerics)
+              for sid, scene in load_config(cfg).tasks()}
+    for row in df.itertuples():
+        res = direct[row.scene_id]
+        assert (row.status, row.reason, row.steps) == (res.status, res.reason, res.steps)
+        assert row.pull_off == pytest.approx(res.pull_off, rel=1e-12, nan_ok=True)
+        assert row.a_pulloff == pytest.approx(res.a_pulloff, rel=1e-12, nan_ok=True)
     attrs = read_attrs(out)
     assert attrs["config_text"] == TINY and attrs["complete"]
     assert attrs["numba_version"] and attrs["git_commit"]
@@ -304,3 +313,10 @@ def test_sigkill_at_several_moments_then_resume(tmp_path):
             assert snapshot[sid] == fin
     assert not parts_dir(out).exists() and read_attrs(out)["complete"]
     assert f"{len(tasks) - len(final_ids)} already done" in final.stdout
+
+
+def test_info_on_a_directory_is_one_line(tmp_path, capsys):
+    # h5py's message for a directory spans two lines; the CLI prints one
+    assert main(["info", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is a directory" in err

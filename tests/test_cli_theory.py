@@ -157,3 +157,15 @@ def test_material_bad_input(capsys, argv, message):
     assert code == 2
     assert out == ""
     assert err.startswith(message) and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["pb", "--n", "0.4", "--k", "0.1", "--v", "1e300"], "error: vhat must be <= 1e+100"),
+    (["material", "--n", "0.4", "--k", "0.1", "--t", "1e-200,1e200"],
+     "error: t_max/t_min must be at most 1e100"),
+])
+def test_extreme_values_are_one_line_errors(capsys, argv, message):
+    # these ended in a ValueError / OverflowError traceback before
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and out == ""
+    assert err.startswith(message) and err.count("\n") == 1

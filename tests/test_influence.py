@@ -1,10 +1,11 @@
 """Influence matrix of overlapping triangles: second method (quad), closed forms, scaling."""
 import numpy as np
 import pytest
+from scipy import integrate
 from scipy.special import ellipe, ellipkm1
 
 from kernels.influence import assemble_unit, ellipk_complement, load_weights
-from tests.naive import influence_matrix_quad
+from tests.naive import _kernel_s, influence_matrix_quad
 
 
 def test_ellipk_by_agm_matches_scipy():
@@ -23,15 +24,21 @@ def test_matrix_matches_quadrature_of_the_elliptic_kernel():
     np.testing.assert_allclose(ours, ref, rtol=1e-9, atol=1e-12)
 
 
-def test_matrix_scales_with_spacing():
-    # u = A(dr) p with A(dr) = dr * A(1): a disc of radius 1 meshed two ways
-    A = assemble_unit(200)
-    for dr in (0.01, 0.02):
-        r = np.arange(200) * dr
-        p = np.where(r < 1 - 1e-12, 1.0, 0.0)
-        p[int(round(1 / dr))] = 0.5
-        u0 = (A @ p * dr)[0]
-        assert u0 == pytest.approx(2.0, rel=1e-12)     # u(0) = 2 p a exactly
+@pytest.mark.parametrize("dr", [0.01, 0.37])
+def test_matrix_scales_with_spacing(dr):
+    # The engine builds the matrix once per N at unit spacing and multiplies by the spacing
+    # (sweep.solver.influence_matrix). Check that law against scipy quadrature done at the
+    # spacing itself, in physical coordinates: A_ij = int phi_j(s) G(r_i, s) s ds over the
+    # two linear pieces of the hat of node j (log singularity at s = r_i on a piece end).
+    N = 30
+    scaled = assemble_unit(N) * dr
+    for i, j in [(0, 0), (0, 7), (3, 3), (3, 4), (5, 17), (17, 5), (29, 12), (12, 28)]:
+        ri, rj = i * dr, j * dr
+        pieces = [(rj - dr, rj, lambda s: (s - (rj - dr)) / dr)] if j > 0 else []
+        pieces.append((rj, rj + dr, lambda s: (rj + dr - s) / dr))
+        quad = sum(integrate.quad(lambda s: _kernel_s(ri, s) * phi(s), a, b, epsabs=0,
+                                  epsrel=1e-12, limit=200)[0] for a, b, phi in pieces)
+        assert scaled[i, j] == pytest.approx(quad, rel=1e-9), (i, j)
 
 
 def _disc_error(a_nodes):

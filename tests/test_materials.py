@@ -212,7 +212,7 @@ def test_mpl_psi_matches_spectrum_and_quad_of_chat(n, k):
 @pytest.mark.parametrize("n", N_VALUES)
 def test_mpl_psi_design_formula_and_small_T(n):
     k = 0.1
-    # DESIGN.md section 4 formula where it does not cancel
+    # docs/design.md section 3 formula where it does not cancel
     T = np.array([3.0, 10.0, 100.0])
     X = 2.0 * np.sqrt(T)
     design = T - (1 - k) * (n - 2.0 ** (-n) / special.gamma(n) * X ** (n + 1) * special.kv(n + 1, X))

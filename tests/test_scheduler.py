@@ -202,7 +202,8 @@ def test_progress_bar_and_log_lines():
     p.update({"scene_id": "b", "status": "failed"})
     p.close()
     text = buf.getvalue()
-    assert "\r[12/40] 1 failed  ETA 0:" in text and "\n" in text[-1:]
+    # a tqdm bar: starts at the scenes already done, counts failures, ends with a newline
+    assert "10/40" in text and "12/40" in text and "1 failed" in text and text.endswith("\n")
     class Tty(io.StringIO):
         def isatty(self):
             return True
@@ -277,3 +278,13 @@ def test_consolidation_interval(tmp_path):
                   simulate=fake_simulate, progress=watch, consolidate_every=interval)
         assert (max(sizes) > 0) is expect_mid, sizes
         assert len(load(out)) == 6
+
+
+def test_grid_is_expanded_and_hashed_once_per_run(tmp_path, monkeypatch):
+    import sweep.config as config_module
+    calls = []
+    real = config_module.scene_id
+    monkeypatch.setattr(config_module, "scene_id", lambda s, n: calls.append(1) or real(s, n))
+    c = cfg()
+    rep = run_sweep(c, jobs=1, out=tmp_path / "r.h5", simulate=fake_simulate, progress="none")
+    assert rep.total == len(calls) == 4

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from tests import reference
+from tests import naive, reference
 from sweep import Numerics, Scene, simulate
 from sweep.errors import InputError
 from sweep.theory import jkr_load
@@ -60,14 +60,23 @@ def test_elastic_pull_off_converges_with_mesh():
     assert abs(p[1] - p[2]) < 3e-4
 
 
+#: Pull-off error of the balanced preset against the independent solver that the README
+#: states (table "Speed and accuracy": -0.02 % / +0.002 % / -0.09 %; measured -2.2e-4,
+#: +2.2e-5, -8.9e-4). The tolerance is twice that claim: the margin covers the yaml's own
+#: quoted uncertainty (A 6e-4, D 1e-4, F 9e-4 absolute, i.e. 7.7e-5, 6.8e-6, 3.7e-4
+#: relative, each below the claim) and rounding across platforms.
+BALANCED_CLAIM = {"A": 2e-4, "D": 2e-5, "F": 9e-4}
+
+
 @pytest.mark.parametrize("name", ["A", "D", "F"])
 def test_viscoelastic_matches_independent_solver(name):
     ref = next(c for c in _ref()["viscoelastic"] if c["name"] == name)
     res = simulate(Scene(**ref["scene"]), Numerics.preset("balanced"))
     assert res.ok, res.reason
-    assert res.pull_off == pytest.approx(ref["pull_off"], rel=3e-3)
+    assert res.pull_off == pytest.approx(ref["pull_off"], rel=2 * BALANCED_CLAIM[name])
     assert res.a0_result == pytest.approx(ref["a0"], abs=0.01)
-    assert res.a_pulloff == pytest.approx(ref["a_pulloff"], abs=0.02)
+    # the yaml quotes a_pulloff to 3 decimals; measured within 2.2e-3 (case D)
+    assert res.a_pulloff == pytest.approx(ref["a_pulloff"], abs=5e-3)
     assert res.crack_speed == pytest.approx(ref["crack_speed"], rel=0.05)   # +-5% (yaml)
     assert res.delta0_result == ref["scene"]["delta0"]
 
@@ -120,11 +129,18 @@ def test_slow_unloading_and_k_to_one_give_the_elastic_result():
     assert fast(k=0.999, a0=2.0, rate=100.0).pull_off == pytest.approx(el, rel=2e-3)
 
 
-def test_amplification_is_bounded_by_glassy_limit():
-    # pull-off cannot exceed the JKR value of the glassy material, 1.5/k (+ LJ correction)
+def test_fast_unloading_reaches_the_glassy_limit():
+    # rate -> infinity: the unloading takes ~1e-6 tau0, Chat stays at k, and the substrate
+    # answers u = A [k sigma + (1 - k) sigma_0] whatever the spectrum. The limit is therefore
+    # material independent: SLS, MPL n = 1.6 and MPL n = 3 agree to 2e-7 at rate 1e10
+    # (14.71333). At rate 1e8 the MPL n = 1.6 creeps by about (1-k) t/(n-1) ~ 1e-6 during
+    # the unloading: measured 14.71235, 7e-5 below the limit; tolerance 2e-4.
+    limit = fast(n=1.0, k=0.1, a0=3.0, rate=1e10, material="sls")
     res = fast(n=1.6, k=0.1, a0=3.0, rate=1e8)
-    assert res.ok
-    assert 1.5 < res.pull_off < 1.6 / 0.1
+    assert res.ok and limit.ok
+    assert res.pull_off == pytest.approx(limit.pull_off, rel=2e-4)
+    # and below the JKR value with the glassy work of adhesion, 1.5/k (measured 14.71)
+    assert res.pull_off < 1.5 / 0.1
 
 
 def test_results_are_consistent():
@@ -154,6 +170,22 @@ def test_sls_material():
     res = simulate(Scene(n=1.0, k=0.1, mu=3.24, a0=2.0, rate=10.0, material="sls"),
                    Numerics.preset("fast"))
     assert res.ok and res.prony_terms == 1
+
+
+@pytest.mark.parametrize("rate", [1.0, 10.0])
+def test_sls_pull_off_matches_naive_solver(rate):
+    # tests/naive.py (dense quadrature matrix, exact hereditary sum) on the same small mesh
+    # (mu = 1, N = 80, spacing 0.05, the paper's full last triangle) and the same steps. The
+    # SLS is one Prony mode, represented exactly, so both solve the same discrete equations:
+    # measured differences 5e-12 (pull-off) and 4e-11 (radius); tolerance 1e-8 (Newton 1e-10).
+    N, dr, step, d0 = 80, 0.05, 0.1, 2.0
+    ref = naive.naive_unload(1.0, 0.1, 1.0, d0, rate, N, dr, step, material="sls", tail="full")
+    res = simulate(Scene(n=1.0, k=0.1, mu=1.0, delta0=d0, rate=rate, material="sls"),
+                   Numerics(nodes=N, domain=(N - 1) * dr, step=step, da_max=1e6, tol=1e-10))
+    assert res.ok, res.reason
+    assert not ref["snaps"]
+    assert res.pull_off == pytest.approx(ref["pull_off"], rel=1e-8)
+    assert res.a_pulloff == pytest.approx(ref["a_pulloff"], abs=1e-8)
 
 
 EXTREMES = [

@@ -1,4 +1,4 @@
-"""Dimensionless <-> physical conversions (sweep.units), DESIGN.md section 2."""
+"""Dimensionless <-> physical conversions (sweep.units), docs/design.md section 2."""
 import math
 
 import numpy as np
@@ -41,7 +41,7 @@ def test_dimensionless_functions_of_mu():
     assert units.lj_prefactor(mu) * np.max(x**3 - x**9) == pytest.approx(
         units.sigma0_hat(mu), rel=1e-9
     )
-    # c_l about 1.693 / mu^2 for alpha = pi/9 (DESIGN.md)
+    # c_l about 1.693 / mu^2 for alpha = pi/9 (docs/design.md section 2)
     assert units.l0_hat(1.0) == pytest.approx(1.693, abs=5e-4)
     assert units.l0_coefficient() == pytest.approx(243 * 81 / (256 * math.pi**3), rel=1e-14)
 
@@ -53,7 +53,7 @@ def test_physical_scale_consistent_with_mu_functions(scale):
     assert scale.h0_hat == pytest.approx(units.h0_hat(mu), rel=1e-13)
     assert scale.sigma0 / scale.p_ref == pytest.approx(units.sigma0_hat(mu), rel=1e-13)
     assert scale.l0 / scale.a_ref == pytest.approx(units.l0_hat(mu), rel=1e-13)
-    # l0 / h0 = c_l E0* h0 / dg (DESIGN.md)
+    # l0 / h0 = c_l E0* h0 / dg (docs/design.md section 2)
     assert scale.l0 / scale.h0 == pytest.approx(
         units.l0_coefficient() * scale.E0_star * scale.h0 / scale.dg, rel=1e-13
     )

@@ -1,0 +1,106 @@
+"""Stable scene ids and results files that keep working (issue 12, item 4).
+
+(a) The ids of a fixed set of scenes stay those recorded in tests/data/scene_ids.yaml
+    (written by the version-1 id form), also after a field with a default is added.
+(b) tests/data/results_v1.h5, written by version 1 (config tests/data/results_v1.yaml),
+    loads, shows in ``sweep info`` and resumes with nothing recomputed; a file of a newer id
+    version is refused with exit 2 and one line, and is left untouched.
+"""
+from __future__ import annotations
+
+import dataclasses
+import shutil
+
+import h5py
+import pytest
+
+from tests import reference
+from sweep import Numerics, Scene, scene_id
+from sweep.cli import main
+from sweep.config import parse_config
+from sweep.scene import SCENE_ID_VERSION, axis
+from sweep.scheduler import run_sweep
+from sweep.store import load, load_trajectory, read_attrs
+
+V1_FILE = reference.DATA / "results_v1.h5"
+
+
+def _recorded():
+    return reference.load("scene_ids")
+
+
+def test_ids_stay_as_recorded():
+    for case in _recorded():
+        assert scene_id(Scene(**case["scene"]), Numerics(**case["numerics"])) == case["id"]
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class GrownScene(Scene):
+    """Scene with a field added later (as a new physical parameter would be)."""
+
+    adhesion_hysteresis: float = axis(0.0, help="a new parameter", limits=(0.0, 1.0), order=8)
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class GrownNumerics(Numerics):
+    line_search: str = "backtracking"
+
+
+def test_a_defaulted_new_field_renames_no_scene():
+    for case in _recorded():
+        scene = GrownScene(**case["scene"])
+        numerics = GrownNumerics(**case["numerics"])
+        assert scene_id(scene, numerics) == case["id"]
+        # the new field enters the id as soon as it leaves its default
+        moved = dataclasses.replace(scene, adhesion_hysteresis=0.5)
+        assert scene_id(moved, numerics) != case["id"]
+
+
+def test_version_1_file_loads_and_shows_in_info(capsys):
+    df = load(V1_FILE)
+    cfg = parse_config(read_attrs(V1_FILE)["config_text"])
+    assert sorted(df.scene_id) == sorted(sid for sid, _ in cfg.tasks())
+    assert set(df.status) == {"ok"}
+    assert len(load_trajectory(V1_FILE, df.scene_id[0])["P"]) > 2
+    assert main(["info", str(V1_FILE)]) == 0
+    out = capsys.readouterr().out
+    assert "scenes: 3 finished of 3" in out and "material: mpl, sls" in out
+
+
+def _must_not_run(scene, numerics):
+    raise AssertionError(f"scene recomputed: {scene}")
+
+
+def test_version_1_file_resumes_with_nothing_recomputed(tmp_path):
+    path = tmp_path / "v1.h5"
+    shutil.copyfile(V1_FILE, path)
+    cfg = parse_config(read_attrs(path)["config_text"])
+    report = run_sweep(cfg, jobs=1, out=path, simulate=_must_not_run, progress="none")
+    assert (report.total, report.skipped, report.ran) == (3, 3, 0)
+    assert sorted(load(path).scene_id) == sorted(load(V1_FILE).scene_id)
+
+
+def test_newer_id_version_is_refused_in_one_line(tmp_path, capsys):
+    path = tmp_path / "future.h5"
+    shutil.copyfile(V1_FILE, path)
+    with h5py.File(path, "r+") as f:
+        f.attrs["scene_id_version"] = SCENE_ID_VERSION + 1
+    before = path.read_bytes()
+    cfg_path = tmp_path / "cfg.yaml"
+    cfg_path.write_text(read_attrs(path)["config_text"])
+    assert main(["run", str(cfg_path), "--out", str(path), "--progress", "none"]) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert len(err) == 1 and "scene id version" in err[0], err
+    assert path.read_bytes() == before
+    assert main(["info", str(path)]) == 0          # reading it still works
+
+
+def _fake(scene, numerics):
+    from sweep.scene import Result
+    return Result(scene=scene, numerics=numerics, status="ok", pull_off=1.0)
+
+
+def test_new_files_record_the_id_version(tmp_path):
+    cfg = parse_config(read_attrs(V1_FILE)["config_text"])
+    run_sweep(cfg, jobs=1, out=tmp_path / "new.h5", simulate=_fake, progress="none")
+    assert read_attrs(tmp_path / "new.h5")["scene_id_version"] == SCENE_ID_VERSION
