@@ -9,14 +9,18 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow coverage-kernels bench bench-convergence pdms agreement clean
+.PHONY: help venv demo test test-slow coverage-kernels bench bench-convergence clean \
+        threshold vr fig3 figures report reproduce pdms agreement
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
 	@echo "make test   - create/update .venv and run the test suite"
 	@echo "make bench  - speed benchmarks (JSON in results/bench/)"
 	@echo "make coverage-kernels - kernel tests with NUMBA_DISABLE_JIT=1 under coverage"
+	@echo "make reproduce - the paper's campaigns, fits, figures and results/REPORT.md"
+	@echo "               (make threshold | vr | fig3 | figures | report; QUICK=1: thinned grids)"
 	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/)"
+	@echo "make agreement - BEM vs crack-front model vs PB estimate (results/agreement/)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -56,6 +60,49 @@ bench: $(STAMP)
 
 bench-convergence: $(STAMP)
 	$(BIN)/python -m sweep.benchmarks convergence --mu 6 --out results/bench/convergence_mu6.json
+
+# -- reproduction of the paper (results/REPORT.md) ----------------------------------------
+# Each campaign target runs (or resumes) its sweep, then writes fit.json/figures with
+# `python -m sweep.reproduce`, and records its own wall time in <dir>/make_wall_s.txt.
+# QUICK=1 runs the thinned grids of configs/quick/ into results/quick/ (a smoke run, never
+# the committed report).
+ifeq ($(QUICK),1)
+CFG := configs/quick
+OUT := results/quick
+else
+CFG := configs
+OUT := results
+endif
+REPRO := $(BIN)/sweep reproduce
+# run a sweep and its analysis, timing the whole: $(call campaign,config,dir,reproduce-cmd)
+define campaign
+	@mkdir -p $(OUT)/$(2)
+	@start=$$(date +%s); \
+	$(BIN)/sweep run $(CFG)/$(1).yaml --out $(OUT)/$(2)/runs.h5 --progress none && \
+	$(REPRO) $(3) $(OUT)/$(2)/runs.h5 $(OUT)/$(2) && \
+	echo "$$(( $$(date +%s) - start )) s: make $@ $(if $(QUICK),QUICK=$(QUICK))" > $(OUT)/$(2)/make_wall_s.txt && \
+	cat $(OUT)/$(2)/make_wall_s.txt
+endef
+
+threshold: $(STAMP)
+	$(call campaign,threshold,threshold,threshold)
+
+vr: $(STAMP)
+	$(call campaign,v_vs_r,vr,vr)
+
+fig3: $(STAMP)
+	$(call campaign,fig3,fig3,fig3)
+
+figures: fig3 $(STAMP)
+	$(call campaign,aconv,aconv,aconv)
+	@test -f $(OUT)/vr/runs.h5 || $(MAKE) --no-print-directory vr
+	$(REPRO) theory $(OUT)/theory --vr $(OUT)/vr/runs.h5
+
+report: $(STAMP)
+	$(REPRO) report --results $(OUT)
+
+reproduce: threshold vr figures
+	@$(MAKE) --no-print-directory report
 
 pdms: $(STAMP)
 	$(BIN)/python -m sweep.pdms --out results/pdms

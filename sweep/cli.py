@@ -449,6 +449,133 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
         click.echo(f"plot: {plot_out}")
 
 
+# == fit commands (fit threshold, fit vr): the paper's fits of a results file ==
+def _load_results(path: str):
+    """The runs table of the results file ``path``, or an InputError naming it."""
+    from pathlib import Path
+
+    from .store import load
+
+    if not Path(path).is_file():
+        raise InputError(f"results: no such file {path!r}")
+    try:
+        return load(path)
+    except (OSError, KeyError, ValueError) as exc:
+        raise InputError(f"results: {path!r} is not a sweep results file ({exc})") from None
+
+
+def _ci(ci) -> str:
+    return "-" if ci is None else f"[{ci[0]:.4g}, {ci[1]:.4g}]"
+
+
+_fit_options = [
+    click.option("--saturation", "saturation", default="0.9", show_default=True,
+                 help="Unsaturated: P_po < SATURATION * 1.5/k, in (0, 10]."),
+    click.option("--boot", "boot", default="2000", show_default=True,
+                 help="Bootstrap resamples for the 95 % intervals (0: none)."),
+    click.option("--json", "as_json", is_flag=True, help="Print one JSON object."),
+]
+
+
+def _with_fit_options(fn):
+    for opt in reversed(_fit_options):
+        fn = opt(fn)
+    return fn
+
+
+def _fit_numbers(saturation: str, boot: str) -> tuple[float, int]:
+    from .errors import check_int, check_range
+
+    try:
+        n_boot = int(boot.strip())
+    except ValueError:
+        raise InputError(f"boot must be an integer in [0, 1000000] (got {boot!r})") from None
+    return (check_range("saturation", saturation, 0.0, 10.0, lo_open=True),
+            check_int("boot", n_boot, lo=0, hi=1_000_000))
+
+
+@cli.group("fit")
+def fit_group():
+    """The paper's fits of a results file (threshold radius collapse, crack speed vs rate)."""
+
+
+@fit_group.command("threshold")
+@click.argument("results")
+@click.option("--slope", "slope", default="0.1", show_default=True,
+              help="Threshold rule: first a0 where dP_po/da0 < SLOPE (> 0).")
+@_with_fit_options
+def fit_threshold_cmd(results, slope, saturation, boot, as_json):
+    """Threshold radius a0t per (n, rate) and the collapse fit P_po = A a0t^B of an a0 sweep."""
+    from .analysis import threshold_analysis
+    from .errors import check_positive
+
+    slope = check_positive("slope", slope)
+    sat, n_boot = _fit_numbers(saturation, boot)
+    out = threshold_analysis(_load_results(results), slope, sat, n_boot)
+    if as_json:
+        echo_json(out)
+        return
+    click.echo(f"# {results}: {out['scenes']} scenes, {out['failed']} failed")
+    click.echo(f"# rule: {out['rule']}")
+    click.echo(f"P_po = A a0t^B   A = {out['prefactor']:.4g} {_ci(out['prefactor_ci'])}   "
+               f"B = {out['exponent']:.4g} {_ci(out['exponent_ci'])}   "
+               f"points = {out['n_points']}")
+    click.echo(f"a0t as the h = h0 radius: A = {out['prefactor_inner']:.4g} "
+               f"{_ci(out['prefactor_inner_ci'])}, B = {out['exponent_inner']:.4g}; "
+               f"a0 in (R^2 dg/E0*)^(1/3): A = {out['prefactor_no_pi']:.4g}")
+    click.echo(f"{'selection':<42} {'A':>8} {'B':>7} {'B 95 % CI':>18} {'points':>6}")
+    for r in out["sensitivity"]:
+        click.echo(f"{r['rule']:<42} {r['prefactor']:>8.4g} {r['exponent']:>7.4g} "
+                   f"{_ci(r['exponent_ci']):>18} {r['n_points']:>6}")
+    click.echo(f"{'n':>5} {'rate':>10} {'a0t':>8} {'P(a0t)':>8} {'P plateau':>9} "
+               f"{'status':<14} fit")
+    for r in out["table"]:
+        click.echo(f"{r['n']:>5g} {r['rate']:>10.4g} {r['a0t']:>8.4g} {r['P_at_a0t']:>8.4g} "
+                   f"{r['P_plateau']:>9.4g} {r['status']:<14} {'x' if r['in_fit'] else ''}")
+
+
+@fit_group.command("vr")
+@click.argument("results")
+@_with_fit_options
+def fit_vr_cmd(results, saturation, boot, as_json):
+    """Crack speed at pull-off vs rate, vhat = A rhat_PB^B, and Persson-Brener vs the BEM."""
+    from .analysis import vr_analysis
+
+    sat, n_boot = _fit_numbers(saturation, boot)
+    out = vr_analysis(_load_results(results), sat, n_boot)
+    if as_json:
+        echo_json(out)
+        return
+    u = out["unsaturated"]
+    click.echo(f"# {results}: {out['scenes']} scenes, {out['failed']} failed; "
+               f"{out['rhat_pb_definition']}")
+    click.echo(f"vhat = A rhat_PB^B, all MPL points: A = {out['prefactor']:.4g} "
+               f"{_ci(out['prefactor_ci'])}, B = {out['exponent']:.4g} "
+               f"{_ci(out['exponent_ci'])}, points = {out['n_points']}")
+    click.echo(f"unsaturated (P_po < {sat:g} * 1.5/k): A = {u['prefactor']:.4g} "
+               f"{_ci(u['prefactor_ci'])}, B = {u['exponent']:.4g} {_ci(u['exponent_ci'])}, "
+               f"points = {u['n_points']}")
+    for way, text in (("measured", "Gamma_PB at the measured vhat"),
+                      ("predicted", "Gamma_PB at the fitted vhat(rhat_PB)")):
+        c = out["pb_vs_bem"][way]
+        click.echo(f"{text}: within 15 % {100 * c['share_within_15pct']:.1f} %, median error "
+                   f"{100 * c['median_abs_error']:.2f} %, max {100 * c['max_abs_error']:.1f} %")
+    a = out["alpha"]
+    click.echo(f"alpha_best = {a['alpha_best']:.4g} ({a['alpha_best_over_paper']:.3f} pi/9): "
+               f"RMS ln error {a['rms_log_error_best']:.4g} (pi/9: "
+               f"{a['rms_log_error_paper_alpha']:.4g})")
+
+
+def _add_reproduce() -> None:
+    """``sweep reproduce ...``: the paper's fits, figures and report (sweep/reproduce.py)."""
+    from .reproduce import cli as reproduce_group
+
+    cli.add_command(reproduce_group, "reproduce")
+
+
+_add_reproduce()
+
+
 def main(argv=None) -> int:
     """Entry point: run the click group, mapping errors to one line + exit code."""
     try:

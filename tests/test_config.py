@@ -230,8 +230,10 @@ def test_threshold_campaign():
 
 def test_v_vs_r_campaign():
     cfg = load_config(CONFIGS / "v_vs_r.yaml")
-    assert values(cfg, "n") == [0.4, 0.6, 0.8, 1.6]
-    assert values(cfg, "k") == [0.01, 0.05, 0.1]
+    mpl = sorted({(s.n, s.k) for s in cfg.scenes() if s.material == "mpl"})
+    assert sorted({n for n, _ in mpl}) == [0.4, 0.6, 0.8, 1.6]
+    assert sorted({k for _, k in mpl}) == [0.01, 0.05, 0.1]
+    assert {(s.material, s.k) for s in cfg.scenes() if s.material != "mpl"} == {("sls", 0.1)}
     rates = values(cfg, "rate")
     assert np.log10(rates[-1] / rates[0]) >= 5
     for s in cfg.scenes():  # above the threshold radius of its k

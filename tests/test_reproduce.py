@@ -1,0 +1,51 @@
+"""The reproduction pipeline (python -m sweep.reproduce): fit files, figures and REPORT.md
+from synthetic results files with known fits (no simulation: fast)."""
+import json
+
+import pytest
+
+from sweep.reproduce import main
+from tests.test_analysis import synthetic_threshold_runs, synthetic_vr_runs, write_results
+
+pytest.importorskip("matplotlib")
+
+
+def test_pipeline_writes_fits_figures_and_report(tmp_path, capsys):
+    root = tmp_path / "results"
+    thr = tmp_path / "thr.h5"
+    write_results(thr, synthetic_threshold_runs().assign(wall_s=1.0, reason=""))
+    vr = tmp_path / "vr.h5"
+    write_results(vr, synthetic_vr_runs().assign(wall_s=2.0, reason=""))
+    assert main(["threshold", str(thr), str(root / "threshold")]) == 0
+    assert main(["vr", str(vr), str(root / "vr")]) == 0
+    assert main(["theory", str(root / "theory"), "--vr", str(vr)]) == 0
+    assert main(["report", "--results", str(root)]) == 0
+    capsys.readouterr()
+    for rel in ("threshold/threshold.png", "vr/v_vs_r.png", "vr/pb_vs_bem.png",
+                "theory/mplplot.png", "theory/pb_bem.png", "theory/b1.png"):
+        assert (root / rel).stat().st_size > 10_000, rel
+    fit = json.loads((root / "threshold" / "fit.json").read_text())
+    assert fit["exponent"] == pytest.approx(2.7, abs=1e-2)           # the synthetic truth
+    assert fit["cost"]["scenes"] == fit["cost"]["ok"] + fit["cost"]["failed"]
+    assert fit["cost"]["failed"] == 1 and fit["provenance"]["results"] == str(thr)
+    vfit = json.loads((root / "vr" / "fit.json").read_text())
+    assert vfit["exponent"] == pytest.approx(1.1, rel=1e-9)
+    theory = json.loads((root / "theory" / "theory.json").read_text())
+    # q1(n) of PB theory: (1-k) pi n for small k, a line through ~0
+    q = theory["b1"]["q1_linear_fit"]
+    assert abs(q["intercept"]) < 0.05 and q["slope"] == pytest.approx(3.14, rel=1e-2)
+    report = (root / "REPORT.md").read_text()
+    # each fit beside the paper's value, figures linked, counts and the failure listed
+    assert f"{fit['exponent']:.4g}" in report and "| 2.7 |" in report
+    assert f"{vfit['prefactor']:.4g}" in report and "| 2.887 |" in report
+    assert "](threshold/threshold.png)" in report and "](vr/pb_vs_bem.png)" in report
+    assert "`make fig3` | `configs/fig3.yaml` | not run" in report
+    assert "Failures: " in report and "failed" in report
+
+
+def test_bad_input_one_line_exit_2(tmp_path, capsys):
+    assert main(["threshold", str(tmp_path / "none.h5"), str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: results") and "\n" not in err
+    assert main(["report", "--results", str(tmp_path / "nodir")]) == 2
+    assert "\n" not in capsys.readouterr().err.strip()
