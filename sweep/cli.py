@@ -169,7 +169,7 @@ def scene_options(func):
             option = click.option(
                 f"--{a.name}", a.name, type=str,
                 default=None if default is None else format(default, "g"),
-                required=False, show_default=default is not None,
+                show_default=default is not None,
                 help=a.describe() + ".")
         else:
             option = click.option(f"--{a.name}", a.name, type=click.Choice(list(a.choices)),
@@ -191,35 +191,25 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
                "speed")
 
 
-def si_options(func):
-    """The options of an SI scene (``sweep scene --si``; :class:`sweep.si.SIScene`)."""
-    opts = [
-        ("--si", dict(is_flag=True, help="Give the scene in SI units: --n --R --E0 --Einf --nu "
-                      "--tau0 --dg --h0, one of --preload/--a0-si/--indentation, and --speed "
-                      "(instead of --k --mu --a0 --delta0 --rate).")),
-        ("--R", dict(help="[--si] sphere radius [m].")),
-        ("--E0", dict(help="[--si] relaxed Young's modulus [Pa].")),
-        ("--Einf", dict(help="[--si] glassy Young's modulus [Pa].")),
-        ("--nu", dict(help="[--si] Poisson's ratio.")),
-        ("--tau0", dict(help="[--si] MPL time tau0 [s].")),
-        ("--dg", dict(help="[--si] work of adhesion [J/m^2].")),
-        ("--h0", dict(help="[--si] LJ equilibrium distance [m].")),
-        ("--preload", dict(help="[--si] preload force [N] (relaxed JKR contact at that load).")),
-        ("--a0-si", dict(help="[--si] initial contact radius [m].")),
-        ("--indentation", dict(help="[--si] initial indentation [m].")),
-        ("--speed", dict(help="[--si] unloading speed [m/s].")),
-    ]
-    for name, kw in reversed(opts):
-        dest = name[2:].replace("-", "_")
-        if not kw.get("is_flag"):
-            kw = {"type": str, "default": None, **kw}
-        func = click.option(name, dest, **kw)(func)
-    return func
-
-
 @cli.command("scene")
 @scene_options
-@si_options
+@click.option("--si", "si", is_flag=True,
+              help="Give the scene in SI units: --n --R --E0 --Einf --nu --tau0 --dg --h0, one "
+                   "of --preload/--a0-si/--indentation, and --speed (instead of --k --mu --a0 "
+                   "--delta0 --rate).")
+@click.option("--R", "R", type=str, default=None, help="[--si] sphere radius [m].")
+@click.option("--E0", "E0", type=str, default=None, help="[--si] relaxed Young's modulus [Pa].")
+@click.option("--Einf", "Einf", type=str, default=None, help="[--si] glassy Young's modulus [Pa].")
+@click.option("--nu", "nu", type=str, default=None, help="[--si] Poisson's ratio.")
+@click.option("--tau0", "tau0", type=str, default=None, help="[--si] MPL time tau0 [s].")
+@click.option("--dg", "dg", type=str, default=None, help="[--si] work of adhesion [J/m^2].")
+@click.option("--h0", "h0", type=str, default=None, help="[--si] LJ equilibrium distance [m].")
+@click.option("--preload", "preload", type=str, default=None,
+              help="[--si] preload force [N] (relaxed JKR contact at that load).")
+@click.option("--a0-si", "a0_si", type=str, default=None, help="[--si] initial contact radius [m].")
+@click.option("--indentation", "indentation", type=str, default=None,
+              help="[--si] initial indentation [m].")
+@click.option("--speed", "speed", type=str, default=None, help="[--si] unloading speed [m/s].")
 @click.option("--preset", type=click.Choice(list(PRESETS)), default="balanced",
               show_default=True)
 @click.option("--nodes", type=str, default=None, help="Override the preset's node count.")
@@ -228,21 +218,24 @@ def si_options(func):
 @click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
-def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, **axes):
+def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, **values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .errors import as_float
     from .models import simulate_scene
     from .scene import Numerics
 
-    si_values = {name: axes.pop(name) for name in _SI_OPTIONS}
+    si_values = {name: values.pop(name) for name in _SI_OPTIONS}
+    axes = values
     if si:
         _scene_si(axes, as_json, si_values)
         return
     given = [f"--{name.replace('_', '-')}" for name, v in si_values.items() if v is not None]
     if given:
         raise InputError(f"{', '.join(given)}: SI options need --si")
-    if axes["rate"] is None:
-        raise InputError("rate must be given (--rate, the unloading rate r-hat > 0)")
+    missing = [f"--{a.name}" for a in AXES.values()
+               if a.required and a.cli_default is None and axes[a.name] is None]
+    if missing:
+        raise InputError(f"{', '.join(missing)} must be given (or use --si)")
     sc = scene_from_options(axes)
     overrides = {}
     if nodes is not None:
@@ -283,25 +276,28 @@ def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, *
 
 def _scene_si(axes, as_json, values):
     """``sweep scene --si``: build an SIScene, run it, print both unit systems."""
+    from click.core import ParameterSource
+
     from .errors import as_float
     from .si import SIScene, run_si
 
-    dimless = {name: axes[name] for name in ("k", "mu", "a0", "delta0", "rate")}
-    defaults = {name: (None if AXES[name].default is None else format(AXES[name].default, "g"))
-                for name in dimless}
-    clash = [f"--{name}" for name, v in dimless.items() if v is not None and v != defaults[name]]
+    ctx = click.get_current_context()
+    clash = [f"--{name}" for name in ("k", "mu", "a0", "delta0", "rate")
+             if ctx.get_parameter_source(name) == ParameterSource.COMMANDLINE]
     if clash:
         raise InputError(f"{', '.join(clash)}: dimensionless options cannot be combined with "
                          f"--si (give --Einf, --h0, --preload/--a0-si/--indentation, --speed)")
+    n, material, model = axes["n"], axes["material"], axes["model"]
     required = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "speed")
     missing = [f"--{name}" for name in required if values[name] is None]
+    if n is None:
+        missing.insert(0, "--n")
     if missing:
         raise InputError(f"{', '.join(missing)} must be given with --si")
     kw = {name: as_float(name, v) for name, v in values.items() if v is not None}
     if "a0_si" in kw:
         kw["a0"] = kw.pop("a0_si")
-    out = run_si(SIScene(n=as_float("n", axes["n"]), material=axes["material"], **kw),
-                 axes["model"])
+    out = run_si(SIScene(n=as_float("n", n), material=material, **kw), model)
     if as_json:
         echo_json(out)
     else:
@@ -447,6 +443,7 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
                f"(threshold {kk.threshold:g})")
     if plot_out is not None:
         click.echo(f"plot: {plot_out}")
+
 
 
 # == fit commands (fit threshold, fit vr): the paper's fits of a results file ==

@@ -123,7 +123,7 @@ def compute(case=PDMS_CASE) -> dict:
                                 math.log(1e-3), math.log(1e24), xtol=1e-10))
     rhat_full = (vhat_full / 2.887) ** (1.0 / 1.171)
     speed_full_l0 = rhat_full * sc.l0 / tau0                 # paper's convention r tau0/l0
-    speed_full_dref = rhat_full * sc.d_ref / tau0            # the project's r tau0/d_ref
+    speed_full_dref = rhat_full * sc.d_ref / tau0            # DESIGN's r tau0/d_ref
     # the crack-front model's own answer: unloading speed for f * 1.5/k with a0 = 2 a0t_cf
     a_big = 2.0 * a0t_cf_hat
 

@@ -114,9 +114,9 @@ class Scene:
                          choices=MATERIALS, order=0)
     stop: str = axis("pulloff", help="stop after the pull-off, or follow the curve to "
                      "separation", choices=STOPS, order=1, plot_group=False)
-    model: str = axis("bem", help="model that runs the scene (sweep.models): boundary "
-                      "elements, crack-front model, PB estimate, or auto", choices=MODEL_NAMES,
-                      order=-1)
+    model: str = axis("bem", help="model that runs the scene (sweep.models): the BEM, the "
+                      "crack-front model, the closed-form PB estimate, or auto",
+                      choices=MODEL_NAMES, order=-1)
 
     def __post_init__(self):
         info = _axes_of(type(self))
