@@ -20,6 +20,7 @@ help:
 	@echo "make reproduce - the paper's campaigns, fits, figures and results/REPORT.md"
 	@echo "               (make threshold | vr | fig3 | figures | report; QUICK=1: thinned grids)"
 	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/)"
+	@echo "make agreement - BEM vs crack-front model vs PB estimate (results/agreement/)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
