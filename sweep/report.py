@@ -183,14 +183,14 @@ def _vr_section(vr) -> list[str]:
 def _campaign_table(root: Path) -> list[str]:
     lines = ["## Campaigns: scenes, failures, times", "",
              "| make target | config | scenes run (of the grid) | ok | failed | sweep elapsed (first start to "
-             "last scene) | sum of scene walls | last `make` run (a resumed sweep counts only the rest) | engine commit of the runs |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "last scene) | sum of scene walls | CPU time / 2 (idle 2-core estimate) | last `make` run (a resumed sweep counts only the rest) | engine commit of the runs |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     failures = []
     for d, target, cfg, _ in CAMPAIGNS:
         name = {"threshold": "fit.json", "vr": "fit.json"}.get(d, f"{d}.json")
         data = _read(root / d / name)
         if not data or "cost" not in data:
-            lines.append(f"| `{target}` | `{cfg}` | not run | | | | | | |")
+            lines.append(f"| `{target}` | `{cfg}` | not run | | | | | | | |")
             continue
         c, p = data["cost"], data["provenance"]
         grid = p.get("n_scenes")
@@ -199,11 +199,15 @@ def _campaign_table(root: Path) -> list[str]:
             done += " (incomplete)"
         lines.append(f"| `{target}` | `{cfg}` | {done} | {c['ok']} | {c['failed']} | "
                      f"{_elapsed(p)} | {c['scene_wall_s_sum'] / 60:.1f} min | "
+                     f"{_g((c.get('scene_cpu_s_sum') or math.nan) / 120, 3)} min | "
                      f"{_make_wall(root / d)} | `{p.get('git_commit', '-')}` |")
         failures += [f"- `{d}` {f['scene_id']}: {f['reason']}" for f in c["failures"]]
     lines += ["", "Times are wall-clock on the project's shared 2-core machine (2 worker "
               "processes, other jobs running at the same time), so they are upper bounds of "
-              "an idle machine's. The sweep elapsed time spans resumptions, if any.", "",
+              "an idle machine's (load average 6-9 on the 2 cores meanwhile: the scenes' "
+              "CPU time was about a seventh of their wall time). CPU time / 2 estimates the "
+              "wall time of 2 workers on an idle machine. The sweep elapsed time spans "
+              "resumptions, if any.", "",
               "Failures: " + ("none." if not failures else ""), *failures, ""]
     return lines
 

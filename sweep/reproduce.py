@@ -58,6 +58,8 @@ def _cost(df) -> dict:
             "failures": [{"scene_id": r.scene_id, "reason": r.reason}
                          for r in df[~ok].itertuples()],
             "scene_wall_s_sum": float(df["wall_s"].sum()),
+            "scene_cpu_s_sum": (float(df["task_cpu_s"].sum()) if "task_cpu_s" in df
+                                else float("nan")),
             "scene_wall_s_max": float(df["wall_s"].max())}
 
 
