@@ -41,8 +41,10 @@ from .theory import jkr_contact_radius
 MAX_NEWTON_ITER = 12
 #: iterations of the elastic solves of the initial state (poorer starting guesses)
 MAX_NEWTON_ITER_INITIAL = 40
-#: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time]
+#: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
 WINDOW_SAFETY = 10.0
+#: ... widened outward to multiples of this many decades (shared by the scenes of a sweep)
+WINDOW_GRID = 0.5
 
 
 @lru_cache(maxsize=8)
@@ -197,10 +199,14 @@ def relaxed_state(el: _Elastic, delta0=None, a0=None):
 
 def material_of(scene: Scene):
     """The material object of a scene, in units where E0 = 1 and tau0 = 1."""
+    return _material(scene.material, scene.n, scene.k)
+
+
+def _material(material: str, n: float, k: float):
     from .materials import SLS, MPLRetardation
-    if scene.material == "sls":
-        return SLS(1.0, 1.0 / scene.k, 1.0)
-    return MPLRetardation(1.0, 1.0 / scene.k, scene.n, 1.0)
+    if material == "sls":
+        return SLS(1.0, 1.0 / k, 1.0)
+    return MPLRetardation(1.0, 1.0 / k, n, 1.0)
 
 
 def auto_domain(scene: Scene, numerics: Numerics, delta0_estimate: float) -> float:
@@ -212,12 +218,29 @@ def auto_domain(scene: Scene, numerics: Numerics, delta0_estimate: float) -> flo
 
 
 def time_window(scene: Scene, numerics: Numerics, delta0: float) -> tuple[float, float]:
-    """Prony window [t_min, t_max] in tau0 for this scene's unloading."""
+    """Prony window [t_min, t_max] in tau0 for this scene's unloading.
+
+    The window is widened outward to the grid of WINDOW_GRID decades, so that the scenes
+    of a sweep share a few windows (and their cached Prony series, :func:`prony_series`).
+    """
     h0 = units.h0_hat(scene.mu)
     t_min = numerics.min_step / scene.rate        # the smallest step the run may take
     travel = max(delta0, 0.0) + 3.0 + 2.0 * math.sqrt(max(delta0, 1.0))
-    t_max = WINDOW_SAFETY * travel / (scene.rate * h0)
-    return t_min, max(t_max, 10 * t_min)
+    t_max = max(WINDOW_SAFETY * travel / (scene.rate * h0), 10 * t_min)
+    lo = math.floor(math.log10(t_min) / WINDOW_GRID) * WINDOW_GRID
+    hi = math.ceil(math.log10(t_max) / WINDOW_GRID) * WINDOW_GRID
+    return 10.0 ** lo, 10.0 ** hi
+
+
+@lru_cache(maxsize=256)
+def prony_series(material: str, n: float, k: float, t_min: float, t_max: float, rtol: float):
+    """The Prony series of a scene's creep compliance on [t_min, t_max] (tau0), cached.
+
+    A fit costs 0.02-0.2 s, more than a fast scene's unloading; the scenes of a sweep
+    repeat the same (material, n, k) and, through the snapped :func:`time_window`, the
+    same window, so each worker fits each series once.
+    """
+    return _material(material, n, k).prony(t_min, t_max, rtol)
 
 
 # ------------------------------------------------------------------------ post-processing
@@ -344,7 +367,8 @@ def _simulate(scene: Scene, numerics: Numerics, res: Result) -> None:
             res.prony_terms, res.prony_error = 0, 0.0
         else:
             t_min, t_max = time_window(scene, numerics, delta0)
-            prony = material.prony(t_min, t_max, numerics.prony_rtol)
+            prony = prony_series(scene.material, scene.n if scene.material == "mpl" else 0.0,
+                                 scene.k, t_min, t_max, numerics.prony_rtol)
             weights = np.ascontiguousarray(prony.weights, dtype=float)
             times = np.ascontiguousarray(prony.times, dtype=float)
             res.prony_terms, res.prony_error = int(weights.size), float(prony.max_rel_error)
