@@ -1,7 +1,7 @@
 """Prony-series hereditary integral: O(N M) recursive update per time step (Numba kernels).
 
 With Chat(t) = 1 - sum_i c_i exp(-t/tau_i), traction piecewise linear in time over a step
-dt and a fully relaxed start (all q_i = 0), DESIGN.md section 4:
+dt and a fully relaxed start (all q_i = 0), docs/design.md section 4:
 
     q_i(n+1) = e_i q_i(n) + b_i (sigma(n+1) - sigma(n)),  e_i = exp(-dt/tau_i),
     b_i = tau_i (1 - e_i)/dt,

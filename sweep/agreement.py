@@ -26,7 +26,8 @@ from . import units
 from .crack_front import simulate_crack
 from .models import simulate_pb
 from .scene import Numerics, Scene
-from .solver import auto_domain, simulate
+from .problem import auto_domain
+from .solver import simulate
 
 A0S = (1.0, 2.0, 3.0, 4.0, 6.0, 8.0)
 RATES = (1.0, 10**2.5, 1e4)

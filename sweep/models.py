@@ -107,7 +107,7 @@ def bem_nodes_needed(scene, numerics=None) -> int:
     """Nodes the BEM needs for ``scene``: its automatic (or given) domain over the spacing at
     which the process zone ``l0 = 1.693/mu^2`` spans ``numerics.zone_nodes`` spacings."""
     from .scene import Numerics
-    from .solver import auto_domain
+    from .problem import auto_domain
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     if scene.a0 is not None:
