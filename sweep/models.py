@@ -28,7 +28,7 @@ from .errors import check_choice, check_positive
 from .theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 
 __all__ = ["MODELS", "pb_estimate", "simulate_pb", "simulate_model", "simulate_scene",
-           "choose_model", "bem_nodes_needed"]
+           "choose_model", "bem_nodes_needed", "bem_node_budget"]
 
 
 def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171) -> dict:
@@ -104,10 +104,18 @@ def _crack(scene, numerics=None):
 
 
 def bem_nodes_needed(scene, numerics=None) -> int:
-    """Nodes the BEM needs for ``scene``: its automatic (or given) domain over the spacing at
-    which the process zone ``l0 = 1.693/mu^2`` spans ``numerics.zone_nodes`` spacings."""
-    from .scene import Numerics
+    """Nodes the BEM needs for ``scene``.
+
+    Uniform mesh: its automatic (or given) domain over the spacing at which the process zone
+    ``l0 = 1.693/mu^2`` spans ``numerics.zone_nodes`` spacings. Graded mesh: the nodes of
+    the mesh the solver would build (:func:`sweep.mesh.scene_mesh`, sized from the band
+    resolution).
+    """
+    import dataclasses
+
+    from .mesh import scene_mesh
     from .problem import auto_domain
+    from .scene import Numerics
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     if scene.a0 is not None:
@@ -116,15 +124,26 @@ def bem_nodes_needed(scene, numerics=None) -> int:
         d_est = scene.delta0
     domain = numerics.domain if numerics.domain is not None else \
         auto_domain(scene, numerics, d_est)
-    return int(math.ceil(domain * numerics.zone_nodes / units.l0_hat(scene.mu))) + 1
+    l0 = units.l0_hat(scene.mu)
+    if numerics.mesh == "uniform":
+        return int(math.ceil(domain * numerics.zone_nodes / l0)) + 1
+    a_est = scene.a0 if scene.a0 is not None else max(d_est, 0.0) ** 0.5
+    mesh = scene_mesh(dataclasses.replace(numerics, nodes=None), l0, a_est, domain,
+                      pull_off_only=scene.stop == "pulloff")
+    return mesh.nodes
+
+
+def bem_node_budget(numerics) -> int:
+    """The most nodes ``numerics`` lets the BEM use: ``nodes`` (uniform) or ``max_nodes``."""
+    return numerics.nodes if numerics.mesh == "uniform" else numerics.max_nodes
 
 
 def choose_model(scene, numerics=None) -> str:
-    """The model "auto" picks: "bem" if its mesh fits ``numerics.nodes``, else "crack"."""
+    """The model "auto" picks: "bem" if its mesh fits the node budget, else "crack"."""
     from .scene import Numerics
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
-    return "bem" if bem_nodes_needed(scene, numerics) <= numerics.nodes else "crack"
+    return "bem" if bem_nodes_needed(scene, numerics) <= bem_node_budget(numerics) else "crack"
 
 
 #: model name -> simulate(scene, numerics=None) -> Result

@@ -446,8 +446,9 @@ class ResultStore:
             self._lock_fd = None
 
     # -- checks -----------------------------------------------------------------
-    def _existing_hashes(self) -> list[tuple[str, str, int]]:
-        """(where, config hash, scene id version) of the main file and the journal's meta.
+    def _existing_hashes(self) -> list[tuple[str, str, int, str]]:
+        """(where, config hash, scene id version, config text) of the main file and the
+        journal's meta.
 
         Files written before the id version was recorded are version 1.
         """
@@ -459,7 +460,8 @@ class ResultStore:
             try:
                 with _open_main(self.path) as f:
                     found.append((str(self.path), str(f.attrs.get("config_hash", "")),
-                                  int(f.attrs.get("scene_id_version", 1))))
+                                  int(f.attrs.get("scene_id_version", 1)),
+                                  str(f.attrs.get("config_text", ""))))
             except InputError as exc:
                 raise InputError(f"{exc}; refusing to overwrite it: use --out to write "
                                  f"elsewhere, or --fresh to move it aside to a .bak file") \
@@ -469,9 +471,9 @@ class ResultStore:
             try:
                 m = json.loads(meta.read_text())
                 found.append((str(self.parts), m["config_hash"],
-                              int(m.get("scene_id_version", 1))))
+                              int(m.get("scene_id_version", 1)), str(m.get("config_text", ""))))
             except (ValueError, KeyError, OSError, TypeError):
-                found.append((str(self.parts), "?", 1))
+                found.append((str(self.parts), "?", 1, ""))
         return found
 
     def prepare(self, resume: bool = True) -> None:
@@ -485,12 +487,18 @@ class ResultStore:
             hashes = self._existing_hashes() if resume else []
             if not resume and self.path.is_dir():
                 raise InputError(f"output {self.path} is a directory; give a file path")
-            for where, h, version in hashes:
+            for where, h, version, text in hashes:
                 if version > SCENE_ID_VERSION:
                     raise InputError(
                         f"{where} was written with scene id version {version}, newer than this "
                         f"visco-sweep's {SCENE_ID_VERSION}: resume it with the version that "
                         f"wrote it, or use --out to write elsewhere")
+                if h != self.config_hash and text and text == self.meta.get("config_text"):
+                    raise InputError(
+                        f"{where} was written by this same config when its numerics meant "
+                        f"other values (a preset or default changed since; the file's scenes "
+                        f"are kept and still load): use --fresh to recompute (the old file is "
+                        f"kept as a .bak) or --out to write elsewhere")
                 if h != self.config_hash:
                     raise InputError(
                         f"{where} holds results of a different config (config hash {h}, this "

@@ -56,10 +56,25 @@ def test_a_defaulted_new_field_renames_no_scene():
         assert scene_id(moved, numerics) != case["id"]
 
 
+def _pinned_config(path):
+    """The file's config with its preset replaced by the numerics its rows were run with
+    (the presets were redefined when the graded mesh came; explicit numerics keep ids)."""
+    row = load(path).iloc[0]
+    num = {c[len("num_"):]: row[c] for c in row.index if c.startswith("num_")}
+    num = {k: None if isinstance(v, float) and v != v else getattr(v, "item", lambda: v)()
+           for k, v in num.items()}
+    return dataclasses.replace(parse_config(read_attrs(path)["config_text"]),
+                               numerics=Numerics(**num))
+
+
 def test_version_1_file_loads_and_shows_in_info(capsys):
     df = load(V1_FILE)
-    cfg = parse_config(read_attrs(V1_FILE)["config_text"])
-    assert sorted(df.scene_id) == sorted(sid for sid, _ in cfg.tasks())
+    # the ids in the file are the ids of the scenes and numerics its rows record
+    for _, row in df.iterrows():
+        scene = Scene(**{k: (None if isinstance(row[k], float) and row[k] != row[k] else row[k])
+                         for k in ("n", "k", "mu", "rate", "a0", "delta0", "material", "stop")})
+        numerics = _pinned_config(V1_FILE).numerics
+        assert scene_id(scene, numerics) == row["scene_id"]
     assert set(df.status) == {"ok"}
     assert len(load_trajectory(V1_FILE, df.scene_id[0])["P"]) > 2
     assert main(["info", str(V1_FILE)]) == 0
@@ -74,10 +89,25 @@ def _must_not_run(scene, numerics):
 def test_version_1_file_resumes_with_nothing_recomputed(tmp_path):
     path = tmp_path / "v1.h5"
     shutil.copyfile(V1_FILE, path)
-    cfg = parse_config(read_attrs(path)["config_text"])
+    cfg = _pinned_config(path)
     report = run_sweep(cfg, jobs=1, out=path, simulate=_must_not_run, progress="none")
     assert (report.total, report.skipped, report.ran) == (3, 3, 0)
     assert sorted(load(path).scene_id) == sorted(load(V1_FILE).scene_id)
+
+
+def test_a_redefined_preset_is_refused_in_one_line(tmp_path, capsys):
+    # the file's own config says `preset: fast`, whose numerics changed with the graded
+    # mesh: resuming would mix two discretizations under one config, so it is refused
+    path = tmp_path / "v1.h5"
+    shutil.copyfile(V1_FILE, path)
+    before = path.read_bytes()
+    cfg_path = tmp_path / "cfg.yaml"
+    cfg_path.write_text(read_attrs(path)["config_text"])
+    assert main(["run", str(cfg_path), "--out", str(path), "--progress", "none"]) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert len(err) == 1 and "numerics meant other values" in err[0], err
+    assert path.read_bytes() == before
+    assert main(["info", str(path)]) == 0
 
 
 def test_newer_id_version_is_refused_in_one_line(tmp_path, capsys):

@@ -122,7 +122,7 @@ def test_cli_scene_si_options_need_si(capsys):
 
 
 def test_scene_model_field_and_auto_choice():
-    from sweep.models import bem_nodes_needed, choose_model, simulate_scene
+    from sweep.models import bem_node_budget, bem_nodes_needed, choose_model, simulate_scene
     from sweep.scene import Numerics
 
     assert Scene(n=0.8, a0=3.0, rate=1.0).model == "bem"
@@ -132,7 +132,7 @@ def test_scene_model_field_and_auto_choice():
     big = Scene(n=0.8, k=0.1, mu=20.0, a0=8.0, rate=1.0, model="auto")
     num = Numerics.preset("balanced")
     # l0 = 1.693/mu^2: 0.16 a_ref at mu = 3.24 (a few hundred nodes), 0.0042 at mu = 20
-    assert bem_nodes_needed(small, num) <= num.nodes < bem_nodes_needed(big, num)
+    assert bem_nodes_needed(small, num) <= bem_node_budget(num) < bem_nodes_needed(big, num)
     assert choose_model(small, num) == "bem" and choose_model(big, num) == "crack"
     res = simulate_scene(big, num)
     assert res.ok and res.model_used == "crack" and res.to_row()["model"] == "auto"

@@ -137,8 +137,11 @@ def test_fast_unloading_reaches_the_glassy_limit():
     # material independent: SLS, MPL n = 1.6 and MPL n = 3 agree to 2e-7 at rate 1e10
     # (14.71333). At rate 1e8 the MPL n = 1.6 creeps by about (1-k) t/(n-1) ~ 1e-6 during
     # the unloading: measured 14.71235, 7e-5 below the limit; tolerance 2e-4.
-    limit = fast(n=1.0, k=0.1, a0=3.0, rate=1e10, material="sls")
-    res = fast(n=1.6, k=0.1, a0=3.0, rate=1e8)
+    # Balanced numerics: the fast preset's coarse steps differ by 2e-4 between the two
+    # histories (within its 3 % pull_off_rtol, but not a test of the limit).
+    balanced = Numerics.preset("balanced")
+    limit = simulate(Scene(n=1.0, k=0.1, mu=3.24, a0=3.0, rate=1e10, material="sls"), balanced)
+    res = simulate(Scene(n=1.6, k=0.1, mu=3.24, a0=3.0, rate=1e8), balanced)
     assert res.ok and limit.ok
     assert res.pull_off == pytest.approx(limit.pull_off, rel=2e-4)
     # and below the JKR value with the glassy work of adhesion, 1.5/k (measured 14.71)
