@@ -45,15 +45,14 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from scipy.optimize import minimize_scalar
 
-from kernels.influence import GL8_W, GL8_X, GL16_W, GL16_X, GL32_W, GL32_X, _piece
+from kernels.influence import assemble_nodes, load_weights_nodes
 from kernels.interface import lj_traction_and_stiffness
 
 from . import units
 from .errors import check_range
-from .solver import jkr_gap_guess
+from .initial import jkr_gap_guess
 from .theory import jkr_indentation
 
 #: gap at the crack tip (max LJ tension) per h0
@@ -62,58 +61,6 @@ TIP_GAP = 3.0 ** (1.0 / 6.0)
 PROCESS_ZONE = 243.0 / (256.0 * math.pi * (math.pi / 9.0) ** 2) / math.pi ** (1.0 / 3.0)
 #: contact radius at the JKR (force-controlled) pull-off, a_ref
 A_JKR = (3.0 * math.sqrt(2.0) / 4.0) ** (2.0 / 3.0)
-
-
-# ------------------------------------------------------------------ influence on any nodes
-@njit(cache=True)
-def _influence_nodes(r, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws_far):
-    """A_ij = int phi_j(s) G(r_i, s) s ds for hats on nodes 0 = r_0 < r_1 < ...; node 0 has
-    a half hat, the last node a full hat whose outer piece is as long as the last element."""
-    N = r.size
-    ext = np.empty(N + 1)
-    ext[:N] = r
-    ext[N] = 2.0 * r[N - 1] - r[N - 2]
-    A = np.zeros((N, N))
-    for i in range(N):
-        ri = ext[i]
-        for j in range(N):
-            val = 0.0
-            if j > 0:
-                sing = 1 if i == j else (-1 if i == j - 1 else 0)
-                if i == 0:
-                    sing = 0
-                val += _piece(ri, ext[j - 1], ext[j], 0.0, 1.0, sing, xs_smooth, ws_smooth,
-                              xs_sing, ws_sing, xs_far, ws_far)
-            sing = -1 if i == j else (1 if i == j + 1 else 0)
-            if i == 0:
-                sing = 0
-            val += _piece(ri, ext[j], ext[j + 1], 1.0, 0.0, sing, xs_smooth, ws_smooth,
-                          xs_sing, ws_sing, xs_far, ws_far)
-            A[i, j] = val
-    return A
-
-
-def influence_nodes(r: np.ndarray) -> np.ndarray:
-    """Influence matrix of the hats on the nodes ``r`` (increasing, r[0] = 0), E0* = 1.
-
-    Same quadrature as :func:`kernels.influence.assemble_unit` (graded Gauss rule on the
-    pieces that touch the logarithmic singularity); the far-piece rule applies from three
-    piece lengths on, exact to rounding for neighbouring elements of ratio up to about 1.3.
-    """
-    r = np.ascontiguousarray(r, dtype=float)
-    return _influence_nodes(r, GL16_X, GL16_W, GL32_X, GL32_W, GL8_X, GL8_W)
-
-
-def load_weights_nodes(r: np.ndarray) -> np.ndarray:
-    """w_j = int phi_j(s) s ds, so that P = 2 pi sum_j w_j sigma_j (exact for the hats)."""
-    r = np.asarray(r, dtype=float)
-    ext = np.append(r, 2.0 * r[-1] - r[-2])
-    w = np.zeros(r.size)
-    lo, hi = ext[:-1], ext[1:]
-    # falling piece of node j on [r_j, r_{j+1}] and rising piece of node j+1
-    w += (hi - lo) * (2.0 * lo + hi) / 6.0
-    w[1:] += ((hi - lo) * (lo + 2.0 * hi) / 6.0)[:-1]
-    return w
 
 
 # ------------------------------------------------------------------------------ the mesh
@@ -207,7 +154,7 @@ class ElasticBranch:
         self.x, self.m = node_pattern(zone_spacing, zone_spacing, zone * l0 / a_scale, coarse, x_out,
                                       grading)
         self.tail = tail
-        self.A = influence_nodes(self.x)
+        self.A = assemble_nodes(self.x)
         self.w = load_weights_nodes(self.x)
         self.tol = tol
         self.iterations = 0
