@@ -109,6 +109,13 @@ class ElasticPullOff:
     seconds: float
     converged: bool
     reason: str = ""
+    #: the scanned branch, a decreasing: radii (a_ref), loads (pi dg R), indentations (d_ref)
+    branch: tuple | None = None
+    #: d delta / d a at the pull-off (d_ref / a_ref), central difference on the branch
+    ddelta_da: float = float("nan")
+    #: fine spacing at the tip and mesh radius at the pull-off (a_ref)
+    spacing: float = float("nan")
+    domain: float = float("nan")
 
 
 class ElasticBranch:
@@ -237,7 +244,8 @@ def pull_off_radius_guess(mu: float) -> float:
     return max(A_JKR, math.sqrt(2.0 * (TIP_GAP - 1.0) * h0))
 
 
-def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, **mesh) -> ElasticPullOff:
+def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, a_start=None,
+                     **mesh) -> ElasticPullOff:
     """Elastic quasi-static pull-off at Tabor parameter mu (see the module docstring).
 
     Parameters
@@ -253,6 +261,10 @@ def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, **mesh) -> Elasti
         Radii in the scan (geometric, from the largest down).
     xtol : float
         Brent tolerance on a (relative to the guess).
+    a_start : float, optional
+        Unload from this contact radius: the branch is scanned from a_start down and the
+        pull-off is the largest tension at radii <= a_start (the start itself if the load
+        only rises from there).
 
     Returns
     -------
@@ -265,7 +277,13 @@ def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, **mesh) -> Elasti
     a_g = pull_off_radius_guess(mu)
     a_lo, a_hi = span[0] * a_g, span[1] * a_g
     br = ElasticBranch(mu, a_g, a_lo, **mesh)
-    radii = np.geomspace(a_hi, a_lo, scan)
+    if a_start is None:
+        radii = np.geomspace(a_hi, a_lo, scan)
+    else:
+        a_start = check_range("a_start", a_start, lo=0.0, lo_open=True)
+        a_lo = min(a_lo, 0.5 * a_start)
+        count = max(scan, int(math.ceil(scan * math.log(a_start / a_lo) / math.log(a_hi / a_lo))))
+        radii = np.geomspace(a_start, a_lo, count)
     h, delta = br.guess(radii[0])
     states, loads = [], []
     for a in radii:
@@ -274,9 +292,18 @@ def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, **mesh) -> Elasti
             return _failed(br, mu, t0, f"Newton did not converge at a = {a:.4g}")
         states.append((h, delta))
         loads.append(br.load(a, h))
+    branch = (radii, np.array(loads), np.array([d for _, d in states]))
     i = int(np.argmin(loads))
-    if i == 0 or i == len(radii) - 1:
+    if i == len(radii) - 1 or (i == 0 and a_start is None):
         return _failed(br, mu, t0, f"minimum of P(a) at the end of the scan (a = {radii[i]:.4g})")
+    if i == 0:      # unloading from a_start: the tension only decreases from the start
+        return ElasticPullOff(mu=mu, pull_off=-loads[0], a=float(radii[0]),
+                              delta=float(states[0][1]), nodes=br.nodes, solves=br.solves,
+                              newton_iterations=br.iterations,
+                              seconds=time.perf_counter() - t0, converged=True,
+                              reason="largest tension at the start", branch=branch,
+                              spacing=float(radii[0] * (br.x[br.m + 1] - 1.0)),
+                              domain=float(radii[0] * br.x[-1]))
     cache = {}
 
     def neg_pull(a):
@@ -295,10 +322,18 @@ def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, **mesh) -> Elasti
         return _failed(br, mu, t0, str(err))
     a_star = float(res.x)
     P = float(res.fun)
-    _, d_star = cache[a_star] if a_star in cache else (None, float("nan"))
+    h_star, d_star = cache[a_star]
+    eps = 1e-4 * a_star
+    d_pm = []
+    for a in (a_star + eps, a_star - eps):
+        _, d, ok = br.solve(a, h_star, d_star)
+        d_pm.append(d if ok else float("nan"))
     return ElasticPullOff(mu=mu, pull_off=-P, a=a_star, delta=float(d_star), nodes=br.nodes,
                           solves=br.solves, newton_iterations=br.iterations,
-                          seconds=time.perf_counter() - t0, converged=True)
+                          seconds=time.perf_counter() - t0, converged=True, branch=branch,
+                          ddelta_da=(d_pm[0] - d_pm[1]) / (2.0 * eps),
+                          spacing=float(a_star * (br.x[br.m + 1] - 1.0)),
+                          domain=float(a_star * br.x[-1]))
 
 
 def _failed(br, mu, t0, reason) -> ElasticPullOff:
@@ -335,3 +370,58 @@ if __name__ == "__main__":      # python -m sweep.quasistatic: the table of the 
         print(f"{row['mu']:6.2f} {row['pull_off']:9.5f} {(row['pull_off'] - 1.5) * row['mu']:9.4f} "
               f"{row['a']:7.4f} {row['delta']:8.4f} {row['nodes']:5d} {row['seconds']:6.2f} "
               f"{row['md_pull_off']:7.4f}")
+
+
+def simulate_elastic(scene, numerics=None):
+    """An elastic scene (k = 1) as a :class:`sweep.scene.Result`, by :func:`elastic_pull_off`.
+
+    The quasi-static branch from the initial radius ``scene.a0`` (``delta0`` scenes are
+    refused: give a0); the rate only sets the time axis, ``t = (delta0 - delta) / (rate h0)``,
+    and the crack speed at pull-off, ``v_a = rate h0 / (d delta / d a)``. The trajectory is
+    the scanned branch up to the displacement-controlled fold (smallest delta); ``a_inner``
+    is not computed (NaN). Not handled: a load minimum beyond the fold (not met from mu =
+    0.01 to 100: the fold lies at smaller radii). Counters:
+    ``steps`` = equilibrium solves, ``factorizations`` = Newton iterations (one dense solve
+    each). A numerical failure gives ``status="failed"`` with the reason, never raises.
+    """
+    from .scene import Numerics, Result
+
+    if numerics is None:
+        numerics = Numerics.preset("balanced")
+    t0 = time.perf_counter()
+    res = Result(scene=scene, numerics=numerics)
+    if scene.k != 1.0:
+        res.reason = f"the quasi-static elastic solver needs k = 1 (got k = {scene.k})"
+        return res
+    if scene.a0 is None:
+        res.reason = "the quasi-static elastic solver starts from a0 (give a0, not delta0)"
+        return res
+    po = elastic_pull_off(scene.mu, a_start=scene.a0)
+    res.nodes_used, res.steps = po.nodes, po.solves
+    res.newton_iterations = res.factorizations = po.newton_iterations
+    res.wall_s = time.perf_counter() - t0
+    if not po.converged:
+        res.reason = po.reason
+        return res
+    h0 = units.h0_hat(scene.mu)
+    radii, loads, deltas = po.branch
+    stop = int(np.argmin(deltas)) + 1          # the displacement-controlled fold
+    keep = radii[:stop] >= po.a
+    d0 = float(deltas[0])
+    speed = scene.rate * h0
+    res.status = "ok"
+    res.reason = po.reason
+    res.pull_off, res.a_pulloff, res.delta_pulloff = po.pull_off, po.a, po.delta
+    res.t_pulloff = (d0 - po.delta) / speed
+    res.crack_speed = speed / po.ddelta_da
+    res.vhat = res.crack_speed / units.l0_hat(scene.mu)
+    res.rhat_pb = units.rhat_pb(scene.rate, scene.mu)
+    res.a0_result, res.delta0_result = float(radii[0]), d0
+    res.spacing, res.domain_used = po.spacing, po.domain
+    res.prony_terms, res.prony_error = 0, 0.0
+    a_tr = np.append(radii[:stop][keep], po.a)
+    d_tr = np.append(deltas[:stop][keep], po.delta)
+    res.trajectory = {"t": (d0 - d_tr) / speed, "delta": d_tr,
+                      "P": np.append(loads[:stop][keep], -po.pull_off), "a": a_tr,
+                      "a_inner": np.full(a_tr.size, np.nan)}
+    return res

@@ -97,3 +97,41 @@ def test_pull_off_converged_under_refinement_at_mu_100():
     p = qs.elastic_pull_off(100.0).pull_off
     fine = qs.elastic_pull_off(100.0, zone_resolution=32.0, zone=10.0, grading=1.025).pull_off
     assert p == pytest.approx(fine, abs=1e-4)
+
+
+def test_simulate_elastic_result_against_jkr_at_high_mu():
+    """mu = 20 (the Scene limit today), a0 = 2: the JKR start delta = a^2 - sqrt(2a) = 2 and the crack speed at
+    pull-off v_a = rate h0 / (d delta/da), d delta/da = 2a - 1/sqrt(2a) = 1.387 at a = 1.040."""
+    from sweep.scene import Scene
+    from sweep import units
+    from sweep.theory import jkr_indentation
+
+    scene = Scene(n=1.0, k=1.0, mu=20.0, a0=2.0, rate=3.0)
+    res = qs.simulate_elastic(scene)
+    assert res.ok, res.reason
+    po = qs.elastic_pull_off(20.0, a_start=2.0)
+    assert res.pull_off == po.pull_off and res.a_pulloff == po.a
+    assert res.a0_result == 2.0
+    assert res.delta0_result == pytest.approx(float(jkr_indentation(2.0)), abs=0.02)
+    a = res.a_pulloff
+    v_jkr = 3.0 * units.h0_hat(20.0) / (2 * a - (2 * a) ** -0.5)
+    assert res.crack_speed == pytest.approx(v_jkr, rel=0.02)
+    tr = res.trajectory
+    assert np.all(np.diff(tr["t"]) > 0) and tr["P"][-1] == -res.pull_off
+    assert res.t_pulloff == pytest.approx(tr["t"][-1])
+
+
+def test_simulate_elastic_refuses_viscoelastic_and_delta0_scenes():
+    from sweep.scene import Scene
+
+    res = qs.simulate_elastic(Scene(n=1.0, k=0.5, mu=3.24, a0=2.0, rate=1.0))
+    assert not res.ok and "k = 1" in res.reason
+    res = qs.simulate_elastic(Scene(n=1.0, k=1.0, mu=3.24, delta0=2.0, rate=1.0))
+    assert not res.ok and "a0" in res.reason
+
+
+def test_start_inside_the_pull_off_radius_gives_the_starting_tension():
+    """Unloading from a0 below the load-controlled pull-off radius: the tension only falls."""
+    po = qs.elastic_pull_off(10.0, a_start=0.8)
+    assert po.converged and po.a == 0.8
+    assert po.pull_off < qs.elastic_pull_off(10.0).pull_off
