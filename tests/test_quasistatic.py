@@ -100,8 +100,9 @@ def test_pull_off_converged_under_refinement_at_mu_100():
 
 
 def test_simulate_elastic_result_against_jkr_at_high_mu():
-    """mu = 20 (the Scene limit today), a0 = 2: the JKR start delta = a^2 - sqrt(2a) = 2 and the crack speed at
-    pull-off v_a = rate h0 / (d delta/da), d delta/da = 2a - 1/sqrt(2a) = 1.387 at a = 1.040."""
+    """mu = 20 (the Scene limit today), a0 = 2: the JKR start delta = a^2 - sqrt(2a) = 2 and
+    the crack speed at pull-off v_a = rate h0 / (d delta/da), d delta/da = 2a - 1/sqrt(2a)
+    = 1.387 at a = 1.040."""
     from sweep.scene import Scene
     from sweep import units
     from sweep.theory import jkr_indentation
