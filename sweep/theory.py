@@ -58,6 +58,9 @@ __all__ = [
     "hertz_indentation",
     "gent_schultz",
     "paper_v_vs_r_fit",
+    "maugis_lambda",
+    "maugis_dugdale_load",
+    "maugis_dugdale_pull_off",
 ]
 
 #: Largest MPL exponent accepted by the PB routines (the quadrature step is tuned up to it).
@@ -513,3 +516,103 @@ def paper_v_vs_r_fit(rhat_pb, prefactor: float = 2.887, exponent: float = 1.171)
     prefactor = check_positive("prefactor", prefactor)
     exponent = check_positive("exponent", exponent)
     return prefactor * r[()] ** exponent
+
+
+# --------------------------------------------------------------------------------------------
+# Maugis-Dugdale (a guide across the Tabor range; units of DESIGN.md section 2 on output)
+# --------------------------------------------------------------------------------------------
+#: lambda / mu when the Dugdale stress equals the largest Lennard-Jones tension (see below)
+MAUGIS_LAMBDA_PER_MU = (32.0 / (9.0 * math.sqrt(3.0))) * (9.0 / (16.0 * math.pi)) ** (1.0 / 3.0)
+#: Maugis' contact radius A = a (K / (pi dg R^2))^(1/3), K = 4 E*/3, per a / a_ref
+_MAUGIS_A_PER_A = (4.0 / 3.0) ** (1.0 / 3.0)
+
+
+def maugis_lambda(mu):
+    r"""Maugis' transition parameter lambda equivalent to the Tabor parameter mu.
+
+    Maugis (J. Colloid Interface Sci. 150, 243 (1992)) defines
+    :math:`\lambda = 2\sigma_0 (R / (\pi\,\Delta\gamma K^2))^{1/3}`, ``K = 4 E*/3``. Taking the
+    Dugdale stress ``sigma_0`` equal to the largest Lennard-Jones tension,
+    :math:`\sigma_0 = 16\Delta\gamma / (9\sqrt3\,h_0)` (so that the Dugdale range
+    ``dg / sigma_0 = 0.974 h0``), and Tabor's :math:`\mu = (R\Delta\gamma^2/(E^{*2}h_0^3))^{1/3}`:
+
+    .. math:: \lambda = \frac{32}{9\sqrt3}\left(\frac{9}{16\pi}\right)^{1/3}\mu \approx 1.1570\,\mu
+
+    (Johnson & Greenwood, J. Colloid Interface Sci. 192, 326 (1997), the factor 1.16).
+    """
+    mu = check_array("mu", mu, lo=0.0, lo_open=True)
+    return MAUGIS_LAMBDA_PER_MU * mu[()]
+
+
+def _md_lhs(s, A, lam):
+    """Left side of Maugis' eq. (the Dugdale-zone closure) with s = sqrt(m^2 - 1), m = c/a."""
+    at = np.arctan(s)
+    m2 = 1.0 + s * s
+    return (0.5 * lam * A * A * (s + (m2 - 2.0) * at)
+            + (4.0 * lam * lam * A / 3.0) * (s * at - np.sqrt(m2) + 1.0))
+
+
+def _md_load_zero_radius(lam):
+    """Maugis load at A -> 0 (Dugdale disk of radius C = m A, no contact): -lam pi C^2 / 2.
+
+    The closure tends to ``lam pi C^2 / 4 + (4 lam^2 / 3)(pi/2 - 1) C = 1`` (positive root).
+    """
+    b = (4.0 * lam * lam / 3.0) * (0.5 * math.pi - 1.0)
+    qa = 0.25 * lam * math.pi
+    C = 2.0 / (b + math.sqrt(b * b + 4.0 * qa))
+    return -0.5 * lam * math.pi * C * C
+
+
+def maugis_dugdale_load(A, lam):
+    r"""Maugis-Dugdale load at Maugis' contact radius ``A`` (Maugis' units, P in pi dg R).
+
+    Solves the closure for ``m = c/a`` (the Dugdale zone spans a < r < c)
+
+    .. math::
+        \frac{\lambda A^2}{2}\left[\sqrt{m^2-1} + (m^2-2)\arctan\sqrt{m^2-1}\right]
+        + \frac{4\lambda^2 A}{3}\left[\sqrt{m^2-1}\arctan\sqrt{m^2-1} - m + 1\right] = 1
+
+    (monotone in m, one root by brentq) and returns
+    :math:`\bar P = A^3 - \lambda A^2\left[\sqrt{m^2-1} + m^2\arctan\sqrt{m^2-1}\right]`;
+    ``A = 0`` gives the closed-form limit. ``A = a / a_ref * (4/3)^(1/3)``; the load unit
+    ``pi dg R`` is the project's.
+    """
+    from scipy.optimize import brentq
+
+    A = float(A)
+    lam = float(lam)
+    if A <= 0.0:
+        return _md_load_zero_radius(lam)
+    hi = 1.0
+    while _md_lhs(hi, A, lam) < 1.0:
+        hi *= 2.0
+    s = brentq(lambda x: _md_lhs(x, A, lam) - 1.0, 0.0, hi, xtol=1e-15, rtol=1e-15)
+    return A**3 - lam * A * A * (s + (1.0 + s * s) * math.atan(s))
+
+
+def maugis_dugdale_pull_off(lam):
+    r"""Maugis-Dugdale pull-off under load control: ``(pull_off, a)``.
+
+    ``pull_off = -min_A P(A)`` over the whole branch A >= 0 (units pi dg R; 2 in the DMT
+    limit lambda -> 0, 3/2 in the JKR limit lambda -> inf) and the contact radius there in
+    units of a_ref (it tends to 0 as lambda -> 0 and to the JKR 1.040 as lambda -> inf).
+    Found by a scan of A on [0, 4] and a bounded Brent refinement around the scan's minimum.
+
+    Asymptotics (derived in tests/test_theory.py): ``2 - 1.7175 lambda^(3/2)`` for small
+    lambda (the A -> 0 end of the branch), ``1.5 + (1.5^(2/3)/8) / lambda^2 = 1.5 + 0.1638 /
+    lambda^2`` for large lambda. Values: 1.9506 (lambda 0.1), 1.6007 (1), 1.5063 (5),
+    1.5016 (10).
+    """
+    from scipy.optimize import minimize_scalar
+
+    lam = check_positive("lam", lam)
+    grid = np.linspace(0.0, 4.0, 161)
+    loads = np.array([maugis_dugdale_load(A, lam) for A in grid])
+    i = int(np.argmin(loads))
+    best_A, best_P = float(grid[i]), float(loads[i])
+    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    res = minimize_scalar(lambda A: maugis_dugdale_load(A, lam), bounds=(lo, hi),
+                          method="bounded", options={"xatol": 1e-10})
+    if res.fun < best_P:
+        best_A, best_P = float(res.x), float(res.fun)
+    return -best_P, best_A / _MAUGIS_A_PER_A

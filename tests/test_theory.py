@@ -353,3 +353,82 @@ def test_paper_v_vs_r_fit():
     assert paper_v_vs_r_fit(2.0, prefactor=1.0, exponent=1.0) == 2.0
     with pytest.raises(InputError, match=r"^rhat_pb must be >= 0"):
         paper_v_vs_r_fit(-1.0)
+
+
+# --------------------------------------------------------------------------------------------
+# Maugis-Dugdale
+# --------------------------------------------------------------------------------------------
+def md_pull_off_by_m(lam):
+    """Second route: for fixed m = c/a Maugis' closure is a quadratic in A (explicit root), so
+    P(m) is explicit; minimize over m on a log grid of m - 1 refined by golden section."""
+    def load(t):  # t = log(m - 1)
+        m = 1.0 + math.exp(t)
+        s = math.sqrt(m * m - 1.0)
+        at = math.atan(s)
+        qa = 0.5 * lam * (s + (m * m - 2.0) * at)
+        qb = (4.0 * lam * lam / 3.0) * (s * at - m + 1.0)
+        A = 2.0 / (qb + math.sqrt(qb * qb + 4.0 * qa))
+        return A**3 - lam * A * A * (s + m * m * at), A
+    ts = np.linspace(-30.0, 12.0, 4201)
+    vals = [load(t)[0] for t in ts]
+    i = int(np.argmin(vals))
+    lo, hi = ts[max(i - 1, 0)], ts[min(i + 1, ts.size - 1)]
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    for _ in range(80):
+        x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+        if load(x1)[0] < load(x2)[0]:
+            hi = x2
+        else:
+            lo = x1
+    P, A = load(0.5 * (lo + hi))
+    return -P, A / (4.0 / 3.0) ** (1.0 / 3.0)
+
+
+@pytest.mark.parametrize("lam", [0.05, 0.3, 1.0, 3.0, 20.0])
+def test_maugis_pull_off_two_routes(lam):
+    """brentq for m at each A + Brent over A, against the explicit A(m) + golden over m."""
+    p, a = theory.maugis_dugdale_pull_off(lam)
+    p2, a2 = md_pull_off_by_m(lam)
+    assert p == pytest.approx(p2, rel=1e-9)
+    assert a == pytest.approx(a2, rel=1e-4)
+
+
+def test_maugis_dmt_limit():
+    """lambda -> 0: at A -> 0 the closure is lam pi C^2/4 + (4 lam^2/3)(pi/2 - 1) C = 1 and
+    P = -lam pi C^2/2, so pull-off = 2 - (16/3)(pi/2 - 1)/sqrt(pi) lam^(3/2) + O(lam^2)."""
+    c = (16.0 / 3.0) * (0.5 * math.pi - 1.0) / math.sqrt(math.pi)
+    for lam in (1e-3, 1e-4):
+        p, _ = theory.maugis_dugdale_pull_off(lam)
+        assert (2.0 - p) / lam**1.5 == pytest.approx(c, rel=3e-4)
+
+
+def test_maugis_jkr_limit():
+    """lambda -> inf: with t = lam sqrt(m^2-1), the closure to O(lam^-2) gives
+    t = t0 + (5 t0^3/24 - 3/4)/lam^2, t0^2 = 3/(2A), hence
+    P = A^3 - A^2 (2t + 2t^3/(3 lam^2)) = JKR - A^2 (13 t0^3/12 - 3/2)/lam^2; at the JKR
+    pull-off (A^3 = 3/2, t0^3 = 3/2): pull-off = 3/2 + (1.5^(2/3)/8) / lam^2."""
+    c = 1.5 ** (2.0 / 3.0) / 8.0
+    for lam in (100.0, 300.0):
+        p, a = theory.maugis_dugdale_pull_off(lam)
+        assert (p - 1.5) * lam**2 == pytest.approx(c, rel=2e-3)
+        assert a == pytest.approx(theory.jkr_pull_off_point("force")[0], rel=1e-3)
+
+
+def test_maugis_monotone_between_limits():
+    lams = np.geomspace(1e-2, 1e2, 25)
+    p = np.array([theory.maugis_dugdale_pull_off(x)[0] for x in lams])
+    assert np.all(np.diff(p) < 0.0)
+    assert np.all((p > 1.5) & (p < 2.0))
+
+
+def test_maugis_lambda_from_physical_constants():
+    """lambda = 2 sigma0 (R / (pi dg K^2))^(1/3), K = 4E*/3, sigma0 = 16 dg / (9 sqrt3 h0)
+    (the LJ maximum tension), against mu = (R dg^2 / (E*^2 h0^3))^(1/3), in SI numbers."""
+    R, dg, E, h0 = 5.19e-3, 0.1523, 1.94e6, 30.8e-9
+    mu = (R * dg**2 / (E**2 * h0**3)) ** (1.0 / 3.0)
+    sigma0 = 16.0 * dg / (9.0 * math.sqrt(3.0) * h0)
+    lam = 2.0 * sigma0 * (R / (math.pi * dg * (4.0 * E / 3.0) ** 2)) ** (1.0 / 3.0)
+    assert theory.maugis_lambda(mu) == pytest.approx(lam, rel=1e-12)
+    assert theory.maugis_lambda(1.0) == pytest.approx(1.157, abs=5e-4)
+    with pytest.raises(InputError):
+        theory.maugis_lambda(0.0)

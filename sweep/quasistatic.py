@@ -1,0 +1,427 @@
+r"""Elastic quasi-static pull-off across the Tabor range (mu from 0.01 to 100).
+
+An elastic scene (``k = 1``) unloaded quasi-statically has no history: its states are the
+equilibria of the Lennard-Jones interface on the elastic half-space, and its pull-off is the
+largest tension along that branch. This module models only that (no time steps, no Prony
+series): the branch is parametrized by the contact radius ``a`` (the max-tension radius,
+where the gap is ``h_m = 3^(1/6) h0``, DESIGN.md section 2) instead of the indentation, so
+the folds of the displacement-controlled path are no obstacle, and
+
+    pull_off = - min_a P(a)
+
+is found by a scan of ``a`` (each solve warm-started from its neighbour) and a bounded Brent
+refinement around the scan's minimum.
+
+Units and conventions of DESIGN.md section 2 (a, r in a_ref; gaps and delta in d_ref; P in
+pi dg R; traction positive when compressive).
+
+Equilibrium at fixed ``a``. Nodes ``r_i = a x_i`` on a fixed graded pattern ``x`` with a
+node at ``x = 1`` (index ``m``); traction piecewise linear with the nodal values
+``sigma(h_i)`` (overlapping hats). Unknowns: the gaps ``h_i`` (``i != m``) and ``delta``:
+
+    h_i + delta - h0 - r_i^2 / 2 - sum_j A_ij sigma(h_j) = 0,   h_m = h_m(LJ) = 3^(1/6) h0,
+
+solved by Newton with a backtracking line search. Because the nodes scale with ``a``, the
+influence matrix is ``a`` times that of the pattern (assembled once per scene) and the
+discretization error varies smoothly with ``a``, which the minimization needs.
+
+Mesh pattern (:func:`node_pattern`): uniform spacing ``l0 / 16`` within ``5 l0`` of the
+tip (``l0 = 1.693 / mu^2`` a_ref, the Persson-Brener process zone), then growing
+geometrically by ``grading`` = 1.05 on both sides up to ``coarse`` = 0.01 (relative to a)
+inside and ``coarse * max(1, x)`` outside; where l0/16 is coarser than that (mu below about
+3) the mesh is ``coarse`` throughout. Measured: a geometric refinement right down to the tip
+(l0/128 graded by 1.025) converges slowly (error ~ 3e-4 at mu = 3.24 and 100): collocation of
+the hats loses the error cancellation of a uniform mesh; the uniform zone converges to about
+3e-5 (mu = 100: 1.50019 here, 1.500208 at l0/32 over 10 l0, unchanged at l0/64 or grading
+1.0125). The domain extends to the radius where the rigid-sphere gap from the tip, ``h_m + (r^2 - a^2)/2``,
+reaches ``tail_gap * h0`` (so it grows with h0 = 1 / (pi^(2/3) mu) as mu -> 0). The LJ force
+beyond the mesh is added in closed form for a rigid continuation of the gap,
+``2 pi int_{h_e}^inf sigma(h) dh``.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from kernels.influence import assemble_nodes, load_weights_nodes
+from kernels.interface import lj_traction_and_stiffness
+
+from . import units
+from .errors import check_range
+from .initial import jkr_gap_guess
+from .theory import jkr_indentation
+
+#: gap at the crack tip (max LJ tension) per h0
+TIP_GAP = 3.0 ** (1.0 / 6.0)
+#: Persson-Brener process zone l0 * mu^2 in a_ref (DESIGN.md section 2)
+PROCESS_ZONE = 243.0 / (256.0 * math.pi * (math.pi / 9.0) ** 2) / math.pi ** (1.0 / 3.0)
+#: contact radius at the JKR (force-controlled) pull-off, a_ref
+A_JKR = (3.0 * math.sqrt(2.0) / 4.0) ** (2.0 / 3.0)
+
+
+# ------------------------------------------------------------------------------ the mesh
+def node_pattern(tip: float, zone_spacing: float, zone: float, coarse: float, x_out: float,
+                 grading: float = 1.025):
+    """Graded nodes x on [0, x_out] with a node at x = 1 (the tip), returned with its index.
+
+    Spacing ``tip`` at x = 1, times ``grading`` per element away from it on both sides, capped
+    at ``zone_spacing`` within ``zone`` of the tip, then at ``coarse`` inside and at
+    ``coarse * x`` outside (all lengths relative to a).
+    """
+    def cap(x):
+        far = coarse * max(1.0, x)
+        return zone_spacing if abs(x - 1.0) < zone and zone_spacing < far else far
+
+    inner = [1.0]
+    ds = tip
+    while True:
+        nxt = inner[-1] - ds
+        if nxt <= 0.5 * ds:
+            break
+        inner.append(nxt)
+        ds = min(ds * grading, cap(nxt))
+    inner.append(0.0)       # the last element lies between 0.5 and 1.5 times its neighbour
+    outer = []
+    x = 1.0
+    ds = tip
+    while x < x_out:
+        x += ds
+        outer.append(x)
+        ds = min(ds * grading, cap(x))
+    return np.array(inner[::-1] + outer), len(inner) - 1
+
+
+@dataclass
+class ElasticPullOff:
+    """Elastic quasi-static pull-off of one scene (units of DESIGN.md section 2)."""
+
+    mu: float
+    pull_off: float          # -min P, pi dg R
+    a: float                 # max-tension radius at pull-off, a_ref
+    delta: float             # indentation at pull-off, d_ref
+    nodes: int
+    solves: int
+    newton_iterations: int
+    seconds: float
+    converged: bool
+    reason: str = ""
+    #: the scanned branch, a decreasing: radii (a_ref), loads (pi dg R), indentations (d_ref)
+    branch: tuple | None = None
+    #: d delta / d a at the pull-off (d_ref / a_ref), central difference on the branch
+    ddelta_da: float = float("nan")
+    #: fine spacing at the tip and mesh radius at the pull-off (a_ref)
+    spacing: float = float("nan")
+    domain: float = float("nan")
+
+
+class ElasticBranch:
+    """The elastic LJ equilibria of one mu, parametrized by the max-tension radius a.
+
+    Parameters
+    ----------
+    mu : float
+        Tabor parameter, in [0.01, 100].
+    a_scale : float
+        Radius (a_ref) the tip spacing is sized for (the expected pull-off radius).
+    a_min : float
+        Smallest radius the branch will be solved at (sizes the domain).
+    zone_resolution, zone : float
+        Uniform elements of l0 / zone_resolution within ``zone`` l0 of the tip (at
+        a = a_scale), when that is finer than ``coarse``; graded outside.
+    coarse : float
+        Largest element, relative to a.
+    tail_gap : float
+        Domain edge where the rigid gap is this many h0.
+    grading : float
+        Growth ratio of neighbouring elements.
+    domain : float or None
+        Mesh radius at a = a_scale (a_ref) instead of the tail_gap rule (for comparisons).
+    tail : bool
+        Add the LJ force beyond the mesh (rigid continuation of the gap).
+    """
+
+    def __init__(self, mu, a_scale, a_min, zone_resolution=16.0, zone=5.0, coarse=0.01,
+                 tail_gap=40.0, grading=1.05, domain=None, tail=True, tol=1e-10):
+        self.mu = check_range("mu", mu, lo=0.01, hi=100.0)
+        self.h0 = units.h0_hat(self.mu)
+        self.c = units.lj_prefactor(self.mu)
+        self.hm = TIP_GAP * self.h0
+        l0 = PROCESS_ZONE / self.mu**2
+        zone_spacing = min(l0 / zone_resolution, coarse * a_scale) / a_scale
+        if zone_spacing >= coarse:      # l0 is no finer than the coarse mesh: no zone
+            zone = 0.0
+        if domain is None:
+            x_out = max(math.sqrt(1.0 + 2.0 * (tail_gap - TIP_GAP) * self.h0 / a_min**2), 1.5)
+        else:
+            x_out = domain / a_scale
+        self.x, self.m = node_pattern(zone_spacing, zone_spacing, zone * l0 / a_scale, coarse, x_out,
+                                      grading)
+        self.tail = tail
+        self.A = assemble_nodes(self.x)
+        self.w = load_weights_nodes(self.x)
+        self.tol = tol
+        self.iterations = 0
+        self.solves = 0
+        self._sig = np.empty(self.x.size)
+        self._dsig = np.empty(self.x.size)
+
+    @property
+    def nodes(self) -> int:
+        return int(self.x.size)
+
+    def guess(self, a: float):
+        """Starting gaps at radius a: the JKR gap for mu >= 1, the rigid sphere below."""
+        r = a * self.x
+        if self.mu >= 1.0:
+            d = float(jkr_indentation(a))
+            h = jkr_gap_guess(r, d, self.h0)
+        else:
+            h = np.maximum(self.hm + 0.5 * (r**2 - a * a), self.h0)
+        h[self.m] = self.hm
+        delta = self.hm - self.h0 - 0.5 * a * a
+        return h, delta
+
+    def residual(self, a, h, delta):
+        lj_traction_and_stiffness(h, self.h0, self.c, self._sig, self._dsig)
+        r = a * self.x
+        return h + delta - self.h0 - 0.5 * r**2 - a * (self.A @ self._sig)
+
+    def solve(self, a, h, delta, max_iter=60):
+        """Newton for (h, delta) at radius a from the guess; returns (h, delta, ok)."""
+        h = h.copy()
+        h[self.m] = self.hm
+        F = self.residual(a, h, delta)
+        norm = np.max(np.abs(F))
+        self.solves += 1
+        for _ in range(max_iter):
+            if norm < self.tol * self.h0:
+                return h, delta, True
+            self.iterations += 1
+            J = -a * self.A * self._dsig[None, :]
+            J[np.diag_indices_from(J)] += 1.0
+            J[:, self.m] = 1.0
+            step = np.linalg.solve(J, -F)
+            dh = step.copy()
+            dh[self.m] = 0.0
+            dd = step[self.m]
+            # keep every gap positive: at most a 70 % decrease per step
+            shrink = np.where(dh < 0.0, -0.7 * h / np.minimum(dh, -1e-300), np.inf)
+            t = min(1.0, float(np.min(shrink)))
+            for _ in range(40):
+                h_new = h + t * dh
+                F_new = self.residual(a, h_new, delta + t * dd)
+                n_new = np.max(np.abs(F_new))
+                if n_new < (1.0 - 1e-4 * t) * norm or n_new < self.tol * self.h0:
+                    break
+                t *= 0.5
+            else:
+                return h, delta, False
+            h, delta, F, norm = h_new, delta + t * dd, F_new, n_new
+        ok = norm < self.tol * self.h0
+        if ok:
+            self.residual(a, h, delta)
+        return h, delta, ok
+
+    def load(self, a, h):
+        """P = 2 pi (a^2 sum w_j sigma_j + the rigid-continuation tail beyond the mesh)."""
+        sig = np.empty(h.size)
+        lj_traction_and_stiffness(h, self.h0, self.c, sig, np.empty(h.size))
+        x_end = 2.0 * self.x[-1] - self.x[-2]
+        h_end = h[-1] + 0.5 * a * a * (x_end**2 - self.x[-1] ** 2)
+        q = self.h0 / h_end
+        tail = -self.c * self.h0 * (0.5 * q**2 - 0.125 * q**8) if self.tail else 0.0
+        return 2.0 * math.pi * (a * a * float(self.w @ sig) + tail)
+
+
+def pull_off_radius_guess(mu: float) -> float:
+    """Expected pull-off radius: JKR's 1.040 at high mu, the rigid DMT sphere's
+    sqrt(2 (h_m - h0)) (gap h0 at the centre) at low mu; the larger of the two."""
+    h0 = units.h0_hat(mu)
+    return max(A_JKR, math.sqrt(2.0 * (TIP_GAP - 1.0) * h0))
+
+
+def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, a_start=None,
+                     **mesh) -> ElasticPullOff:
+    """Elastic quasi-static pull-off at Tabor parameter mu (see the module docstring).
+
+    Parameters
+    ----------
+    mu : float
+        Tabor parameter in [0.01, 100].
+    **mesh
+        Mesh and domain options of :class:`ElasticBranch` (zone_resolution, zone, coarse,
+        tail_gap, grading, domain, tail).
+    span : (float, float)
+        Scanned radii relative to :func:`pull_off_radius_guess`.
+    scan : int
+        Radii in the scan (geometric, from the largest down).
+    xtol : float
+        Brent tolerance on a (relative to the guess).
+    a_start : float, optional
+        Unload from this contact radius: the branch is scanned from a_start down and the
+        pull-off is the largest tension at radii <= a_start (the start itself if the load
+        only rises from there).
+
+    Returns
+    -------
+    ElasticPullOff
+        ``converged`` is False (with the reason) if a solve failed or the minimum sits at an
+        end of the scanned span.
+    """
+    t0 = time.perf_counter()
+    mu = check_range("mu", mu, lo=0.01, hi=100.0)
+    a_g = pull_off_radius_guess(mu)
+    a_lo, a_hi = span[0] * a_g, span[1] * a_g
+    br = ElasticBranch(mu, a_g, a_lo, **mesh)
+    if a_start is None:
+        radii = np.geomspace(a_hi, a_lo, scan)
+    else:
+        a_start = check_range("a_start", a_start, lo=0.0, lo_open=True)
+        a_lo = min(a_lo, 0.5 * a_start)
+        count = max(scan, int(math.ceil(scan * math.log(a_start / a_lo) / math.log(a_hi / a_lo))))
+        radii = np.geomspace(a_start, a_lo, count)
+    h, delta = br.guess(radii[0])
+    states, loads = [], []
+    for a in radii:
+        h, delta, ok = br.solve(a, h, delta)
+        if not ok:
+            return _failed(br, mu, t0, f"Newton did not converge at a = {a:.4g}")
+        states.append((h, delta))
+        loads.append(br.load(a, h))
+    branch = (radii, np.array(loads), np.array([d for _, d in states]))
+    i = int(np.argmin(loads))
+    if i == len(radii) - 1 or (i == 0 and a_start is None):
+        return _failed(br, mu, t0, f"minimum of P(a) at the end of the scan (a = {radii[i]:.4g})")
+    if i == 0:      # unloading from a_start: the tension only decreases from the start
+        return ElasticPullOff(mu=mu, pull_off=-loads[0], a=float(radii[0]),
+                              delta=float(states[0][1]), nodes=br.nodes, solves=br.solves,
+                              newton_iterations=br.iterations,
+                              seconds=time.perf_counter() - t0, converged=True,
+                              reason="largest tension at the start", branch=branch,
+                              spacing=float(radii[0] * (br.x[br.m + 1] - 1.0)),
+                              domain=float(radii[0] * br.x[-1]))
+    cache = {}
+
+    def neg_pull(a):
+        j = int(np.argmin(np.abs(radii - a)))
+        h_s, d_s = states[j]
+        h_a, d_a, ok = br.solve(a, h_s, d_s)
+        if not ok:
+            raise RuntimeError(f"Newton did not converge at a = {a:.4g}")
+        cache[a] = (h_a, d_a)
+        return br.load(a, h_a)
+
+    try:
+        res = minimize_scalar(neg_pull, bounds=(radii[i + 1], radii[i - 1]), method="bounded",
+                              options={"xatol": xtol * a_g})
+    except RuntimeError as err:
+        return _failed(br, mu, t0, str(err))
+    a_star = float(res.x)
+    P = float(res.fun)
+    h_star, d_star = cache[a_star]
+    eps = 1e-4 * a_star
+    d_pm = []
+    for a in (a_star + eps, a_star - eps):
+        _, d, ok = br.solve(a, h_star, d_star)
+        d_pm.append(d if ok else float("nan"))
+    return ElasticPullOff(mu=mu, pull_off=-P, a=a_star, delta=float(d_star), nodes=br.nodes,
+                          solves=br.solves, newton_iterations=br.iterations,
+                          seconds=time.perf_counter() - t0, converged=True, branch=branch,
+                          ddelta_da=(d_pm[0] - d_pm[1]) / (2.0 * eps),
+                          spacing=float(a_star * (br.x[br.m + 1] - 1.0)),
+                          domain=float(a_star * br.x[-1]))
+
+
+def _failed(br, mu, t0, reason) -> ElasticPullOff:
+    return ElasticPullOff(mu=mu, pull_off=float("nan"), a=float("nan"), delta=float("nan"),
+                          nodes=br.nodes, solves=br.solves, newton_iterations=br.iterations,
+                          seconds=time.perf_counter() - t0, converged=False, reason=reason)
+
+
+#: Tabor parameters of the elastic pull-off table (:func:`pull_off_table`)
+TABLE_MU = (0.01, 0.03, 0.1, 0.3, 1.0, 3.24, 10.0, 30.0, 100.0)
+
+
+def pull_off_table(mus=TABLE_MU, **options) -> list[dict]:
+    """Elastic pull-off against mu with the Maugis-Dugdale guide (lambda = 1.157 mu).
+
+    Rows: mu, pull_off, a, delta, nodes, seconds, converged, md_pull_off (the MD value at
+    the equivalent lambda, :func:`sweep.theory.maugis_dugdale_pull_off`).
+    """
+    from .theory import maugis_dugdale_pull_off, maugis_lambda
+
+    rows = []
+    for mu in mus:
+        r = elastic_pull_off(mu, **options)
+        rows.append({"mu": mu, "pull_off": r.pull_off, "a": r.a, "delta": r.delta,
+                     "nodes": r.nodes, "seconds": r.seconds, "converged": r.converged,
+                     "md_pull_off": maugis_dugdale_pull_off(maugis_lambda(mu))[0]})
+    return rows
+
+
+if __name__ == "__main__":      # python -m sweep.quasistatic: the table of the issue
+    print(f"{'mu':>6} {'pull_off':>9} {'(P-1.5)mu':>9} {'a':>7} {'delta':>8} {'nodes':>5} "
+          f"{'s':>6} {'MD':>7}")
+    for row in pull_off_table():
+        print(f"{row['mu']:6.2f} {row['pull_off']:9.5f} {(row['pull_off'] - 1.5) * row['mu']:9.4f} "
+              f"{row['a']:7.4f} {row['delta']:8.4f} {row['nodes']:5d} {row['seconds']:6.2f} "
+              f"{row['md_pull_off']:7.4f}")
+
+
+def simulate_elastic(scene, numerics=None):
+    """An elastic scene (k = 1) as a :class:`sweep.scene.Result`, by :func:`elastic_pull_off`.
+
+    The quasi-static branch from the initial radius ``scene.a0`` (``delta0`` scenes are
+    refused: give a0); the rate only sets the time axis, ``t = (delta0 - delta) / (rate h0)``,
+    and the crack speed at pull-off, ``v_a = rate h0 / (d delta / d a)``. The trajectory is
+    the scanned branch up to the displacement-controlled fold (smallest delta); ``a_inner``
+    is not computed (NaN). Not handled: a load minimum beyond the fold (not met from mu =
+    0.01 to 100: the fold lies at smaller radii). Counters:
+    ``steps`` = equilibrium solves, ``factorizations`` = Newton iterations (one dense solve
+    each). A numerical failure gives ``status="failed"`` with the reason, never raises.
+    """
+    from .scene import Numerics, Result
+
+    if numerics is None:
+        numerics = Numerics.preset("balanced")
+    t0 = time.perf_counter()
+    res = Result(scene=scene, numerics=numerics)
+    if scene.k != 1.0:
+        res.reason = f"the quasi-static elastic solver needs k = 1 (got k = {scene.k})"
+        return res
+    if scene.a0 is None:
+        res.reason = "the quasi-static elastic solver starts from a0 (give a0, not delta0)"
+        return res
+    po = elastic_pull_off(scene.mu, a_start=scene.a0)
+    res.nodes_used, res.steps = po.nodes, po.solves
+    res.newton_iterations = res.factorizations = po.newton_iterations
+    res.wall_s = time.perf_counter() - t0
+    if not po.converged:
+        res.reason = po.reason
+        return res
+    h0 = units.h0_hat(scene.mu)
+    radii, loads, deltas = po.branch
+    stop = int(np.argmin(deltas)) + 1          # the displacement-controlled fold
+    keep = radii[:stop] >= po.a
+    d0 = float(deltas[0])
+    speed = scene.rate * h0
+    res.status = "ok"
+    res.reason = po.reason
+    res.pull_off, res.a_pulloff, res.delta_pulloff = po.pull_off, po.a, po.delta
+    res.t_pulloff = (d0 - po.delta) / speed
+    res.crack_speed = speed / po.ddelta_da
+    res.vhat = res.crack_speed / units.l0_hat(scene.mu)
+    res.rhat_pb = units.rhat_pb(scene.rate, scene.mu)
+    res.a0_result, res.delta0_result = float(radii[0]), d0
+    res.spacing, res.domain_used = po.spacing, po.domain
+    res.prony_terms, res.prony_error = 0, 0.0
+    a_tr = np.append(radii[:stop][keep], po.a)
+    d_tr = np.append(deltas[:stop][keep], po.delta)
+    res.trajectory = {"t": (d0 - d_tr) / speed, "delta": d_tr,
+                      "P": np.append(loads[:stop][keep], -po.pull_off), "a": a_tr,
+                      "a_inner": np.full(a_tr.size, np.nan)}
+    return res

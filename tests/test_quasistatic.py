@@ -1,0 +1,138 @@
+"""Elastic quasi-static pull-off (sweep.quasistatic) against independent values and limits.
+
+Independent checks (the influence matrix on graded nodes is tested in test_influence.py): the
+pull-off at mu = 3.24 against the independent solver
+(tests/data/independent_solutions.yaml) on its domain; the JKR limit 1.5 at high mu and the
+DMT limit 2 at low mu (DESIGN.md section 2, the issue's targets); monotone in between.
+"""
+import numpy as np
+import pytest
+
+from sweep import quasistatic as qs
+from sweep.errors import InputError
+from tests import reference
+
+
+def test_node_pattern_is_graded_around_the_tip():
+    x, m = qs.node_pattern(tip=1e-4, zone_spacing=1e-3, zone=0.05, coarse=0.02, x_out=4.0,
+                           grading=1.1)
+    assert x[0] == 0.0 and x[m] == 1.0 and x[-1] >= 4.0
+    d = np.diff(x)
+    assert np.all(d > 0)
+    assert d[m - 1] == pytest.approx(1e-4) and d[m] == pytest.approx(1e-4)
+    ratio = d[1:] / d[:-1]
+    assert np.all(ratio[1:] <= 1.1 + 1e-9) and np.all(ratio >= 1.0 / 1.5 - 1e-9)
+    assert d.max() <= 0.02 * 4.0 * (1 + 1e-12)
+    assert np.all(d[np.abs(x[:-1] - 1.0) < 0.05] <= 1e-3 + 1e-15)
+
+
+def test_equilibrium_at_fixed_radius():
+    """A converged state has its max-tension radius at a: gap h_m there, and the
+    interpolated crossing of h_m (the definition of a, DESIGN.md) is the tip node."""
+    br = qs.ElasticBranch(3.24, 1.0, 0.5)
+    a = 1.2
+    h, d = br.guess(a)
+    h, d, ok = br.solve(a, h, d)
+    assert ok
+    assert np.max(np.abs(br.residual(a, h, d))) < 1e-9 * br.h0
+    assert h[br.m] == br.hm
+    assert np.all(h[br.m + 1:] > br.hm)          # outermost crossing
+    assert h[br.m - 1] < br.hm
+
+
+def test_elastic_pull_off_matches_independent_solver():
+    """mu = 3.24 on the independent solver's domain (radius 5, no LJ force beyond it):
+    1.5459 +- 2e-4 (its N = 1000, spacing 0.005 uniform mesh). The mesh scales with a, so
+    its radius is 5 at the pull-off radius of a first run."""
+    ref = reference.independent_solutions()["elastic"][0]
+    a_scale = qs.pull_off_radius_guess(ref["mu"])
+    first = qs.elastic_pull_off(ref["mu"], domain=5.0, tail=False)
+    res = qs.elastic_pull_off(ref["mu"], domain=5.0 * a_scale / first.a, tail=False)
+    assert res.converged, res.reason
+    assert res.pull_off == pytest.approx(ref["pull_off"], abs=ref["tol"])
+
+
+def test_tail_correction_accounts_for_the_truncated_domain():
+    """The closed-form LJ tail makes the pull-off independent of the domain."""
+    p = [qs.elastic_pull_off(1.0, tail_gap=g).pull_off for g in (20.0, 80.0)]
+    assert p[0] == pytest.approx(p[1], abs=2e-5)
+    bare = qs.elastic_pull_off(1.0, tail_gap=20.0, tail=False).pull_off
+    assert abs(bare - p[1]) > 10 * abs(p[0] - p[1])
+
+
+def test_jkr_limit_at_mu_10():
+    res = qs.elastic_pull_off(10.0)
+    assert res.converged, res.reason
+    assert 1.5 < res.pull_off < 1.5 * 1.01
+    assert res.a == pytest.approx(qs.A_JKR, rel=0.01)
+
+
+@pytest.mark.parametrize("mu", [pytest.param(30.0, marks=pytest.mark.slow), 100.0])
+def test_jkr_limit_at_high_mu(mu):
+    res = qs.elastic_pull_off(mu)
+    assert res.converged, res.reason
+    assert 1.5 < res.pull_off < 1.5 * 1.01
+    assert res.a == pytest.approx(qs.A_JKR, rel=0.005)
+
+
+def test_dmt_limit_and_monotone_in_mu():
+    """2 at mu -> 0 (rigid DMT), decreasing towards 1.5 as mu grows."""
+    p = [qs.elastic_pull_off(mu).pull_off for mu in (0.01, 0.1, 0.3, 1.0)]
+    assert p[0] == pytest.approx(2.0, abs=2e-3)
+    assert np.all(np.diff(p) < 0)
+    assert p[-1] > 1.5
+
+
+def test_bad_mu_is_refused():
+    with pytest.raises(InputError, match="mu"):
+        qs.elastic_pull_off(200.0)
+    with pytest.raises(InputError, match="mu"):
+        qs.elastic_pull_off(0.001)
+
+
+@pytest.mark.slow
+def test_pull_off_converged_under_refinement_at_mu_100():
+    """Default mesh (l0/16 over 5 l0, grading 1.05) against l0/32 over 10 l0, grading 1.025:
+    measured 1.50019 and 1.500208."""
+    p = qs.elastic_pull_off(100.0).pull_off
+    fine = qs.elastic_pull_off(100.0, zone_resolution=32.0, zone=10.0, grading=1.025).pull_off
+    assert p == pytest.approx(fine, abs=1e-4)
+
+
+def test_simulate_elastic_result_against_jkr_at_high_mu():
+    """mu = 20 (the Scene limit today), a0 = 2: the JKR start delta = a^2 - sqrt(2a) = 2 and
+    the crack speed at pull-off v_a = rate h0 / (d delta/da), d delta/da = 2a - 1/sqrt(2a)
+    = 1.387 at a = 1.040."""
+    from sweep.scene import Scene
+    from sweep import units
+    from sweep.theory import jkr_indentation
+
+    scene = Scene(n=1.0, k=1.0, mu=20.0, a0=2.0, rate=3.0)
+    res = qs.simulate_elastic(scene)
+    assert res.ok, res.reason
+    po = qs.elastic_pull_off(20.0, a_start=2.0)
+    assert res.pull_off == po.pull_off and res.a_pulloff == po.a
+    assert res.a0_result == 2.0
+    assert res.delta0_result == pytest.approx(float(jkr_indentation(2.0)), abs=0.02)
+    a = res.a_pulloff
+    v_jkr = 3.0 * units.h0_hat(20.0) / (2 * a - (2 * a) ** -0.5)
+    assert res.crack_speed == pytest.approx(v_jkr, rel=0.02)
+    tr = res.trajectory
+    assert np.all(np.diff(tr["t"]) > 0) and tr["P"][-1] == -res.pull_off
+    assert res.t_pulloff == pytest.approx(tr["t"][-1])
+
+
+def test_simulate_elastic_refuses_viscoelastic_and_delta0_scenes():
+    from sweep.scene import Scene
+
+    res = qs.simulate_elastic(Scene(n=1.0, k=0.5, mu=3.24, a0=2.0, rate=1.0))
+    assert not res.ok and "k = 1" in res.reason
+    res = qs.simulate_elastic(Scene(n=1.0, k=1.0, mu=3.24, delta0=2.0, rate=1.0))
+    assert not res.ok and "a0" in res.reason
+
+
+def test_start_inside_the_pull_off_radius_gives_the_starting_tension():
+    """Unloading from a0 below the load-controlled pull-off radius: the tension only falls."""
+    po = qs.elastic_pull_off(10.0, a_start=0.8)
+    assert po.converged and po.a == 0.8
+    assert po.pull_off < qs.elastic_pull_off(10.0).pull_off
