@@ -11,6 +11,9 @@ crack    the crack-front model (:func:`sweep.crack_front.simulate_crack`): JKR c
 pb       the paper's closed-form estimate (:func:`pb_estimate`): the crack speed at pull-off
          from the paper's fit vhat = 2.887 rhat_PB^1.171, Gamma_PB at that speed, and the
          load-control JKR pull-off with it, P = 1.5 Gamma_PB
+elastic  the quasi-static elastic branch (:func:`sweep.quasistatic.simulate_elastic`), no
+         hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100; "bem" and
+         "auto" scenes that are elastic and quasi-static run it (:func:`wants_quasistatic`)
 auto     the cheapest model the scene allows (:func:`choose_model`): the BEM where the mesh that
          resolves l0 fits the numerics' node count, the crack-front model otherwise
 =======  ======================================================================================
@@ -28,7 +31,7 @@ from .errors import check_choice, check_positive
 from .theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 
 __all__ = ["MODELS", "pb_estimate", "simulate_pb", "simulate_model", "simulate_scene",
-           "choose_model", "bem_nodes_needed", "bem_node_budget"]
+           "choose_model", "bem_nodes_needed", "bem_node_budget", "wants_quasistatic"]
 
 
 def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171) -> dict:
@@ -97,6 +100,12 @@ def _bem(scene, numerics=None):
     return simulate(scene, numerics)
 
 
+def _elastic(scene, numerics=None):
+    from .quasistatic import simulate_elastic
+
+    return simulate_elastic(scene, numerics)
+
+
 def _crack(scene, numerics=None):
     from .crack_front import simulate_crack
 
@@ -147,14 +156,28 @@ def choose_model(scene, numerics=None) -> str:
 
 
 #: model name -> simulate(scene, numerics=None) -> Result
-MODELS = {"bem": _bem, "crack": _crack, "pb": simulate_pb}
+MODELS = {"bem": _bem, "crack": _crack, "pb": simulate_pb, "elastic": _elastic}
+
+
+def wants_quasistatic(scene, numerics) -> bool:
+    """Whether a "bem" or "auto" scene is elastic and quasi-static, so that the equilibrium
+    branch (:mod:`sweep.quasistatic`) answers it without the hereditary machinery: k = 1,
+    started from a0, stopped at the pull-off, on the engine's own mesh (an explicit
+    ``numerics.domain`` or ``exact`` asks for the hereditary BEM on that domain)."""
+    return (scene.k == 1.0 and scene.a0 is not None and scene.stop == "pulloff"
+            and numerics.domain is None and not numerics.exact)
 
 
 def simulate_model(scene, model: str = "bem", numerics=None):
     """Run ``scene`` with the named model (one of :data:`MODELS` or "auto"); the result's
     ``model_used`` says which ran."""
+    from .scene import Numerics
+
     check_choice("model", model, (*MODELS, "auto"))
-    if model == "auto":
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if model in ("bem", "auto") and wants_quasistatic(scene, numerics):
+        model = "elastic"
+    elif model == "auto":
         model = choose_model(scene, numerics)
     res = MODELS[model](scene, numerics)
     res.model_used = model

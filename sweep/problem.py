@@ -30,6 +30,11 @@ TIP_MARGIN_ZONES = 2.0
 TIP_GAP = 3.0 ** (1.0 / 6.0)
 
 
+#: Tabor parameters the hereditary BEM is validated for (its mesh sizing and folds); the
+#: quasi-static elastic solver (:mod:`sweep.quasistatic`) covers 0.01-100
+BEM_MU_RANGE = (0.5, 20.0)
+
+
 class Refused(Exception):
     """The numerics cannot represent the scene (the message says what to change)."""
 
@@ -145,6 +150,11 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
     ``band`` overrides the crack band of a graded mesh (a_ref radii, see
     :func:`sweep.mesh.crack_band`).
     """
+    lo, hi = BEM_MU_RANGE
+    if not lo <= scene.mu <= hi:
+        raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
+                      f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
+                      f"elastic or auto, large contacts the crack-front model (model crack)")
     h0, c = lj_constants(scene.mu)
     l0 = units.l0_hat(scene.mu)
     if scene.delta0 is not None:

@@ -4,7 +4,7 @@ An elastic scene (``k = 1``) unloaded quasi-statically has no history: its state
 equilibria of the Lennard-Jones interface on the elastic half-space, and its pull-off is the
 largest tension along that branch. This module models only that (no time steps, no Prony
 series): the branch is parametrized by the contact radius ``a`` (the max-tension radius,
-where the gap is ``h_m = 3^(1/6) h0``, DESIGN.md section 2) instead of the indentation, so
+where the gap is ``h_m = 3^(1/6) h0``, docs/design.md section 2) instead of the indentation, so
 the folds of the displacement-controlled path are no obstacle, and
 
     pull_off = - min_a P(a)
@@ -12,7 +12,7 @@ the folds of the displacement-controlled path are no obstacle, and
 is found by a scan of ``a`` (each solve warm-started from its neighbour) and a bounded Brent
 refinement around the scan's minimum.
 
-Units and conventions of DESIGN.md section 2 (a, r in a_ref; gaps and delta in d_ref; P in
+Units and conventions of docs/design.md section 2 (a, r in a_ref; gaps and delta in d_ref; P in
 pi dg R; traction positive when compressive).
 
 Equilibrium at fixed ``a``. Nodes ``r_i = a x_i`` on a fixed graded pattern ``x`` with a
@@ -57,7 +57,7 @@ from .theory import jkr_indentation
 
 #: gap at the crack tip (max LJ tension) per h0
 TIP_GAP = 3.0 ** (1.0 / 6.0)
-#: Persson-Brener process zone l0 * mu^2 in a_ref (DESIGN.md section 2)
+#: Persson-Brener process zone l0 * mu^2 in a_ref (docs/design.md section 2)
 PROCESS_ZONE = 243.0 / (256.0 * math.pi * (math.pi / 9.0) ** 2) / math.pi ** (1.0 / 3.0)
 #: contact radius at the JKR (force-controlled) pull-off, a_ref
 A_JKR = (3.0 * math.sqrt(2.0) / 4.0) ** (2.0 / 3.0)
@@ -97,7 +97,7 @@ def node_pattern(tip: float, zone_spacing: float, zone: float, coarse: float, x_
 
 @dataclass
 class ElasticPullOff:
-    """Elastic quasi-static pull-off of one scene (units of DESIGN.md section 2)."""
+    """Elastic quasi-static pull-off of one scene (units of docs/design.md section 2)."""
 
     mu: float
     pull_off: float          # -min P, pi dg R

@@ -29,7 +29,7 @@ MATERIALS = ("mpl", "sls")
 MESHES = ("uniform", "graded")
 STOPS = ("pulloff", "separation")
 #: Models a scene can ask for (sweep.models maps each to its simulate function).
-MODEL_NAMES = ("bem", "crack", "pb", "auto")
+MODEL_NAMES = ("bem", "crack", "pb", "elastic", "auto")
 
 
 def axis(default=dataclasses.MISSING, *, help: str, unit: str = "", limits=None,
@@ -101,7 +101,9 @@ class Scene:
                     lo_open=True, label="$n$", order=2, cli_default=0.8)
     k: float = axis(0.1, help="E0/Einf, relaxed over glassy modulus; 1 is elastic",
                     limits=(0.0, 1.0), lo_open=True, label="$k$", order=3)
-    mu: float = axis(3.24, help="Tabor parameter", limits=(0.5, 20.0), label=r"$\mu$", order=4)
+    mu: float = axis(3.24, help="Tabor parameter (the hereditary BEM takes 0.5-20; elastic "
+                     "scenes, k = 1, the whole range)", limits=(0.01, 100.0), label=r"$\mu$",
+                     order=4)
     rate: float = axis(help="unloading rate r-hat = r tau0 / h0", limits=(0.0, 1e12),
                        lo_open=True, label=r"unloading rate $\hat r = r\tau_0/h_0$", order=7,
                        plot_group=False)
@@ -116,7 +118,8 @@ class Scene:
     stop: str = axis("pulloff", help="stop after the pull-off, or follow the curve to "
                      "separation", choices=STOPS, order=1, plot_group=False)
     model: str = axis("bem", help="model that runs the scene (sweep.models): the BEM, the "
-                      "crack-front model, the closed-form PB estimate, or auto",
+                      "crack-front model, the closed-form PB estimate, the quasi-static "
+                      "elastic branch, or auto",
                       choices=MODEL_NAMES, order=-1)
 
     def __post_init__(self):

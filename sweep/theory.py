@@ -519,7 +519,7 @@ def paper_v_vs_r_fit(rhat_pb, prefactor: float = 2.887, exponent: float = 1.171)
 
 
 # --------------------------------------------------------------------------------------------
-# Maugis-Dugdale (a guide across the Tabor range; units of DESIGN.md section 2 on output)
+# Maugis-Dugdale (a guide across the Tabor range; units of docs/design.md section 2 on output)
 # --------------------------------------------------------------------------------------------
 #: lambda / mu when the Dugdale stress equals the largest Lennard-Jones tension (see below)
 MAUGIS_LAMBDA_PER_MU = (32.0 / (9.0 * math.sqrt(3.0))) * (9.0 / (16.0 * math.pi)) ** (1.0 / 3.0)

@@ -80,7 +80,7 @@ def test_run_si_crack_and_pb_in_both_unit_systems():
 
 
 def test_registry_maps_names_to_models():
-    assert set(MODELS) == {"bem", "crack", "pb"}
+    assert set(MODELS) == {"bem", "crack", "pb", "elastic"}
     sc = Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=100.0)
     r = simulate_model(sc, "pb")
     assert r.ok and r.pull_off == pytest.approx(pb_estimate(0.8, 0.1, 3.24, 100.0)["pull_off"])
@@ -126,7 +126,7 @@ def test_scene_model_field_and_auto_choice():
     from sweep.scene import Numerics
 
     assert Scene(n=0.8, a0=3.0, rate=1.0).model == "bem"
-    with pytest.raises(InputError, match="model must be one of bem, crack, pb, auto"):
+    with pytest.raises(InputError, match="model must be one of bem, crack, pb, elastic, auto"):
         Scene(n=0.8, a0=3.0, rate=1.0, model="fem")
     small = Scene(n=0.8, k=0.1, mu=3.24, a0=3.0, rate=1.0, model="auto")
     big = Scene(n=0.8, k=0.1, mu=20.0, a0=8.0, rate=1.0, model="auto")
