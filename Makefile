@@ -9,12 +9,13 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow bench bench-convergence clean
+.PHONY: help venv demo test test-slow bench bench-detail bench-reference tradeoff bench-convergence clean
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
 	@echo "make test   - create/update .venv and run the test suite"
-	@echo "make bench  - speed benchmarks (JSON in results/bench/)"
+	@echo "make bench  - speed benchmarks of issue 9 (results/bench.json, ~10 min)"
+	@echo "make tradeoff [QUICK=1] - accuracy vs time over a grid of numerics (results/tradeoff/)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -40,6 +41,16 @@ test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow tests
 
 bench: $(STAMP)
+	$(BIN)/python -m sweep.benchmarks all --out results/bench.json
+
+tradeoff: $(STAMP)
+	$(BIN)/python -m sweep.benchmarks tradeoff $(if $(filter 1,$(QUICK)),--quick) --out results/tradeoff
+
+# converged references of the tradeoff and vs-numpy scenes (configs/references.json; slow)
+bench-reference: $(STAMP)
+	$(BIN)/python -m sweep.benchmarks reference
+
+bench-detail: $(STAMP)
 	$(BIN)/python -m sweep.benchmarks scene --out results/bench/scene.json
 	$(BIN)/python -m sweep.benchmarks presets --out results/bench/presets.json
 	$(BIN)/python -m sweep.benchmarks scheduler --out results/bench/scheduler.json
