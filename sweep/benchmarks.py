@@ -391,8 +391,7 @@ class BenchPlan:
                                                               tol=1e-9, prony_rtol=1e-4))
     compile: bool = True
     campaign: str = "configs/threshold.yaml"
-    campaign_subset: dict = field(default_factory=lambda: dict(
-        a0=[1.5, 4.5, 8.0], rate=[1.0, 1e3, 1e6]))
+    campaign_stride: int = 20
     jobs: int = 2
     vs_numpy_scenes: dict = field(default_factory=lambda: dict(VS_NUMPY_SCENES))
     engine_numerics: dict = field(default_factory=lambda: {
@@ -413,7 +412,7 @@ class BenchPlan:
                    prony_numerics=dict(nodes=60, domain=2.5, da_max=1e6, tol=1e-8,
                                        prony_rtol=1e-2),
                    compile=False, campaign="configs/smoke.yaml",
-                   campaign_subset=dict(n=[0.4], rate=[100.0]), jobs=1,
+                   campaign_stride=4, jobs=1,
                    vs_numpy_scenes={"tiny": small},
                    engine_numerics={"fast": dict(nodes=60, domain=2.5, step=0.5,
                                                  prony_rtol=1e-2)},
@@ -495,41 +494,54 @@ def bench_prony_speedup(plan: BenchPlan) -> dict:
     return out
 
 
+def campaign_subset(config, stride: int):
+    """Every ``stride``-th scene of a sweep config (its task order), as a config whose grid
+    lists them one by one: a sample with the campaign's own mix of n, a0 and rate."""
+    from .config import AXES, config_from_dict
+
+    data = config.to_dict()
+    picked = [scene.to_dict() for _, scene in config.tasks()[::max(int(stride), 1)]]
+    grid = [{k: v for k, v in d.items() if k in AXES and v is not None} for d in picked]
+    return config_from_dict({**data, "grid": grid, "name": f"{config.name}_every{stride}"})
+
+
 def bench_campaign(plan: BenchPlan) -> dict:
-    """Scenes per minute of the campaign's numerics on a subset of its grid, at -j1 and
-    -j{jobs} (warm workers: a first sweep starts and warms them, untimed)."""
+    """Scenes per minute of the campaign's numerics on a sample of its grid (every
+    ``campaign_stride``-th scene), at -j1 and -j{jobs} with warm workers (a first, untimed
+    sweep of the sample's first scenes starts them and loads their caches)."""
     from .config import config_from_dict, load_config
     from .scheduler import run_sweep
     from .solver import warm_up
+    from .store import load
 
     cfg = load_config(ROOT / plan.campaign)
-    data = cfg.to_dict()
-    grids = data["grid"] if isinstance(data["grid"], list) else [data["grid"]]
-    sub = {**grids[0], **plan.campaign_subset}
-    sub_cfg = config_from_dict({**data, "grid": sub, "name": f"{cfg.name}_subset"})
-    n = len(sub_cfg.tasks())
+    sub_cfg = campaign_subset(cfg, plan.campaign_stride)
+    tasks = sub_cfg.tasks()
+    n = len(tasks)
     warm_up()
     tmp = Path(tempfile.mkdtemp(prefix="bench-campaign-"))
     walls = {}
     t = time.perf_counter()
     rep = run_sweep(sub_cfg, jobs=1, out=tmp / "j1.h5", progress="none", resume=False)
     walls["j1"] = time.perf_counter() - t
-    if plan.jobs > 1:      # start the workers and load their caches (untimed)
-        a0 = sub.get("a0")
-        warm = {**sub, "a0": min(a0) if isinstance(a0, list) else a0}
-        run_sweep(config_from_dict({**data, "grid": warm, "name": "warm"}), jobs=plan.jobs,
-                  out=tmp / "warm.h5", progress="none", resume=False)
+    if plan.jobs > 1:
+        data = sub_cfg.to_dict()
+        warm = config_from_dict({**data, "grid": data["grid"][:2 * plan.jobs], "name": "warm"})
+        run_sweep(warm, jobs=plan.jobs, out=tmp / "warm.h5", progress="none", resume=False)
     t = time.perf_counter()
     repj = run_sweep(sub_cfg, jobs=plan.jobs, out=tmp / "jN.h5", progress="none", resume=False)
     walls[f"j{plan.jobs}"] = time.perf_counter() - t
-    from .store import load
-    statuses = load(tmp / "jN.h5").status.value_counts().to_dict()
-    return {"config": plan.campaign, "subset": plan.campaign_subset, "scenes": n,
+    df = load(tmp / "jN.h5")
+    statuses = df.status.value_counts().to_dict()
+    return {"config": plan.campaign, "stride": plan.campaign_stride, "scenes": n,
+            "campaign_scenes": len(cfg.tasks()),
             "numerics": sub_cfg.numerics.to_dict(), "ran": [rep.ran, repj.ran],
             "status_counts": {str(k): int(v) for k, v in statuses.items()},
+            "scene_wall_s": {"mean": float(df.wall_s.mean()), "max": float(df.wall_s.max())},
             "wall_s": walls, "jobs": plan.jobs,
             "scenes_per_minute_j1": 60.0 * n / walls["j1"],
             f"scenes_per_minute_j{plan.jobs}": 60.0 * n / walls[f"j{plan.jobs}"],
+            "campaign_minutes_estimate": len(cfg.tasks()) * walls[f"j{plan.jobs}"] / n / 60.0,
             "parallel_speedup": walls["j1"] / walls[f"j{plan.jobs}"],
             "loadavg": os.getloadavg()}
 
@@ -651,8 +663,9 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
                          "same fixed steps (radius control off), key = number of steps",
         "compile_s": "warm_up() seconds in a fresh interpreter: cold = empty NUMBA_CACHE_DIR, "
                      "cached = the same directory afterwards",
-        "scenes_per_minute": "the campaign's default numerics on a subset of its grid, "
-                             "run_sweep with jobs workers (warm), scenes / wall minute",
+        "scenes_per_minute": "the campaign's default numerics on every campaign_stride-th "
+                             "scene of its grid, run_sweep with jobs workers (warm), scenes "
+                             "per wall minute",
         "parallel_speedup": "run_sweep wall at -j1 / at -j{jobs} (warm workers), same subset",
         "vs_numpy": "per scene and engine configuration: engine wall (best of repeat, caches "
                     "warm) and relative pull-off error vs the scene's converged reference; "
