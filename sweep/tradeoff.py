@@ -57,6 +57,11 @@ PRONY_RTOLS = {"prony_rtol": [1e-2, 1e-3, 1e-6],
                "at": [dict(nodes=300, step=0.25), dict(nodes=500, step=0.1)]}
 ONE_AT_A_TIME = {"tail_gap": [20.0, 200.0], "da_max": [0.25, 1.0, 2.0],
                  "tol": [1e-6, 1e-7, 1e-9]}
+#: with a graded mesh (``Numerics.mesh``): its resolution of the crack band crossed with the
+#: step, and its grading and error check one at a time (the uniform factorial above is then
+#: run with ``mesh="uniform"``)
+GRADED = {"band_resolution": [6.0, 9.0, 16.0, 24.0, 36.0], "step": [0.5, 0.2, 0.1, 0.05]}
+GRADED_ONE_AT_A_TIME = {"grading": [1.05, 1.2, 1.3], "pull_off_rtol": [0.0]}
 #: exact hereditary integral instead of the Prony recursion (O(steps^2 N): coarse steps only)
 EXACT_POINTS = [dict(nodes=300, step=0.25, exact=True), dict(nodes=500, step=0.1, exact=True)]
 QUICK_GRID = [dict(nodes=200, step=0.5, prony_rtol=1e-2), dict(nodes=300, step=0.25),
@@ -81,10 +86,14 @@ def grid(quick: bool = False, base: str = "balanced") -> list[dict]:
     if quick:
         points += [(None, p) for p in QUICK_GRID]
     else:
-        axes = {k: v for k, v in FACTORIAL.items() if k in have}
-        for combo in np.array(np.meshgrid(*axes.values(), indexing="ij")).reshape(len(axes), -1).T:
-            points.append((None, {k: (int(v) if k == "nodes" else float(v))
-                                  for k, v in zip(axes, combo)}))
+        graded = "mesh" in have
+        points += [(None, {**({"mesh": "uniform"} if graded else {}), **p})
+                   for p in _crossed(FACTORIAL, have)]
+        if graded:
+            points += [(None, {"mesh": "graded", **p}) for p in _crossed(GRADED, have)]
+            for k, values in GRADED_ONE_AT_A_TIME.items():
+                if k in have:
+                    points += [(None, {k: v}) for v in values]
         if "prony_rtol" in have:
             points += [(None, {**at, "prony_rtol": v}) for at in PRONY_RTOLS["at"]
                        for v in PRONY_RTOLS["prony_rtol"]]
@@ -101,6 +110,15 @@ def grid(quick: bool = False, base: str = "balanced") -> list[dict]:
         seen.add(key)
         out.append({"label": label or describe(ov), "overrides": ov})
     return out
+
+
+def _crossed(axes: dict, have: set) -> list[dict]:
+    """All combinations of the axes the engine has (nodes as int, the rest as given)."""
+    axes = {k: v for k, v in axes.items() if k in have}
+    combos = [{}]
+    for k, values in axes.items():
+        combos = [{**c, k: v} for c in combos for v in values]
+    return combos
 
 
 def to_numerics(overrides: dict, base: str = "balanced") -> Numerics:
