@@ -31,7 +31,7 @@ from kernels.influence import assemble_unit, load_weights
 from . import units
 from .materials import SLS, MPLRetardation
 from .scene import Scene
-from .solver import _past_pull_off, crack_speed_at, jkr_gap_guess, refine_minimum
+from .solver import crack_speed_at, jkr_gap_guess, refine_minimum
 
 #: Newton tolerance on the gap, in units of h0 (max norm of the residual)
 TOL = 1e-8
@@ -41,6 +41,9 @@ MAX_ITER = 60
 CHORD_CONTRACTION = 0.5
 #: step-length halvings of the line search
 LINE_SEARCH_HALVINGS = 30
+#: stop once the load has recovered from its tensile minimum by this fraction of |P_min| and
+#: by RECOVERY_FLOOR (pi dg R), at least RECOVERY_STEPS steps after it
+RECOVERY, RECOVERY_FLOOR, RECOVERY_STEPS = 0.05, 0.05, 5
 #: a failed step is halved at most this many times
 MAX_HALVINGS = 6
 
@@ -231,6 +234,9 @@ def plain_unload(scene: Scene, nodes: int, domain: float, step: float,
         a.append(_crossing(h, dr, hm))
         if a[-1] >= (N - 1) * dr:
             return done("failed", "contact reached the mesh edge")
-        if _past_pull_off(np.asarray(P)) or (a[-1] == 0.0 and P[-1] > min(P)):
+        i = int(np.argmin(P))
+        recovered = (P[i] < 0 and len(P) - 1 - i >= RECOVERY_STEPS
+                     and P[-1] - P[i] > max(RECOVERY * abs(P[i]), RECOVERY_FLOOR))
+        if recovered or (a[-1] == 0.0 and P[-1] > P[i]):
             return done("ok", "", np.asarray(T), np.asarray(P), np.asarray(a))
     return done("failed", f"step limit ({max_steps})")
