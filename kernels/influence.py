@@ -7,9 +7,10 @@ the deflection at node i due to nodal tractions p_j is ``u_i = sum_j A_ij p_j`` 
     G(r, s) = 4/(pi r) K(s/r)  (s < r),   4/(pi s) K(r/s)  (s > r),   G(0, s) = 2/s,
 
 where K is the complete elliptic integral of the first kind of *modulus* k, and phi_j
-is the hat function of node j on the uniform mesh r_j = j * dr (phi_0 is the half-hat on
-[0, dr]; the last node has a full hat, i.e. its traction falls to zero one spacing beyond
-the mesh). A scales linearly with dr, so the kernel assembles it for dr = 1.
+is the hat function of node j (phi_0 is the half-hat on [0, r_1]; the last node has a full
+hat, i.e. its traction falls to zero one element beyond the mesh). On the uniform mesh
+r_j = j * dr, A scales linearly with dr, so :func:`assemble_unit` assembles it for dr = 1;
+:func:`assemble_nodes` takes arbitrary (graded) node positions.
 
 The logarithmic singularity of K at s = r always sits at an end of a piece of a hat
 (the r_i are nodes), so it is integrated exactly enough by Gauss-Legendre after the
@@ -103,15 +104,25 @@ def _piece(r, sa, sb, phi_a, phi_b, singular_at, xs_smooth, ws_smooth, xs_sing, 
 
 
 @njit(cache=True)
-def influence_matrix_unit(N, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws_far):
-    """Influence matrix A (N x N) for unit node spacing; multiply by dr for spacing dr."""
+def influence_matrix_nodes(r, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws_far):
+    """Influence matrix A (N x N) for the hats of arbitrary nodes 0 = r_0 < r_1 < ... .
+
+    The hat of node j spans [r_{j-1}, r_{j+1}]; node 0 has the half hat on [0, r_1] and
+    the last node a full hat whose outer piece is as long as the last element (the
+    convention of the uniform mesh, :func:`assemble_unit`).
+    Quadrature as in the uniform case; the far-piece rule applies from three piece lengths
+    on, which stays exact to rounding for neighbouring elements of similar length (graded
+    meshes with ratios up to about 1.3).
+    """
+    N = r.size
+    ext = np.empty(N + 1)
+    ext[:N] = r
+    ext[N] = 2.0 * r[N - 1] - r[N - 2]
     A = np.zeros((N, N))
     for i in range(N):
-        r = float(i)
+        ri = ext[i]
         for j in range(N):
-            rj = float(j)
             val = 0.0
-            # left piece [r_{j-1}, r_j]: phi rises 0 -> 1
             if j > 0:
                 sing = 0
                 if i == j:
@@ -120,9 +131,8 @@ def influence_matrix_unit(N, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws_
                     sing = -1
                 if i == 0:
                     sing = 0
-                val += _piece(r, rj - 1.0, rj, 0.0, 1.0, sing, xs_smooth, ws_smooth, xs_sing, ws_sing,
-                          xs_far, ws_far)
-            # right piece [r_j, r_{j+1}]: phi falls 1 -> 0
+                val += _piece(ri, ext[j - 1], ext[j], 0.0, 1.0, sing, xs_smooth, ws_smooth,
+                              xs_sing, ws_sing, xs_far, ws_far)
             sing = 0
             if i == j:
                 sing = -1
@@ -130,15 +140,51 @@ def influence_matrix_unit(N, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws_
                 sing = 1
             if i == 0:
                 sing = 0
-            val += _piece(r, rj, rj + 1.0, 1.0, 0.0, sing, xs_smooth, ws_smooth, xs_sing, ws_sing,
-                          xs_far, ws_far)
+            val += _piece(ri, ext[j], ext[j + 1], 1.0, 0.0, sing, xs_smooth, ws_smooth,
+                          xs_sing, ws_sing, xs_far, ws_far)
             A[i, j] = val
     return A
 
 
+def assemble_nodes(r: np.ndarray) -> np.ndarray:
+    """Assemble the influence matrix of the nodes ``r`` with the module's quadrature rules."""
+    r = np.ascontiguousarray(r, dtype=float)
+    return influence_matrix_nodes(r, GL16_X, GL16_W, GL32_X, GL32_W, GL8_X, GL8_W)
+
+
+@njit(cache=True)
+def combine_lattice_hats(A_rows, idx):
+    """Influence matrix of nodes on the integer lattice from the unit-spacing matrix.
+
+    ``idx`` (N,) are increasing lattice indices with idx[0] = 0; ``A_rows`` (N, M) the rows
+    idx of the unit-spacing matrix, M > idx[-1] + (idx[-1] - idx[-2]) - 1 columns. The hat
+    of node j (vertices idx[j-1], idx[j], idx[j+1]; the last one's outer piece as long as
+    its inner) is piecewise linear with kinks on lattice points, hence exactly the sum of
+    the unit hats times its values there: column j = sum_k phi_j(k) A_rows[:, k].
+    Multiply by the lattice spacing.
+    """
+    N = idx.size
+    A = np.zeros((N, N))
+    for j in range(N):
+        c = idx[j]
+        R = idx[j + 1] if j + 1 < N else 2 * idx[N - 1] - idx[N - 2]
+        if j > 0:
+            L = idx[j - 1]
+            for k in range(L + 1, c):
+                wk = (k - L) / (c - L)
+                for i in range(N):
+                    A[i, j] += wk * A_rows[i, k]
+        for k in range(c, R):
+            wk = (R - k) / (R - c)
+            for i in range(N):
+                A[i, j] += wk * A_rows[i, k]
+    return A
+
+
 def assemble_unit(N: int) -> np.ndarray:
-    """Assemble the unit-spacing influence matrix with the module's quadrature rules."""
-    return influence_matrix_unit(int(N), GL16_X, GL16_W, GL32_X, GL32_W, GL8_X, GL8_W)
+    """Assemble the unit-spacing influence matrix (r_j = j) with the module's quadrature
+    rules; multiply by dr for spacing dr."""
+    return assemble_nodes(np.arange(int(N), dtype=float))
 
 
 @njit(cache=True)
@@ -148,4 +194,24 @@ def load_weights(N, dr):
     w[0] = dr * dr / 6.0
     for j in range(1, N):
         w[j] = j * dr * dr
+    return w
+
+
+@njit(cache=True)
+def load_weights_nodes(r):
+    """Load weights w_j = int phi_j(s) s ds of the hats of arbitrary nodes ``r``.
+
+    Exact for piecewise-linear traction; the last node has a full hat (outer piece as
+    long as the last element), as in :func:`load_weights`.
+    """
+    N = r.size
+    w = np.zeros(N)
+    for j in range(N):
+        if j > 0:               # rising piece [r_{j-1}, r_j]: int x (a + L x) L dx
+            a = r[j - 1]
+            b = r[j]
+            w[j] += (b - a) * (a + 2.0 * b) / 6.0
+        a = r[j]                # falling piece [r_j, r_{j+1}]
+        b = r[j + 1] if j + 1 < N else 2.0 * r[N - 1] - r[N - 2]
+        w[j] += (b - a) * (2.0 * a + b) / 6.0
     return w

@@ -30,17 +30,18 @@ def lj_traction_and_stiffness(h, h0, c, sig, dsig):
 
 
 @njit(cache=True)
-def crossing_radius(h, dr, level):
+def crossing_radius(h, r, level):
     """Outermost radius where the gap equals ``level`` (linear interpolation between nodes).
 
-    Returns 0 when the gap exceeds ``level`` everywhere and the mesh radius when the gap
-    is below ``level`` at the last node (contact reaching the mesh edge).
+    ``r`` holds the node positions (any mesh). Returns 0 when the gap exceeds ``level``
+    everywhere and the mesh radius when the gap is below ``level`` at the last node
+    (contact reaching the mesh edge).
     """
     N = h.size
     if h[N - 1] < level:
-        return (N - 1) * dr
+        return r[N - 1]
     for i in range(N - 2, -1, -1):
         if h[i] < level:
             frac = (level - h[i]) / (h[i + 1] - h[i])
-            return (i + frac) * dr
+            return r[i] + frac * (r[i + 1] - r[i])
     return 0.0

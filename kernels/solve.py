@@ -21,7 +21,8 @@ node); the loop then looks for the snapped state (:func:`snap`, :func:`relax`).
 
 Status codes returned by :func:`unload`:
 0 finished (stop criterion met), 1 no equilibrium at the minimum step, 2 step limit,
-3 contact reached the mesh edge (domain too small).
+3 contact reached the mesh edge (domain too small), 4 the crack tip left the fine band of a
+graded mesh (the driver widens it and starts again).
 """
 from __future__ import annotations
 
@@ -35,6 +36,7 @@ STATUS_DONE = 0
 STATUS_NEWTON_FAILED = 1
 STATUS_STEP_LIMIT = 2
 STATUS_DOMAIN = 3
+STATUS_LEFT_BAND = 4
 
 # stats vector layout
 STAT_ITER = 0
@@ -54,8 +56,36 @@ MAX_MERGES = 8
 
 #: the pull-off is past once the load has recovered by this fraction of |P_min| ...
 RECOVERY = 0.05
-#: ... and by at least this much (units of pi dg R; the elastic pull-off is about 1.5)
+#: ... and by at least this much (units of pi dg R; the elastic pull-off is about 1.5),
 RECOVERY_FLOOR = 0.05
+#: ... at least this many steps after the minimum ...
+RECOVERY_STEPS = 5
+#: ... and the crack tip has receded from its radius at the minimum by at least
+#: ``min_travel`` (the caller gives a few node spacings: a lattice dip of the load, the
+#: tip snapping by one node, cannot end the run)
+#: following to separation ends when the contact is lost and |P| < this fraction of |P_min|
+SEPARATION_LOAD = 1e-3
+
+
+@njit(cache=True)
+def stop_reached(P, a, n, i_min, stop_mode, min_travel):
+    """The one stop rule, on the records P[:n], a[:n] with the load minimum at ``i_min``.
+
+    stop_mode 0 (pull-off): past a tensile minimum by RECOVERY_STEPS steps, the load
+    recovered by max(RECOVERY |P_min|, RECOVERY_FLOOR) and the tip receded by
+    ``min_travel`` (a_ref); or the contact is lost after the minimum.
+    stop_mode 1 (separation): contact lost and the load back to SEPARATION_LOAD |P_min|.
+    """
+    P_min = P[i_min]
+    P_now = P[n - 1]
+    a_now = a[n - 1]
+    if stop_mode == 0:
+        if (P_min < 0.0 and n - 1 - i_min >= RECOVERY_STEPS
+                and P_now - P_min > max(RECOVERY * abs(P_min), RECOVERY_FLOOR)
+                and a[i_min] - a_now >= min_travel):
+            return True
+        return a_now == 0.0 and n - 1 - i_min >= 1
+    return a_now == 0.0 and P_now > P_min and abs(P_now) < SEPARATION_LOAD * abs(P_min)
 
 #: a failed step is halved down to this fraction of the largest step before it is taken
 #: for a fold of the discrete path (and the snapped state is looked for)
@@ -84,6 +114,11 @@ def new_jacobian_cache(N, kmax=WOODBURY_MAX, eta=WOODBURY_ETA):
     kmax = min(int(kmax), N)
     return (np.empty((N, N)), np.zeros(N), np.empty((N, kmax)), np.full(N, -1, np.int64),
             np.full(kmax, -1, np.int64), np.zeros(3, np.int64), np.array([0.0, eta]))
+
+
+def invalidate(cache):
+    """Mark the factorization in ``cache`` stale: the next solve refactorizes."""
+    cache[5][0] = 0
 
 
 @njit(cache=True)
@@ -368,7 +403,7 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
 
 
 @njit(cache=True)
-def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, dr, hm, Jinv, d_base, W, slot_of, node_of,
+def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, Jinv, d_base, W, slot_of, node_of,
          state, c_base, stats):
     """Newton from the gap profile outside the crack tip shifted inward by 1 to 6 nodes.
 
@@ -377,8 +412,8 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, dr, hm, Jinv, d_base, W, sl
     Accepts only a solution whose contact radius moved inward. Solution in ``hp``.
     """
     N = h.size
-    a_old = crossing_radius(h, dr, hm)
-    i_tip = int(a_old / dr)
+    a_old = crossing_radius(h, r, hm)
+    i_tip = max(int(np.searchsorted(r, a_old)) - 1, 0)
     for shift in range(1, 7):
         i0 = max(i_tip - 20, 1)
         for i in range(N):
@@ -390,7 +425,7 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, dr, hm, Jinv, d_base, W, sl
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
         if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, node_of,
                   state, c_base, stats):
-            if crossing_radius(hp, dr, hm) < a_old:
+            if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
 
@@ -402,15 +437,16 @@ def load(sigma, wP):
 
 
 @njit(cache=True)
-def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
-           step_max, step_min, da_max, tol, max_iter, max_steps, stop_mode,
-           Jinv, d_base, W, slot_of, node_of, state, c_base,
+def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times,
+           step_max, step_min, da_max, tol, max_iter, max_steps, stop_mode, min_travel,
+           tip_lo, tip_hi, Jinv, d_base, W, slot_of, node_of, state, c_base,
            t_out, d_out, P_out, a_out, ai_out, h_out, stats):
     """Unload at constant rate from the relaxed state ``h_init`` with the Prony recursion.
 
     Parameters (dimensionless, DESIGN.md section 2)
     ----------
-    A : (N, N) influence matrix for the node spacing ``dr``.
+    A : (N, N) influence matrix of the mesh.
+    r : (N,) node positions (a_ref units), r[0] = 0.
     wP : (N,) load weights, P = 2 pi wP . sigma.
     h_init : (N,) relaxed gap at indentation ``delta0`` (elastic LJ solution).
     rate : r-hat; d delta/dt = -rate h0.
@@ -418,6 +454,10 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
     step_max, step_min : indentation steps in units of h0.
     da_max : largest contact-radius change per step (a_ref units).
     stop_mode : 0 stop after pull-off and load recovery, 1 follow to separation.
+    min_travel : crack-tip recession after the minimum required to stop (a_ref), see
+        :func:`stop_reached`.
+    tip_lo, tip_hi : radii the crack tip must stay within (the well-resolved band of a
+        graded mesh); leaving them ends the run with STATUS_LEFT_BAND.
     Jinv, d_base, W, slot_of, node_of, state, c_base : Jacobian cache arrays
         (:func:`new_jacobian_cache`); may carry the factorization of the initial solve.
     t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
@@ -433,7 +473,7 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
     hm = 3.0 ** (1.0 / 6.0) * h0
     r2half = np.empty(N)
     for i in range(N):
-        r2half[i] = 0.5 * (i * dr) ** 2
+        r2half[i] = 0.5 * r[i] ** 2
     q = np.zeros((M, N))
     e = np.empty(M)
     b = np.empty(M)
@@ -449,12 +489,12 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
 
     t = 0.0
     delta = delta0
-    a_cur = crossing_radius(h, dr, hm)
+    a_cur = crossing_radius(h, r, hm)
     t_out[0] = 0.0
     d_out[0] = delta
     P_out[0] = load(sigma, wP)
     a_out[0] = a_cur
-    ai_out[0] = crossing_radius(h, dr, h0)
+    ai_out[0] = crossing_radius(h, r, h0)
     n = 1
     P_min = P_out[0]
     i_min = 0
@@ -505,7 +545,7 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
             # for the snapped state by Newton from the profile shifted inward by 1..3 nodes,
             # else by pseudo-transient relaxation from the last state
             stats[STAT_JUMPS] += 1
-            ok = snap(h, hp, g, A, ceff, H, h0, c, tol * h0, max_iter, dr, hm, Jinv, d_base, W,
+            ok = snap(h, hp, g, A, ceff, H, h0, c, tol * h0, max_iter, r, hm, Jinv, d_base, W,
                       slot_of, node_of, state, c_base, stats)
             if not ok:
                 for i in range(N):
@@ -514,7 +554,7 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
             if not ok:
                 h_out[:] = h
                 return STATUS_NEWTON_FAILED, n
-        a_new = crossing_radius(hp, dr, hm)
+        a_new = crossing_radius(hp, r, hm)
         if ok and abs(a_new - a_cur) > da_max and dd > dd_min * 1.0001:
             stats[STAT_REJECTED] += 1
             easy = 0
@@ -541,26 +581,20 @@ def unload(A, dr, wP, h_init, delta0, rate, h0, c, weights, times,
         d_out[n] = delta
         P_out[n] = P
         a_out[n] = a_new
-        ai_out[n] = crossing_radius(h, dr, h0)
+        ai_out[n] = crossing_radius(h, r, h0)
         if P < P_min:
             P_min = P
             i_min = n
         n += 1
-        if a_new >= (N - 1) * dr:
+        if a_new >= r[N - 1]:
             h_out[:] = h
             return STATUS_DOMAIN, n
-        if stop_mode == 0:
-            if P_min < 0.0 and n - 1 - i_min >= 5 and P - P_min > max(RECOVERY * abs(P_min),
-                                                                      RECOVERY_FLOOR):
-                h_out[:] = h
-                return STATUS_DONE, n
-            if a_new == 0.0 and n - 1 - i_min >= 1:
-                h_out[:] = h
-                return STATUS_DONE, n
-        else:
-            if a_new == 0.0 and P > P_min and abs(P) < 1e-3 * abs(P_min):
-                h_out[:] = h
-                return STATUS_DONE, n
+        if a_new > tip_hi or a_new < tip_lo:
+            h_out[:] = h
+            return STATUS_LEFT_BAND, n
+        if stop_reached(P_out, a_out, n, i_min, stop_mode, min_travel):
+            h_out[:] = h
+            return STATUS_DONE, n
         da = abs(a_new - a_cur)
         a_cur = a_new
         # steps change by factors of 2 only, and grow after 8 easy steps in a row: C_eff

@@ -208,7 +208,7 @@ def scene_command(n, k, mu, a0, delta0, rate, material, stop, preset, nodes, dom
         click.echo(f"scene      n={sc.n:g} k={sc.k:g} mu={sc.mu:g} rate={sc.rate:g} "
                    f"{'a0=' + format(sc.a0, 'g') if sc.a0 is not None else 'delta0=' + format(sc.delta0, 'g')}"
                    f" material={sc.material}")
-        click.echo(f"numerics   preset={preset} nodes={num.nodes} spacing={res.spacing:.4g} "
+        click.echo(f"numerics   preset={preset} mesh={num.mesh} nodes={res.nodes_used} spacing={res.spacing:.4g} "
                    f"domain={res.domain_used:.4g} prony_terms={res.prony_terms}")
         click.echo(f"status     {res.status}{' (' + res.reason + ')' if res.reason else ''}")
         click.echo(f"initial    a0={res.a0_result:.6g} a0_inner={res.a0_inner:.6g} "

@@ -25,6 +25,7 @@ import numpy as np
 from .errors import InputError, check_choice, check_int, check_range
 
 MATERIALS = ("mpl", "sls")
+MESHES = ("uniform", "graded")
 STOPS = ("pulloff", "separation")
 
 #: Physical ranges accepted by :class:`Scene` (wider than the tested extremes).
@@ -109,9 +110,12 @@ class Scene:
 #: Named numerical presets. Each is a complete set of :class:`Numerics` fields.
 #: Their measured error and cost are in the README ("Speed and accuracy").
 PRESETS = {
-    "fast": dict(nodes=300, step=0.25, da_max=1.0, prony_rtol=1e-3, tol=1e-7),
-    "balanced": dict(nodes=500, step=0.1, da_max=0.5, prony_rtol=1e-4, tol=1e-8),
-    "accurate": dict(nodes=1000, step=0.05, da_max=0.25, prony_rtol=1e-6, tol=1e-9),
+    "fast": dict(mesh="graded", band_resolution=9.0, grading=1.1, step=0.25, da_max=1.0,
+                 prony_rtol=1e-3, tol=1e-7, pull_off_rtol=0.03, max_nodes=400),
+    "balanced": dict(mesh="graded", band_resolution=16.0, grading=1.1, step=0.1, da_max=0.5,
+                     prony_rtol=1e-4, tol=1e-8, pull_off_rtol=0.01, max_nodes=1000),
+    "accurate": dict(mesh="graded", band_resolution=36.0, grading=1.05, step=0.05, da_max=0.25,
+                     prony_rtol=1e-6, tol=1e-9, pull_off_rtol=0.003, max_nodes=2500),
 }
 
 
@@ -121,8 +125,31 @@ class Numerics:
 
     Parameters
     ----------
-    nodes : int
-        Number of mesh nodes N (uniform radial mesh, node 0 at r = 0), in [20, 5000].
+    nodes : int or None
+        Number of mesh nodes N (node 0 at r = 0), in [20, 5000]. Uniform mesh: ``None``
+        means 500. Graded mesh: ``None`` (default of the presets) sizes the mesh from
+        ``band_resolution``; a number gives the graded mesh of that many nodes (its fine
+        spacing follows).
+    mesh : {"uniform", "graded"}
+        "uniform": equal spacing from 0 to the domain. "graded" (the presets): fine spacing
+        across the crack band the tip sweeps (from just outside the initial contact radius
+        down to below the pull-off radius), element lengths growing by ``grading`` per
+        element inside the contact and outside it (see :mod:`sweep.mesh`).
+    band_resolution : float
+        Graded mesh: node spacings per process zone l0 = 1.693/mu^2 a_ref in the crack band
+        (the fine spacing is l0 / band_resolution).
+    grading : float
+        Graded mesh: growth factor of neighbouring element lengths outside the band, in
+        [1, 1.5].
+    max_nodes : int
+        Largest graded mesh accepted; a scene whose crack band needs more nodes (large a0
+        at a large Tabor parameter) is refused with the count it needs.
+    pull_off_rtol : float
+        Tolerance of the error indicator: every scene is solved a second time on a mesh of
+        half the resolution (half the band resolution, or half the nodes), and a result
+        whose pull-off moves by more than this fraction is not ``ok`` (``failed`` with the
+        reason "unresolved: ..."); ``Result.error_estimate`` holds the change. 0 skips the
+        check (then ``error_estimate`` is NaN).
     domain : float or None
         Mesh radius in a_ref units. ``None`` (default) chooses it from the scene: large
         enough that the gap at the mesh edge is ``tail_gap`` h0 at the start of unloading,
@@ -152,7 +179,7 @@ class Numerics:
         ``failed`` status that says how many nodes it needs.
     """
 
-    nodes: int = 500
+    nodes: int | None = None
     domain: float | None = None
     tail_gap: float = 60.0
     step: float = 0.1
@@ -163,10 +190,21 @@ class Numerics:
     max_steps: int = 200_000
     exact: bool = False
     zone_nodes: float = 2.0
+    mesh: str = "uniform"
+    band_resolution: float = 16.0
+    grading: float = 1.1
+    max_nodes: int = 2000
+    pull_off_rtol: float = 0.02
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
-        set_("nodes", check_int("nodes", self.nodes, 20, 5000))
+        if self.nodes is not None:
+            set_("nodes", check_int("nodes", self.nodes, 20, 5000))
+        check_choice("mesh", self.mesh, MESHES)
+        set_("band_resolution", check_range("band_resolution", self.band_resolution, 2.0, 500.0))
+        set_("grading", check_range("grading", self.grading, 1.0, 1.5))
+        set_("max_nodes", check_int("max_nodes", self.max_nodes, 20, 20000))
+        set_("pull_off_rtol", check_range("pull_off_rtol", self.pull_off_rtol, 0.0, 1.0))
         if self.domain is not None:
             set_("domain", check_range("domain", self.domain, 0.5, 500.0))
         set_("tail_gap", check_range("tail_gap", self.tail_gap, 10.0, 1e5))
@@ -231,7 +269,7 @@ RESULT_SCALARS = (
     "crack_speed", "vhat", "rhat_pb",
     "a0_result", "a0_inner", "delta0_result",
     "steps", "newton_iterations", "factorizations", "prony_terms", "prony_error",
-    "spacing", "domain_used", "wall_s",
+    "spacing", "nodes_used", "domain_used", "error_estimate", "wall_s",
 )
 
 TRAJECTORY_KEYS = ("t", "delta", "P", "a", "a_inner")
@@ -267,13 +305,17 @@ class Result:
     prony_error : float
         Max relative error of the Prony Chat over the scene's window (0 in exact mode).
     spacing, domain_used : float
-        Node spacing and mesh radius (a_ref units).
+        Node spacing (the fine spacing of a graded mesh) and mesh radius (a_ref units).
+    nodes_used : int
+        Number of mesh nodes.
+    error_estimate : float
+        |pull-off change| / pull-off between this solve and one on a mesh of half the
+        resolution (NaN when not checked; see ``Numerics.pull_off_rtol``). For a
+        second-order discretization the error of this solve is about a third of it.
     wall_s : float
         Wall-clock time of the run in seconds.
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
-    final_gap : ndarray or None
-        Nodal gap (d_ref units) of the last accepted step (Prony path only).
     """
 
     scene: Scene
@@ -297,10 +339,11 @@ class Result:
     prony_terms: int = 0
     prony_error: float = math.nan
     spacing: float = math.nan
+    nodes_used: int = 0
+    error_estimate: float = math.nan
     domain_used: float = math.nan
     wall_s: float = 0.0
     trajectory: dict = field(default_factory=dict)
-    final_gap: np.ndarray | None = None
 
     @property
     def ok(self) -> bool:

@@ -55,11 +55,12 @@ def test_scene_bad_input_one_line_exit_2(args, name, capsys):
 
 
 def test_failed_scene_exits_1(capsys):
-    # a mesh far too coarse for mu = 10 is refused with advice, status failed
+    # mu = 10, a0 = 10: the graded mesh's crack band needs ~4000 nodes (> the fast preset's
+    # max_nodes); refused with the count and the advice, status failed
     assert main(["scene", "--n", "1", "--mu", "10", "--a0", "10", "--rate", "1",
                  "--preset", "fast", "--json"]) == 1
     out = json.loads(capsys.readouterr().out)
-    assert out["status"] == "failed" and "use nodes >=" in out["reason"]
+    assert out["status"] == "failed" and "needs" in out["reason"] and "max_nodes" in out["reason"]
 
 
 def test_console_script_and_plot(tmp_path):

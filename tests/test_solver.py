@@ -21,7 +21,8 @@ def _ref():
 
 
 def elastic(mu, a0=2.0, **num):
-    num = {"nodes": 1000, "domain": 5.0, "step": 0.05, "tol": 1e-9, **num}
+    # compared with independent values: the error indicator's second solve is skipped
+    num = {"nodes": 1000, "domain": 5.0, "step": 0.05, "tol": 1e-9, "pull_off_rtol": 0.0, **num}
     return simulate(Scene(n=1.0, k=1.0, mu=mu, a0=a0, rate=1.0), Numerics(**num))
 
 
@@ -74,9 +75,10 @@ def test_viscoelastic_matches_independent_solver(name):
 
 @pytest.mark.parametrize("n, rate", [(0.4, 3.16), (1.6, 316.2)])
 def test_prony_matches_exact_convolution(n, rate):
-    # same step sequence (da_max off), default Prony tolerance of the balanced preset
+    # same step sequence (da_max off), default Prony tolerance of the balanced preset; two
+    # time integrators on the same coarse mesh (the mesh error indicator is off)
     scene = Scene(n=n, k=0.1, mu=3.24, a0=2.0, rate=rate)
-    num = dict(nodes=100, step=0.2, da_max=1e6, tol=1e-9)
+    num = dict(nodes=100, step=0.2, da_max=1e6, tol=1e-9, pull_off_rtol=0.0)
     prony = simulate(scene, Numerics(**num, prony_rtol=1e-4))
     exact = simulate(scene, Numerics(**num, exact=True))
     assert prony.ok and exact.ok
@@ -87,7 +89,7 @@ def test_prony_matches_exact_convolution(n, rate):
 
 def test_prony_error_shrinks_with_rtol():
     scene = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=100.0)
-    num = dict(nodes=100, step=0.2, da_max=1e6, tol=1e-9)
+    num = dict(nodes=100, step=0.2, da_max=1e6, tol=1e-9, pull_off_rtol=0.0)
     exact = simulate(scene, Numerics(**num, exact=True)).pull_off
     errs = [abs(simulate(scene, Numerics(**num, prony_rtol=r)).pull_off / exact - 1)
             for r in (1e-2, 1e-6)]
@@ -178,8 +180,13 @@ def test_extremes_finish_with_a_finite_result_or_a_clear_failure(scene):
 
 
 def test_under_resolved_mesh_is_refused_with_advice():
-    res = simulate(Scene(n=2, k=1e-4, rate=1e-3, a0=10, mu=10), Numerics.preset("fast"))
+    # uniform mesh: l0 = 0.017 at mu = 10 spans < 2 spacings of 300 nodes on the domain
+    scene = Scene(n=2, k=1e-4, rate=1e-3, a0=10, mu=10)
+    res = simulate(scene, Numerics.preset("fast", mesh="uniform", nodes=300))
     assert res.status == "failed" and "use nodes >=" in res.reason
+    # graded mesh: the crack band from 3 to 10.5 a_ref needs ~4000 nodes at l0/9 (> 400)
+    res = simulate(scene, Numerics.preset("fast"))
+    assert res.status == "failed" and "max_nodes" in res.reason
 
 
 @pytest.mark.parametrize("kwargs, name", [
@@ -203,6 +210,6 @@ def test_bad_numerics_input_names_the_parameter(kwargs, name):
 
 
 def test_presets_and_unknown_preset():
-    assert Numerics.preset("fast").nodes < Numerics.preset("accurate").nodes
+    assert Numerics.preset("fast").band_resolution < Numerics.preset("accurate").band_resolution
     with pytest.raises(InputError, match="preset"):
         Numerics.preset("turbo")

@@ -1,0 +1,141 @@
+"""The relaxed initial state: the elastic (Chat = 1) Lennard-Jones solution at delta0, or at
+the indentation whose max-tension contact radius is a0.
+
+Units of DESIGN.md section 2 (radii a_ref, gaps and indentations d_ref). A secant root find
+on delta, each solve warm-started from the previous one, the first from the JKR solution;
+elastic continuation where a direct solve does not converge (a coarse mesh can trap Newton
+in a non-solution minimum of |F| where the contact edge sits between nodes).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from kernels.interface import crossing_radius
+from kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton
+
+from .problem import jkr_radius
+
+#: Newton iterations of the elastic solves of the initial state (poorer starting guesses)
+MAX_NEWTON_ITER_INITIAL = 40
+
+
+def jkr_gap_guess(r: np.ndarray, delta: float, h0: float) -> np.ndarray:
+    """JKR gap (Hertz + flat-punch deflection) at indentation ``delta``, floored at h0."""
+    a = jkr_radius(delta)
+    rigid = -delta + h0 + 0.5 * r**2
+    if a <= 0.0:
+        return np.maximum(rigid, h0)
+    inside = r <= a
+    ro = np.where(inside, a, r)
+    asin = np.arcsin(np.clip(a / ro, -1.0, 1.0))
+    u_hertz = np.where(inside, 0.5 * (2 * a * a - r**2),
+                       ((2 * a * a - r**2) * asin + a * np.sqrt(np.maximum(r**2 - a * a, 0.0))) / np.pi)
+    u_punch = np.where(inside, 1.0, 2.0 / np.pi * asin)
+    gap = rigid + u_hertz - math.sqrt(2.0 * a) * u_punch
+    return np.maximum(gap, h0)
+
+
+class ElasticSolver:
+    """Elastic (Chat = 1) LJ solves on one mesh, with a reusable inverse Jacobian."""
+
+    def __init__(self, A, r, h0, c, tol):
+        self.A, self.r, self.h0, self.c, self.tol = A, r, h0, c, tol
+        N = A.shape[0]
+        self.zero = np.zeros(N)
+        self.cache = new_jacobian_cache(N)
+        self.stats = np.zeros(N_STATS, dtype=np.int64)
+
+    def solve(self, delta, guess):
+        h = np.array(guess, dtype=float)
+        g = -delta + self.h0 + 0.5 * self.r**2
+        ok = newton(h, g, self.A, 1.0, self.zero, self.h0, self.c, self.tol * self.h0,
+                    MAX_NEWTON_ITER_INITIAL, *self.cache, self.stats)
+        if not ok:
+            invalidate(self.cache)   # refactorize next time
+        return ok, h
+
+    def radius(self, h, level_factor=3.0 ** (1.0 / 6.0)):
+        return crossing_radius(h, self.r, level_factor * self.h0)
+
+
+def _walk(el: ElasticSolver, d_from: float, h_from: np.ndarray, d_to: float):
+    """Elastic continuation from a converged state at ``d_from`` to ``d_to``.
+
+    Adaptive steps in delta (halved on a failed solve, grown after successes), each solve
+    warm-started from the previous gap shifted by the change of indentation.
+    Returns the gap at ``d_to`` or None.
+    """
+    d, h = d_from, h_from
+    step = min(0.25, abs(d_to - d_from)) if d_to != d_from else 0.0
+    while d != d_to:
+        if step < 1e-6:
+            return None
+        d_next = d_to if abs(d_to - d) <= step else d + math.copysign(step, d_to - d)
+        guess = np.maximum(h - (d_next - d), 0.3 * h)
+        ok, h_new = el.solve(d_next, guess)
+        if ok:
+            d, h = d_next, h_new
+            step *= 1.5
+        else:
+            step *= 0.5
+    return h
+
+
+def _solve_at(el: ElasticSolver, delta: float) -> np.ndarray:
+    """Elastic LJ solution at ``delta``: from the JKR guess, else by continuation from the
+    nearest indentation that converges directly (a coarse mesh can trap Newton in a
+    non-solution minimum of |F| where the contact edge sits between nodes)."""
+    ok, h = el.solve(delta, jkr_gap_guess(el.r, delta, el.h0))
+    if ok:
+        return h
+    for offset in (0.5, -0.5, 1.0, -1.0, 2.0, -2.0, 4.0, 8.0):
+        d = delta + offset
+        ok, h = el.solve(d, jkr_gap_guess(el.r, d, el.h0))
+        if ok:
+            h = _walk(el, d, h, delta)
+            if h is not None:
+                return h
+    raise RuntimeError(f"no converged relaxed state at delta0={delta:.6g}")
+
+
+def relaxed_state(el: ElasticSolver, delta0=None, a0=None):
+    """Relaxed elastic state at ``delta0`` or at the indentation giving contact radius ``a0``.
+
+    Returns (h, delta0) or raises RuntimeError with a reason.
+    """
+    if delta0 is not None:
+        return _solve_at(el, float(delta0)), float(delta0)
+
+    # find delta with a(delta) = a0: secant on delta, warm-started solves
+    d1 = a0 * a0 - math.sqrt(2.0 * a0)
+    h1 = _solve_at(el, d1)
+    f1 = el.radius(h1) - a0
+    slope = 1.0 / (2 * a0 - 0.5 ** 0.5 * a0 ** -0.5)     # JKR da/d delta
+    d2 = d1 - f1 / slope
+    lo = hi = None
+    for _ in range(60):
+        ok, h2 = el.solve(d2, np.maximum(h1 + (d1 - d2), 0.3 * h1))
+        if not ok:
+            h2 = _walk(el, d1, h1, d2)
+            if h2 is None:
+                h2 = _solve_at(el, d2)
+        f2 = el.radius(h2) - a0
+        if f2 < 0:
+            lo = d2 if lo is None else max(lo, d2)
+        else:
+            hi = d2 if hi is None else min(hi, d2)
+        if abs(f2) < 1e-10 * max(1.0, a0):
+            return h2, float(d2)
+        if f2 != f1:
+            d_new = d2 - f2 * (d2 - d1) / (f2 - f1)
+        else:
+            d_new = d2 - f2 / slope
+        if lo is not None and hi is not None and not (lo < d_new < hi):
+            d_new = 0.5 * (lo + hi)
+        d1, h1, f1 = d2, h2, f2
+        d2 = d_new
+        if lo is not None and hi is not None and hi - lo < 1e-13 * max(1.0, abs(d2)):
+            return h2, float(d2)
+    raise RuntimeError(f"could not reach the initial contact radius a0={a0:.6g}")

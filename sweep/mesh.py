@@ -1,0 +1,231 @@
+"""Radial meshes of the half-space surface and their cached influence matrices.
+
+Two kinds (``Numerics.mesh``), nodes in a_ref units with r_0 = 0:
+
+* ``"uniform"``: ``nodes`` nodes at spacing domain / (nodes - 1);
+* ``"graded"``: uniform fine spacing across the *crack band* [band_lo, band_hi] that the
+  crack tip sweeps while unloading (from a little outside the initial contact radius a0
+  down to below the pull-off radius), spacings growing geometrically by ``grading`` from
+  the band inward to r = 0 (deep inside the compressed contact) and outward to the domain
+  edge (the far Lennard-Jones tail). The fine spacing is the process zone
+  l0 = 1.693/mu^2 divided by ``band_resolution``, or the one that gives exactly ``nodes``
+  nodes when a node count is requested.
+
+The influence matrix of a mesh is assembled once per process (:func:`influence`); a
+uniform mesh scales the cached unit-spacing matrix.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from kernels.influence import assemble_unit, combine_lattice_hats, load_weights_nodes
+
+#: the crack band reaches this fraction of a0 inward (pull-off radii measured on the
+#: reference scenes are 0.42-0.53 a0; the elastic limit is 1.145 a_ref) ...
+BAND_INNER_FRACTION = 0.3
+#: ... and this many process zones l0 beyond each end (the cohesive zone around the tip)
+BAND_MARGIN_ZONES = 4.0
+#: the outer band edge lies this factor outside the estimated initial contact radius, and
+#: at least at BAND_OUTER_MIN: from a0 below the elastic pull-off radius 1.145 the tip first
+#: advances (to 1.10 from a0 = 1 at mu = 10)
+BAND_OUTER_FACTOR = 1.05
+BAND_OUTER_MIN = 1.3
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """Node positions of one radial mesh (a_ref units) and where its fine band lies.
+
+    Attributes
+    ----------
+    r : ndarray
+        Node positions, r[0] = 0, increasing; read-only.
+    kind : {"uniform", "graded"}
+    spacing : float
+        The fine spacing (the only spacing of a uniform mesh).
+    band : (float, float)
+        [lo, hi] of the uniformly fine crack band (the whole mesh when uniform).
+    key : tuple
+        Hashable parameters that determine ``r`` in units of ``spacing`` (the influence
+        matrix of the mesh is ``spacing`` times a matrix cached under this key).
+    lattice : ndarray of int
+        r / spacing: every node lies on the lattice of the fine spacing.
+    """
+
+    r: np.ndarray
+    kind: str
+    spacing: float
+    band: tuple
+    key: tuple
+    lattice: np.ndarray
+
+    @property
+    def nodes(self) -> int:
+        return int(self.r.size)
+
+    @property
+    def domain(self) -> float:
+        return float(self.r[-1])
+
+    @property
+    def load_weights(self) -> np.ndarray:
+        """w_j with P = 2 pi w . sigma (exact for piecewise-linear traction)."""
+        return _load_weights(self)
+
+    @property
+    def influence(self) -> np.ndarray:
+        """The influence matrix (read-only, cached per process)."""
+        return influence(self)
+
+
+def uniform_mesh(nodes: int, domain: float) -> Mesh:
+    """``nodes`` nodes from 0 to ``domain`` (a_ref units)."""
+    nodes = int(nodes)
+    spacing = domain / (nodes - 1)
+    r = np.arange(nodes) * spacing
+    r.setflags(write=False)
+    idx = np.arange(nodes)
+    idx.setflags(write=False)
+    return Mesh(r, "uniform", spacing, (0.0, float(domain)), ("uniform", nodes), idx)
+
+
+def _graded_steps(length: int, ratio: float) -> list:
+    """Integer element lengths growing like ratio^k (k = 1, 2, ...) that sum to ``length``.
+
+    Lengths are floor(ratio^k), at least 1 and never decreasing; the remainder goes to the
+    last element (or a new one when it is at least half as long as the previous).
+    """
+    steps, total, k = [], 0, 1
+    while True:
+        m = max(1, int(math.floor(ratio ** k)))
+        if steps:
+            m = max(m, steps[-1])
+        if total + m > length:
+            rest = length - total
+            if rest > 0:
+                if steps and rest < 0.5 * steps[-1]:
+                    steps[-1] += rest
+                else:
+                    steps.append(rest)
+            return steps
+        steps.append(m)
+        total += m
+        k += 1
+
+
+def _graded_lattice(n_domain: int, lo: int, hi: int, ratio: float) -> np.ndarray:
+    """Lattice indices: every point of [lo, hi], graded steps inward to 0 and out to n_domain."""
+    inner = np.cumsum(_graded_steps(lo, ratio)) if lo > 0 else np.zeros(0, np.int64)
+    outer = np.cumsum(_graded_steps(n_domain - hi, ratio)) if n_domain > hi else np.zeros(0, np.int64)
+    left = (lo - inner)[::-1]                   # nodes below the band, from 0 up
+    return np.concatenate([left, np.arange(lo, hi + 1), hi + outer]).astype(np.int64)
+
+
+def graded_mesh(domain: float, band: tuple, spacing: float, grading: float) -> Mesh:
+    """Fine ``spacing`` across ``band`` = (lo, hi), element lengths growing by about
+    ``grading`` per element outside (inward to r = 0 and outward to ``domain``).
+
+    Every node lies on the lattice of the fine spacing (element lengths are integer
+    multiples of it), so the influence matrix is an exact combination of the cached
+    unit-spacing one; the band ends and the domain are rounded outward to the lattice.
+    """
+    n_domain = int(math.ceil(domain / spacing - 1e-9))
+    lo = max(int(math.floor(band[0] / spacing + 1e-9)), 0)
+    hi = min(int(math.ceil(band[1] / spacing - 1e-9)), n_domain)
+    idx = _graded_lattice(n_domain, lo, hi, float(grading))
+    r = idx * float(spacing)
+    r.setflags(write=False)
+    idx.setflags(write=False)
+    return Mesh(r, "graded", float(spacing), (lo * spacing, hi * spacing),
+                ("graded", n_domain, lo, hi, float(grading)), idx)
+
+
+def graded_mesh_with_nodes(nodes: int, domain: float, band: tuple, grading: float) -> Mesh:
+    """The graded mesh of ``domain`` and ``band`` with about ``nodes`` nodes (never more):
+    the fine spacing found by bisection."""
+    lo_s, hi_s = domain / (50.0 * nodes), float(domain) / 2.0
+    mesh = graded_mesh(domain, band, hi_s, grading)
+    for _ in range(60):
+        mid = math.sqrt(lo_s * hi_s)
+        m = graded_mesh(domain, band, mid, grading)
+        if m.nodes > nodes:
+            lo_s = mid
+        else:
+            hi_s, mesh = mid, m
+            if m.nodes == nodes:
+                break
+    return mesh
+
+
+def crack_band(a0: float, l0: float, pull_off_only: bool = True) -> tuple[float, float]:
+    """[lo, hi] of the radii the crack tip sweeps from the initial contact radius ``a0``.
+
+    ``pull_off_only=False`` (following the curve to separation) reaches down to r = 0.
+    """
+    hi = max(BAND_OUTER_FACTOR * a0, BAND_OUTER_MIN) + BAND_MARGIN_ZONES * l0
+    lo = BAND_INNER_FRACTION * a0 - BAND_MARGIN_ZONES * l0 if pull_off_only else 0.0
+    return max(lo, 0.0), hi
+
+
+#: the cached unit-spacing matrix grows in multiples of this many nodes
+UNIT_BLOCK = 256
+_UNIT = [np.zeros((0, 0))]
+_MESH_CACHE: dict = {}
+_MESH_CACHE_SIZE = 32
+
+
+def unit_influence(N: int) -> np.ndarray:
+    """The leading N x N block of the unit-spacing influence matrix (read-only).
+
+    Its entries do not depend on the matrix size (the last node has a full hat), so one
+    matrix, grown in blocks of UNIT_BLOCK nodes, serves every mesh of the process.
+    """
+    if _UNIT[0].shape[0] < N:
+        size = UNIT_BLOCK * int(math.ceil(N / UNIT_BLOCK))
+        A = assemble_unit(size)
+        A.setflags(write=False)
+        _UNIT[0] = A
+    return _UNIT[0][:N, :N]
+
+
+def influence(mesh: Mesh) -> np.ndarray:
+    """The influence matrix of ``mesh`` (read-only), from the cached unit-spacing matrix."""
+    A1 = _MESH_CACHE.get(mesh.key)
+    if A1 is None:
+        idx = mesh.lattice
+        if mesh.kind == "uniform":
+            A1 = unit_influence(mesh.nodes)
+        else:
+            width = int(2 * idx[-1] - idx[-2]) + 1
+            A1 = combine_lattice_hats(np.ascontiguousarray(unit_influence(width)[idx, :]),
+                                      np.ascontiguousarray(idx))
+        if len(_MESH_CACHE) >= _MESH_CACHE_SIZE:
+            _MESH_CACHE.pop(next(iter(_MESH_CACHE)))
+        _MESH_CACHE[mesh.key] = A1
+    A = A1 * mesh.spacing
+    A.setflags(write=False)
+    return A
+
+
+def _load_weights(mesh: Mesh) -> np.ndarray:
+    return load_weights_nodes(np.ascontiguousarray(mesh.r))
+
+
+def scene_mesh(numerics, l0: float, a0_estimate: float, domain: float,
+               pull_off_only: bool = True, band: tuple | None = None) -> Mesh:
+    """The mesh of a scene: ``numerics.mesh`` over ``domain`` (a_ref units).
+
+    Graded: the crack band from the estimated initial contact radius ``a0_estimate`` and
+    the process zone ``l0`` (or the given ``band``), fine spacing l0/band_resolution or
+    the one that gives ``numerics.nodes`` nodes.
+    """
+    if numerics.mesh == "uniform":
+        return uniform_mesh(numerics.nodes if numerics.nodes is not None else 500, domain)
+    if band is None:
+        band = crack_band(a0_estimate, l0, pull_off_only)
+    if numerics.nodes is not None:
+        return graded_mesh_with_nodes(numerics.nodes, domain, band, numerics.grading)
+    return graded_mesh(domain, band, l0 / numerics.band_resolution, numerics.grading)

@@ -1,0 +1,183 @@
+"""A scene's numbers derived once: the prepared problem the kernels receive.
+
+``prepare(scene, numerics)`` computes, in the units of DESIGN.md section 2, everything a
+solve needs before it starts -- the Lennard-Jones constants (h0, c), the process zone l0,
+the estimated initial state, the domain, the mesh with its influence matrix and load
+weights, the Prony time window and series -- so that data flows one way: scene ->
+problem -> kernels -> result. The per-process caches (Prony series, influence matrices)
+live here and in :mod:`sweep.mesh`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from . import units
+from .mesh import Mesh, scene_mesh
+from .scene import Numerics, Scene
+from .theory import jkr_contact_radius
+
+#: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
+WINDOW_SAFETY = 10.0
+#: ... widened outward to multiples of this many decades (shared by the scenes of a sweep)
+WINDOW_GRID = 0.5
+#: the crack tip stays this many process zones inside the fine band of a graded mesh
+TIP_MARGIN_ZONES = 2.0
+#: max-tension gap over h0: the crack tip (contact radius a) is where the gap is 3^(1/6) h0
+TIP_GAP = 3.0 ** (1.0 / 6.0)
+
+
+class Refused(Exception):
+    """The numerics cannot represent the scene (the message says what to change)."""
+
+
+def lj_constants(mu: float) -> tuple[float, float]:
+    """(h0, c) of the LJ law sigma = -c[(h0/h)^3 - (h0/h)^9] for Tabor parameter mu."""
+    return units.h0_hat(mu), units.lj_prefactor(mu)
+
+
+def jkr_radius(delta: float) -> float:
+    """JKR contact radius at indentation ``delta`` (stable branch); 0 below the fixed-grip
+    fold delta = -3/4, where JKR has no contact."""
+    return float(jkr_contact_radius(indentation=delta)) if delta >= -0.75 else 0.0
+
+
+def material(kind: str, n: float, k: float):
+    """The material object (units E0 = 1, tau0 = 1): "mpl" or "sls"."""
+    from .materials import SLS, MPLRetardation
+    if kind == "sls":
+        return SLS(1.0, 1.0 / k, 1.0)
+    return MPLRetardation(1.0, 1.0 / k, n, 1.0)
+
+
+def material_of(scene: Scene):
+    """The material object of a scene, in units where E0 = 1 and tau0 = 1."""
+    return material(scene.material, scene.n, scene.k)
+
+
+def auto_domain(scene: Scene, numerics: Numerics, delta0_estimate: float) -> float:
+    """Mesh radius: the rigid gap r^2/2 - delta0 reaches ``tail_gap`` h0 at the edge."""
+    h0 = units.h0_hat(scene.mu)
+    r_tail = math.sqrt(2.0 * (max(delta0_estimate, 0.0) + numerics.tail_gap * h0))
+    a_est = jkr_radius(delta0_estimate) if scene.a0 is None else scene.a0
+    return max(r_tail, 1.3 * a_est + 0.5)
+
+
+def time_window(scene: Scene, numerics: Numerics, delta0: float) -> tuple[float, float]:
+    """Prony window [t_min, t_max] in tau0 for this scene's unloading.
+
+    The window is widened outward to the grid of WINDOW_GRID decades, so that the scenes
+    of a sweep share a few windows (and their cached Prony series, :func:`prony_series`).
+    """
+    h0 = units.h0_hat(scene.mu)
+    t_min = numerics.min_step / scene.rate        # the smallest step the run may take
+    travel = max(delta0, 0.0) + 3.0 + 2.0 * math.sqrt(max(delta0, 1.0))
+    t_max = max(WINDOW_SAFETY * travel / (scene.rate * h0), 10 * t_min)
+    lo = math.floor(math.log10(t_min) / WINDOW_GRID) * WINDOW_GRID
+    hi = math.ceil(math.log10(t_max) / WINDOW_GRID) * WINDOW_GRID
+    return 10.0 ** lo, 10.0 ** hi
+
+
+@lru_cache(maxsize=256)
+def prony_series(kind: str, n: float, k: float, t_min: float, t_max: float, rtol: float):
+    """The Prony series of a material's creep compliance on [t_min, t_max] (tau0), cached.
+
+    A fit costs 0.02-0.2 s, more than a fast scene's unloading; the scenes of a sweep
+    repeat the same (material, n, k) and, through the snapped :func:`time_window`, the
+    same window, so each worker fits each series once.
+    """
+    return material(kind, n, k).prony(t_min, t_max, rtol)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Everything a solve of one scene needs, derived once (DESIGN.md units).
+
+    Attributes
+    ----------
+    scene, numerics : the inputs.
+    h0, c : LJ range (d_ref) and prefactor; ``hm = 3^(1/6) h0`` the max-tension gap.
+    l0 : process zone 1.693/mu^2 (a_ref).
+    delta0_estimate, a0_estimate : the initial state before it is solved (delta0 given, or
+        JKR from a0), which sizes the domain, the crack band and the time window.
+    mesh : the mesh (``mesh.r`` node radii, ``mesh.spacing`` the fine spacing).
+    A, wP : influence matrix and load weights of the mesh (read-only, cached).
+    prony_weights, prony_times : Prony modes of Chat (empty when elastic or exact).
+    prony_error : achieved max relative error of the series (0 when none).
+    """
+
+    scene: Scene
+    numerics: Numerics
+    h0: float
+    c: float
+    hm: float
+    l0: float
+    delta0_estimate: float
+    a0_estimate: float
+    mesh: Mesh
+    A: np.ndarray
+    wP: np.ndarray
+    prony_weights: np.ndarray
+    prony_times: np.ndarray
+    prony_error: float
+
+    @property
+    def tip_range(self) -> tuple[float, float]:
+        """Radii the crack tip must stay within: the fine band less TIP_MARGIN_ZONES l0 at
+        each end that has a coarse region beyond it."""
+        lo, hi = self.mesh.band
+        lo = lo + TIP_MARGIN_ZONES * self.l0 if lo > 0 else -1.0
+        hi = hi - TIP_MARGIN_ZONES * self.l0 if hi < self.mesh.domain else math.inf
+        return lo, hi
+
+    @property
+    def stop_mode(self) -> int:
+        """0: stop after the pull-off, 1: follow to separation (``kernels.solve.stop_reached``)."""
+        return 0 if self.scene.stop == "pulloff" else 1
+
+
+def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Problem:
+    """Derive a scene's numbers once. Raises :class:`Refused` when the mesh cannot do.
+
+    ``band`` overrides the crack band of a graded mesh (a_ref radii, see
+    :func:`sweep.mesh.crack_band`).
+    """
+    h0, c = lj_constants(scene.mu)
+    l0 = units.l0_hat(scene.mu)
+    if scene.delta0 is not None:
+        d_est = scene.delta0
+    else:
+        d_est = scene.a0**2 - math.sqrt(2 * scene.a0)
+    a_est = scene.a0 if scene.a0 is not None else max(jkr_radius(d_est), 0.0)
+    domain = numerics.domain if numerics.domain is not None else auto_domain(scene, numerics, d_est)
+    mesh = scene_mesh(numerics, l0, a_est, domain, pull_off_only=scene.stop == "pulloff",
+                      band=band)
+    zone = l0 / mesh.spacing
+    if zone < numerics.zone_nodes:
+        if mesh.kind == "uniform":
+            need = int(math.ceil(numerics.zone_nodes * domain / l0)) + 1
+            advice = f"use nodes >= {need} for domain {domain:.3g}"
+        else:
+            advice = "use more nodes (or leave nodes unset to size the mesh from band_resolution)"
+        raise Refused(f"mesh too coarse: the process zone l0 = {l0:.3g} a_ref spans {zone:.2g} "
+                      f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
+    if mesh.nodes > numerics.max_nodes:
+        raise Refused(f"mesh too large: the crack band needs {mesh.nodes} nodes at "
+                      f"band_resolution {numerics.band_resolution:g} (> max_nodes = "
+                      f"{numerics.max_nodes}); raise max_nodes or lower band_resolution")
+    weights = times = np.zeros(0)
+    error = 0.0
+    if scene.k < 1.0 and not numerics.exact:
+        t_min, t_max = time_window(scene, numerics, d_est)
+        n = scene.n if scene.material == "mpl" else 0.0
+        prony = prony_series(scene.material, n, scene.k, t_min, t_max, numerics.prony_rtol)
+        weights = np.ascontiguousarray(prony.weights, dtype=float)
+        times = np.ascontiguousarray(prony.times, dtype=float)
+        error = float(prony.max_rel_error)
+    return Problem(scene=scene, numerics=numerics, h0=h0, c=c, hm=TIP_GAP * h0, l0=l0,
+                   delta0_estimate=float(d_est), a0_estimate=float(a_est), mesh=mesh,
+                   A=mesh.influence, wP=mesh.load_weights, prony_weights=weights,
+                   prony_times=times, prony_error=error)

@@ -1,0 +1,80 @@
+"""The low-rank-corrected Newton step of the kernel against a dense numpy solve of the same
+system, and the Newton solve against the residual it claims to zero."""
+import numpy as np
+import pytest
+
+from kernels import solve as ks
+from kernels.interface import lj_traction_and_stiffness
+from sweep.mesh import uniform_mesh
+from sweep.solver import lj_constants
+
+
+def _problem(N=60, seed=1):
+    rng = np.random.default_rng(seed)
+    mesh = uniform_mesh(N, 3.0)
+    A = np.array(mesh.influence)
+    h0, c = lj_constants(3.24)
+    r = np.asarray(mesh.r)
+    # a contact-like gap: h0 inside r < 1.5, opening outside, with a perturbation
+    h = np.maximum(h0 * (1.0 + 0.2 * rng.random(N)), 0.5 * (r - 1.5) ** 2 + h0)
+    return A, h, h0, c, rng
+
+
+def _dense_jacobian(A, h, h0, c, ceff):
+    sig, d = np.empty(h.size), np.empty(h.size)
+    lj_traction_and_stiffness(h, h0, c, sig, d)
+    return np.eye(h.size) - ceff * A * d[None, :], d
+
+
+@pytest.mark.parametrize("moved", [3, 25])
+def test_woodbury_newton_step_equals_dense_solve(moved):
+    A, h, h0, c, rng = _problem()
+    ceff = 0.7
+    cache = ks.new_jacobian_cache(h.size, kmax=40, eta=0.0)      # eta = 0: exact corrections
+    ks.factorize(h, A, ceff, h0, c, cache[0], cache[1], cache[3], cache[5], cache[6])
+    # the stiffness moves at a few nodes (the crack tip region)
+    h2 = h.copy()
+    idx = rng.choice(h.size, moved, replace=False)
+    h2[idx] *= 1.0 + 0.3 * rng.random(moved)
+    J, d = _dense_jacobian(A, h2, h0, c, ceff)
+    F = rng.standard_normal(h.size)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    dh, ok = ks.newton_direction(F, d, A, ceff, 0.0, *cache[:6], stats)
+    assert ok
+    assert stats[ks.STAT_COLUMNS] == moved            # one column per moved node
+    np.testing.assert_allclose(dh, -np.linalg.solve(J, F), rtol=1e-9, atol=1e-12)
+
+
+def test_merged_corrections_give_the_inverse_of_the_new_jacobian():
+    A, h, h0, c, rng = _problem(seed=2)
+    ceff = 0.55
+    cache = ks.new_jacobian_cache(h.size, kmax=h.size, eta=0.0)
+    ks.factorize(h, A, ceff, h0, c, cache[0], cache[1], cache[3], cache[5], cache[6])
+    h2 = h * (1.0 + 0.2 * rng.random(h.size))
+    J, d = _dense_jacobian(A, h2, h0, c, ceff)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    _, ok = ks.newton_direction(np.ones(h.size), d, A, ceff, 0.0, *cache[:6], stats)
+    assert ok and cache[5][1] == h.size                    # every node corrected
+    ks.merge_corrections(d, *cache)
+    np.testing.assert_allclose(cache[0] @ J, np.eye(h.size), atol=1e-9)
+
+
+def test_newton_solves_the_discrete_equilibrium():
+    # from the relaxed elastic state at delta = 1, one unloading-like step: new indentation,
+    # C_eff < 1 and a history vector; Newton must zero the residual computed here by numpy
+    from sweep.initial import ElasticSolver, relaxed_state
+    A, _, h0, c, rng = _problem(N=120, seed=3)
+    r = np.arange(120) * 3.0 / 119
+    el = ElasticSolver(A, r, h0, c, 1e-10)
+    h_start, _ = relaxed_state(el, delta0=1.0)
+    g = -(1.0 - 0.2 * h0) + h0 + 0.5 * r**2
+    ceff = 0.8
+    H = -0.05 * np.exp(-r)
+    cache = ks.new_jacobian_cache(120)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    hs = h_start.copy()
+    assert ks.newton(hs, g, A, ceff, H, h0, c, 1e-10 * h0, 40, *cache, stats)
+    sig, d = np.empty(120), np.empty(120)
+    lj_traction_and_stiffness(hs, h0, c, sig, d)
+    assert np.max(np.abs(hs - g - A @ (ceff * sig - H))) < 1e-10 * h0
+    assert np.max(np.abs(hs - h_start)) > 1e-3 * h0          # it did move
