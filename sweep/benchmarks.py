@@ -36,7 +36,7 @@ import click
 import numpy as np
 
 from .tradeoff import (REFERENCE_OVERRIDES, REFERENCES, TRADEOFF_SCENES, VS_NUMPY_SCENES,
-                       compute_reference, write_tradeoff)
+                       compute_reference, existing, write_tradeoff)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -405,6 +405,7 @@ class BenchPlan:
     @classmethod
     def tiny(cls) -> "BenchPlan":
         small = dict(n=0.8, k=0.5, mu=3.24, delta0=1.0, rate=10.0)
+        once = dict(mesh="uniform", pull_off_rtol=0.0)   # one solve per scene, where they exist
         return cls(matvec_nodes=(60,), matvec_scene=dict(n=0.8, k=0.5, mu=3.24, a0=1.2,
                                                          rate=10.0),
                    matvec_preset="fast", prony_steps=(20,),
@@ -414,10 +415,11 @@ class BenchPlan:
                    compile=False, campaign="configs/smoke.yaml",
                    campaign_stride=4, jobs=1,
                    vs_numpy_scenes={"tiny": small},
-                   engine_numerics={"fast": dict(nodes=60, domain=2.5, step=0.5,
-                                                 prony_rtol=1e-2)},
+                   engine_numerics={"fast": existing(dict(nodes=60, domain=2.5, step=0.5,
+                                                          prony_rtol=1e-2, **once))},
                    plain_ladder=((60, 0.5),), plain_time_limit_s=30.0,
-                   reference_fallback=dict(nodes=80, domain=2.5, step=0.25), repeat=1)
+                   reference_fallback=existing(dict(nodes=80, domain=2.5, step=0.25, **once)),
+                   repeat=1)
 
 
 def _numerics(overrides: dict):
@@ -459,7 +461,8 @@ def bench_step_over_matvec(plan: BenchPlan) -> dict:
     scene = Scene(**plan.matvec_scene)
     out = {}
     for N in plan.matvec_nodes:
-        row = step_cost(scene, Numerics.preset(plan.matvec_preset, nodes=N), plan.repeat)
+        num = Numerics.preset(plan.matvec_preset, **existing(dict(nodes=N, pull_off_rtol=0.0)))
+        row = step_cost(scene, num, plan.repeat)
         row["matvec_s"] = matvec_seconds(row["nodes"])
         row["ratio"] = row["step_s"] / row["matvec_s"]
         out[str(N)] = row
@@ -470,13 +473,14 @@ def bench_prony_speedup(plan: BenchPlan) -> dict:
     """Prony recursion vs exact convolution on the same scene and (about) the same steps.
 
     The step is set so that the run takes the requested number of steps (the radius
-    control is off: ``da_max`` huge, so both integrators take the same fixed steps). The
+    control is off: ``da_max`` huge, so both integrators take the same fixed steps; uniform
+    mesh, no second error-check solve). The
     speed-up is the ratio of wall time per step (whole runs, setup included).
     """
     from .scene import Numerics, Scene
     from .solver import simulate
     scene = Scene(**plan.prony_scene)
-    base = dict(plan.prony_numerics)
+    base = existing({"mesh": "uniform", "pull_off_rtol": 0.0, **plan.prony_numerics})
     probe = simulate(scene, Numerics(**base, step=0.1))
     travel = probe.steps * 0.1                     # indentation to pull-off, units of h0
     out = {}

@@ -31,7 +31,8 @@ from kernels.influence import assemble_unit, load_weights
 from . import units
 from .materials import SLS, MPLRetardation
 from .scene import Scene
-from .solver import crack_speed_at, jkr_gap_guess, refine_minimum
+from .initial import jkr_gap_guess
+from .postprocess import crack_speed_at, refine_minimum
 
 #: Newton tolerance on the gap, in units of h0 (max norm of the residual)
 TOL = 1e-8
