@@ -102,14 +102,31 @@ WOODBURY_ETA = 0.02
 WOODBURY_MAX = 96
 
 
+#: The Jacobian cache is a tuple of arrays (Numba passes it unpacked); its parts by position:
+CACHE_INVERSE = 0      # Jinv (N, N): inverse of J_b = I - C_b A diag(d_b)
+CACHE_D_BASE = 1       # d_b (N): the stiffness sigma'(h_b) Jinv was built with
+CACHE_COLUMNS = 2      # W (N, kmax): columns J_b^-1 A[:, i] of the corrected nodes
+CACHE_SLOT_OF = 3      # slot_of (N): slot of a corrected node in W, or -1
+CACHE_NODE_OF = 4      # node_of (kmax): node of each slot
+CACHE_STATE = 5        # state (3, int64), indexed by the STATE_* constants
+CACHE_C_BASE = 6       # c_base (2, float), indexed by the CBASE_* constants
+#: state[STATE_VALID]: 1 when Jinv holds a factorization, 0 to refactorize at the next solve
+STATE_VALID = 0
+#: state[STATE_SLOTS]: slots of W in use
+STATE_SLOTS = 1
+#: state[STATE_MERGES]: rank-k merges since the last factorization
+STATE_MERGES = 2
+#: c_base[CBASE_CEFF]: C_eff of the factorization (a step of another size refactorizes)
+CBASE_CEFF = 0
+#: c_base[CBASE_ETA]: relative stiffness change above which a node is corrected
+CBASE_ETA = 1
+
+
 def new_jacobian_cache(N, kmax=WOODBURY_MAX, eta=WOODBURY_ETA):
     """Work arrays that carry a factorized Jacobian and its low-rank corrections between steps.
 
-    Returns (Jinv, d_base, W, slot_of, node_of, state, c_base): ``Jinv`` (N, N) inverse of
-    J_b = I - C_b A diag(d_b); ``d_base`` (N) the stiffness d_b = sigma'(h_b) it was built
-    with; ``W`` (N, kmax) columns J_b^-1 A[:, i] of the corrected nodes, ``slot_of`` (N)
-    their slot or -1 and ``node_of`` (kmax) the inverse map; ``state`` = [valid, slots used,
-    merges since the last factorization]; ``c_base`` = [C_b, eta].
+    Returns the tuple (Jinv, d_base, W, slot_of, node_of, state, c_base), positions named by
+    the CACHE_* constants, ``state`` indexed by STATE_*, ``c_base`` by CBASE_*.
     """
     kmax = min(int(kmax), N)
     return (np.empty((N, N)), np.zeros(N), np.empty((N, kmax)), np.full(N, -1, np.int64),
@@ -118,7 +135,7 @@ def new_jacobian_cache(N, kmax=WOODBURY_MAX, eta=WOODBURY_ETA):
 
 def invalidate(cache):
     """Mark the factorization in ``cache`` stale: the next solve refactorizes."""
-    cache[5][0] = 0
+    cache[CACHE_STATE][STATE_VALID] = 0
 
 
 @njit(cache=True)
@@ -170,10 +187,10 @@ def factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base):
     Jinv[:, :] = np.linalg.inv(J)
     for i in range(N):
         slot_of[i] = -1
-    state[0] = 1
-    state[1] = 0
-    state[2] = 0
-    c_base[0] = ceff
+    state[STATE_VALID] = 1
+    state[STATE_SLOTS] = 0
+    state[STATE_MERGES] = 0
+    c_base[CBASE_CEFF] = ceff
 
 
 @njit(cache=True)
@@ -185,9 +202,9 @@ def merge_corrections(d, Jinv, d_base, W, slot_of, node_of, state, c_base):
     freed. Costs a k x k solve with N right-hand sides and one N x k x N product, about a
     fifth of a new inverse for k ~ 100 at N = 500.
     """
-    k = state[1]
+    k = state[STATE_SLOTS]
     N = Jinv.shape[0]
-    ceff = c_base[0]
+    ceff = c_base[CBASE_CEFF]
     nodes = node_of[:k].copy()
     delta = np.empty(k)
     for b in range(k):
@@ -209,8 +226,8 @@ def merge_corrections(d, Jinv, d_base, W, slot_of, node_of, state, c_base):
     for b in range(k):
         d_base[nodes[b]] = d[nodes[b]]
         slot_of[nodes[b]] = -1
-    state[1] = 0
-    state[2] += 1
+    state[STATE_SLOTS] = 0
+    state[STATE_MERGES] += 1
 
 
 @njit(cache=True)
@@ -241,7 +258,7 @@ def newton_direction(F, d, A, ceff, eta, Jinv, d_base, W, slot_of, node_of, stat
             new[m] = S[a]
             m += 1
     if m > 0:
-        if state[1] + m > kmax:
+        if state[STATE_SLOTS] + m > kmax:
             return np.empty(0), False
         cols = np.empty((N, m))
         for r in range(N):
@@ -249,8 +266,8 @@ def newton_direction(F, d, A, ceff, eta, Jinv, d_base, W, slot_of, node_of, stat
                 cols[r, b] = A[r, new[b]]
         Wn = Jinv @ cols
         for b in range(m):
-            slot = state[1]
-            state[1] += 1
+            slot = state[STATE_SLOTS]
+            state[STATE_SLOTS] += 1
             for r in range(N):
                 W[r, slot] = Wn[r, b]
             slot_of[new[b]] = slot
@@ -298,26 +315,26 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, nod
     norm = residual(h, g, A, ceff, H, h0, c, sig, w, F)
     if norm <= tol:
         return True
-    if state[0] == 0 or abs(ceff - c_base[0]) > 1e-12 * abs(ceff):
+    if state[STATE_VALID] == 0 or abs(ceff - c_base[CBASE_CEFF]) > 1e-12 * abs(ceff):
         factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
         stats[STAT_FACTOR] += 1
     fresh = True
     for it in range(max_iter):
         stats[STAT_ITER] += 1
         lj_traction_and_stiffness(h, h0, c, sig, d)
-        dh, ok = newton_direction(F, d, A, ceff, c_base[1], Jinv, d_base, W, slot_of, node_of,
+        dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of, node_of,
                                  state, stats)
-        if not ok and state[2] < MAX_MERGES and state[1] > 0:
+        if not ok and state[STATE_MERGES] < MAX_MERGES and state[STATE_SLOTS] > 0:
             # the correction set is full: fold it into the inverse and try again
             merge_corrections(d, Jinv, d_base, W, slot_of, node_of, state, c_base)
             stats[STAT_MERGES] += 1
-            dh, ok = newton_direction(F, d, A, ceff, c_base[1], Jinv, d_base, W, slot_of,
+            dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of,
                                       node_of, state, stats)
         if not ok:
             factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
             stats[STAT_FACTOR] += 1
             stats[STAT_REFACTOR_OVERFLOW] += 1
-            dh, ok = newton_direction(F, d, A, ceff, c_base[1], Jinv, d_base, W, slot_of,
+            dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of,
                                       node_of, state, stats)
         lam = positive_step(h, dh)
         # backtracking on the merit |F|_2 (Newton directions descend it); the max norm
@@ -536,7 +553,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times,
                     node_of, state, c_base, stats)
         if not ok:
             stats[STAT_FAILED_SOLVES] += 1
-            state[0] = 0
+            state[STATE_VALID] = 0
             easy = 0
             if dd > max(dd_min, SNAP_STEP_FRACTION * step_max * h0) * 1.0001:
                 dd = max(0.5 * dd, dd_min)

@@ -145,11 +145,13 @@ class Numerics:
         Largest graded mesh accepted; a scene whose crack band needs more nodes (large a0
         at a large Tabor parameter) is refused with the count it needs.
     pull_off_rtol : float
-        Tolerance of the error indicator: every scene is solved a second time on a mesh of
-        half the resolution (half the band resolution, or half the nodes), and a result
-        whose pull-off moves by more than this fraction is not ``ok`` (``failed`` with the
-        reason "unresolved: ..."); ``Result.error_estimate`` holds the change. 0 skips the
-        check (then ``error_estimate`` is NaN).
+        Tolerance of the error indicator ``Result.error_estimate``: the pull-off error
+        expected from the crack-band resolution, 0.3 (spacing/l0)^2 (a bound of the measured
+        convergence); where it exceeds a quarter of this tolerance the scene is solved a
+        second time on a mesh of half the resolution (half the band resolution, or half the
+        nodes) and the pull-off change is the indicator. A result whose indicator exceeds
+        the tolerance is not ``ok`` (``failed``, reason "unresolved: ..."). 0 skips the
+        indicator (then ``error_estimate`` is NaN).
     domain : float or None
         Mesh radius in a_ref units. ``None`` (default) chooses it from the scene: large
         enough that the gap at the mesh edge is ``tail_gap`` h0 at the start of unloading,
@@ -309,9 +311,10 @@ class Result:
     nodes_used : int
         Number of mesh nodes.
     error_estimate : float
-        |pull-off change| / pull-off between this solve and one on a mesh of half the
-        resolution (NaN when not checked; see ``Numerics.pull_off_rtol``). For a
-        second-order discretization the error of this solve is about a third of it.
+        Relative pull-off error indicator: 0.3 (spacing/l0)^2, or, where that is not well
+        below ``Numerics.pull_off_rtol``, |pull-off change| / pull-off against a solve on a
+        mesh of half the resolution (about three times this solve's error for a
+        second-order discretization). NaN when not checked.
     wall_s : float
         Wall-clock time of the run in seconds.
     trajectory : dict of arrays

@@ -26,12 +26,17 @@ def _dense_jacobian(A, h, h0, c, ceff):
     return np.eye(h.size) - ceff * A * d[None, :], d
 
 
+def _factorize(h, A, ceff, h0, c, cache):
+    ks.factorize(h, A, ceff, h0, c, cache[ks.CACHE_INVERSE], cache[ks.CACHE_D_BASE],
+                 cache[ks.CACHE_SLOT_OF], cache[ks.CACHE_STATE], cache[ks.CACHE_C_BASE])
+
+
 @pytest.mark.parametrize("moved", [3, 25])
 def test_woodbury_newton_step_equals_dense_solve(moved):
     A, h, h0, c, rng = _problem()
     ceff = 0.7
     cache = ks.new_jacobian_cache(h.size, kmax=40, eta=0.0)      # eta = 0: exact corrections
-    ks.factorize(h, A, ceff, h0, c, cache[0], cache[1], cache[3], cache[5], cache[6])
+    _factorize(h, A, ceff, h0, c, cache)
     # the stiffness moves at a few nodes (the crack tip region)
     h2 = h.copy()
     idx = rng.choice(h.size, moved, replace=False)
@@ -49,14 +54,14 @@ def test_merged_corrections_give_the_inverse_of_the_new_jacobian():
     A, h, h0, c, rng = _problem(seed=2)
     ceff = 0.55
     cache = ks.new_jacobian_cache(h.size, kmax=h.size, eta=0.0)
-    ks.factorize(h, A, ceff, h0, c, cache[0], cache[1], cache[3], cache[5], cache[6])
+    _factorize(h, A, ceff, h0, c, cache)
     h2 = h * (1.0 + 0.2 * rng.random(h.size))
     J, d = _dense_jacobian(A, h2, h0, c, ceff)
     stats = np.zeros(ks.N_STATS, np.int64)
     _, ok = ks.newton_direction(np.ones(h.size), d, A, ceff, 0.0, *cache[:6], stats)
-    assert ok and cache[5][1] == h.size                    # every node corrected
+    assert ok and cache[ks.CACHE_STATE][ks.STATE_SLOTS] == h.size                    # every node corrected
     ks.merge_corrections(d, *cache)
-    np.testing.assert_allclose(cache[0] @ J, np.eye(h.size), atol=1e-9)
+    np.testing.assert_allclose(cache[ks.CACHE_INVERSE] @ J, np.eye(h.size), atol=1e-9)
 
 
 def test_newton_solves_the_discrete_equilibrium():
