@@ -287,7 +287,7 @@ def plot_pareto(rows: list[dict], path: str | Path, references: dict | None = No
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     markers = {"fast": "s", "balanced": "D", "accurate": "^"}
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5), constrained_layout=True)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.5), layout="constrained")
     floor = 1e-7
     for ax, key, title in ((axes[0], "err_pull_off", "pull-off"),
                            (axes[1], "err_crack_speed", "crack speed")):
@@ -322,7 +322,7 @@ def plot_pareto(rows: list[dict], path: str | Path, references: dict | None = No
         labels.append(f"preset {name}")
     handles.append(plt.Line2D([], [], ls=":", color="k"))
     labels.append("reference uncertainty")
-    axes[0].legend(handles, labels, fontsize=8, loc="lower left")
+    fig.legend(handles, labels, fontsize=9, loc="outside lower center", ncol=len(labels))
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
