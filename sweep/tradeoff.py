@@ -66,6 +66,8 @@ GRADED = {"band_resolution": [6.0, 9.0, 16.0, 24.0, 36.0], "step": [0.5, 0.2, 0.
 GRADED_ONE_AT_A_TIME = {"grading": [1.05, 1.2, 1.3], "pull_off_rtol": [0.0]}
 #: exact hereditary integral instead of the Prony recursion (O(steps^2 N): coarse steps only)
 EXACT_POINTS = [dict(nodes=300, step=0.25, exact=True), dict(nodes=500, step=0.1, exact=True)]
+#: the exact points are pinned to a uniform mesh and one solve, where those fields exist
+EXACT_PINNED = dict(mesh="uniform", pull_off_rtol=0.0)
 QUICK_GRID = [dict(nodes=200, step=0.5, prony_rtol=1e-2), dict(nodes=300, step=0.25),
               dict(nodes=300, step=0.25, exact=True)]
 
@@ -108,7 +110,7 @@ def grid(quick: bool = False, base: str = "balanced") -> list[dict]:
         for k, values in ONE_AT_A_TIME.items():
             if k in have:
                 points += [(None, {k: v}) for v in values]
-        points += [(None, p) for p in EXACT_POINTS]
+        points += [(None, {**existing(EXACT_PINNED), **p}) for p in EXACT_POINTS]
     out, seen = [], set()
     for label, ov in points:
         num = to_numerics(ov, base)
@@ -199,8 +201,11 @@ def reference_for(name: str, scene: dict, refs: dict, fallback: Numerics | None 
 
 # ---------------------------------------------------------------------- the trade
 
-def run_tradeoff(quick: bool = False, repeat: int = 1, progress=print) -> dict:
-    """Run the grid on the reference scenes; rows with errors against the references."""
+def run_tradeoff(quick: bool = False, repeat: int = 1, progress=print,
+                 partial: str | Path | None = None) -> dict:
+    """Run the grid on the reference scenes; rows with errors against the references.
+    With ``partial``, the table so far is rewritten there after each scene (a long run
+    that is stopped keeps its finished scenes)."""
     from .solver import simulate, warm_up
     warm_up()
     refs = load_references()
@@ -230,6 +235,8 @@ def run_tradeoff(quick: bool = False, repeat: int = 1, progress=print) -> dict:
             progress(f"{name:20s} {p['label']:40s} {best.status:6s} "
                      f"err {row['err_pull_off']:.2e} / {row['err_crack_speed']:.2e} "
                      f"{best.wall_s:.2f} s")
+        if partial:
+            write_table(rows, partial)
     return {"rows": rows, "references": used_refs, "presets": suggest_presets(rows)}
 
 
@@ -331,8 +338,9 @@ def write_tradeoff(out_dir: str | Path, quick: bool = False, repeat: int = 1,
                    progress=print) -> dict:
     """Run the trade and write table.csv, pareto.png and presets.json into ``out_dir``."""
     t0 = time.perf_counter()
-    report = run_tradeoff(quick=quick, repeat=repeat, progress=progress)
     out = Path(out_dir)
+    report = run_tradeoff(quick=quick, repeat=repeat, progress=progress,
+                          partial=out / "table.csv")
     write_table(report["rows"], out / "table.csv")
     plot_pareto(report["rows"], out / "pareto.png", report["references"])
     meta = {"quick": quick, "wall_s": time.perf_counter() - t0,
