@@ -94,7 +94,8 @@ def grid(quick: bool = False, base: str = "balanced") -> list[dict]:
     have = numerics_fields()
     points = [(name, {"preset": name}) for name in (["fast"] if quick else PRESETS)]
     if quick:
-        points += [(None, p) for p in QUICK_GRID]
+        points += [(None, {**existing(EXACT_PINNED), **p} if p.get("exact") else p)
+                   for p in QUICK_GRID]
     else:
         graded = "mesh" in have
         points += [(None, {**({"mesh": "uniform"} if graded else {}), **p})
