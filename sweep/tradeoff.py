@@ -217,6 +217,8 @@ def run_tradeoff(quick: bool = False, repeat: int = 1, progress=print,
         ref = reference_for(name, sdict, refs, Numerics.preset("fast") if quick else None)
         used_refs[name] = ref
         scene = Scene(**sdict)
+        simulate(scene, to_numerics({"preset": "fast" if quick else "balanced"}))  # untimed:
+        # fills the per-process caches (Prony series, unit influence matrix) of this scene
         for p in points:
             num = to_numerics(p["overrides"])
             best = None
