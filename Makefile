@@ -9,13 +9,15 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow coverage-kernels bench bench-convergence clean \
-        threshold vr fig3 figures report reproduce pdms agreement
+.PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
+        tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms \
+        agreement
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
 	@echo "make test   - create/update .venv and run the test suite"
-	@echo "make bench  - speed benchmarks (JSON in results/bench/)"
+	@echo "make bench  - speed benchmarks of issue 9 (results/bench.json, ~10 min)"
+	@echo "make tradeoff [QUICK=1] - accuracy vs time over a grid of numerics (results/tradeoff/)"
 	@echo "make coverage-kernels - kernel tests with NUMBA_DISABLE_JIT=1 under coverage"
 	@echo "make reproduce - the paper's campaigns, fits, figures and results/REPORT.md"
 	@echo "               (make threshold | vr | fig3 | figures | report; QUICK=1: thinned grids)"
@@ -53,6 +55,16 @@ coverage-kernels: $(STAMP)
 	  --cov-report=term-missing $(KERNEL_TESTS) -k "not uniform_pressure and not hertz"
 
 bench: $(STAMP)
+	$(BIN)/python -m sweep.benchmarks all --out results/bench.json
+
+tradeoff: $(STAMP)
+	$(BIN)/python -m sweep.benchmarks tradeoff $(if $(filter 1,$(QUICK)),--quick) --out results/tradeoff
+
+# converged references of the tradeoff and vs-numpy scenes (configs/references.json; slow)
+bench-reference: $(STAMP)
+	$(BIN)/python -m sweep.benchmarks reference
+
+bench-detail: $(STAMP)
 	$(BIN)/python -m sweep.benchmarks scene --out results/bench/scene.json
 	$(BIN)/python -m sweep.benchmarks presets --out results/bench/presets.json
 	$(BIN)/python -m sweep.benchmarks scheduler --out results/bench/scheduler.json

@@ -19,18 +19,24 @@ Reported: parallel efficiency ``t_j1 / (2 t_j2)`` and per-scene overhead
 """
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 import os
 import platform
 import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
 
 import click
 import numpy as np
+
+from .tradeoff import (REFERENCE_OVERRIDES, REFERENCES, TRADEOFF_SCENES, VS_NUMPY_SCENES,
+                       compute_reference, existing, write_tradeoff)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -367,6 +373,320 @@ def bench_convergence(mu: float = 6.0, nodes=(1000, 1500, 2000), domain: float =
             "rows": rows}
 
 
+# ------------------------------------------------------------------ make bench: bench.json
+
+@dataclass(frozen=True)
+class BenchPlan:
+    """What ``bench_all`` measures (the defaults are ``make bench``; :meth:`tiny` is a
+    seconds-long configuration for tests of the harness)."""
+
+    matvec_nodes: tuple = (250, 500, 1000)
+    matvec_scene: dict = field(default_factory=lambda: dict(PAPER_SCENE))
+    matvec_preset: str = "balanced"
+    prony_steps: tuple = (500, 2000, 8000)
+    prony_scene: dict = field(default_factory=lambda: dict(n=0.8, k=0.1, mu=3.24, a0=2.0,
+                                                           rate=100.0))
+    prony_numerics: dict = field(default_factory=lambda: dict(nodes=100, da_max=1e6,
+                                                              tol=1e-9, prony_rtol=1e-4))
+    compile: bool = True
+    campaign: str = "configs/threshold.yaml"
+    campaign_stride: int = 20
+    jobs: int = 2
+    vs_numpy_scenes: dict = field(default_factory=lambda: dict(VS_NUMPY_SCENES))
+    engine_numerics: dict = field(default_factory=lambda: {
+        "fast": {"preset": "fast"}, "balanced": {"preset": "balanced"}})
+    plain_ladder: tuple = ((150, 0.25), (250, 0.25), (250, 0.1), (400, 0.1), (600, 0.1),
+                           (600, 0.05), (900, 0.05))
+    plain_time_limit_s: float = 90.0
+    reference_fallback: dict | None = None
+    repeat: int = 2
+
+    @classmethod
+    def tiny(cls) -> "BenchPlan":
+        small = dict(n=0.8, k=0.5, mu=3.24, delta0=1.0, rate=10.0)
+        once = dict(mesh="uniform", pull_off_rtol=0.0)   # one solve per scene, where they exist
+        return cls(matvec_nodes=(60,), matvec_scene=dict(n=0.8, k=0.5, mu=3.24, a0=1.2,
+                                                         rate=10.0),
+                   matvec_preset="fast", prony_steps=(20,),
+                   prony_scene=dict(n=0.8, k=0.5, mu=3.24, a0=1.2, rate=10.0),
+                   prony_numerics=dict(nodes=60, domain=2.5, da_max=1e6, tol=1e-8,
+                                       prony_rtol=1e-2),
+                   compile=False, campaign="configs/smoke.yaml",
+                   campaign_stride=4, jobs=1,
+                   vs_numpy_scenes={"tiny": small},
+                   engine_numerics={"fast": existing(dict(nodes=60, domain=2.5, step=0.5,
+                                                          prony_rtol=1e-2, **once))},
+                   plain_ladder=((60, 0.5),), plain_time_limit_s=30.0,
+                   reference_fallback=existing(dict(nodes=80, domain=2.5, step=0.25, **once)),
+                   repeat=1)
+
+
+def _numerics(overrides: dict):
+    from .tradeoff import to_numerics
+    return to_numerics(overrides)
+
+
+def step_cost(scene, numerics, repeat: int = 2) -> dict:
+    """Marginal wall time per time step: a full run and the same run cut at 10 steps
+    (``max_steps=10``, so setup and the first steps are alike), differenced.
+
+    Uses only the public API (``Result.wall_s``, ``Result.steps``): setup (mesh, Prony
+    series, relaxed start) cancels in the difference.
+    """
+    from .solver import simulate
+    full = min((simulate(scene, numerics) for _ in range(repeat)), key=lambda r: r.wall_s)
+    cut_num = dataclasses.replace(numerics, max_steps=10)
+    cut = min((simulate(scene, cut_num) for _ in range(repeat)), key=lambda r: r.wall_s)
+    steps = full.steps - cut.steps
+    per_step = (full.wall_s - cut.wall_s) / steps if steps > 0 else math.nan
+    return {"status": full.status, "steps": full.steps, "wall_s": full.wall_s,
+            "wall_10_steps_s": cut.wall_s, "step_s": per_step,
+            "newton_iterations_per_step": full.newton_iterations / max(full.steps, 1),
+            "nodes": _nodes_used(full)}
+
+
+def _nodes_used(res) -> int:
+    """Mesh nodes of a result (a graded engine may report them; else Numerics.nodes)."""
+    for name in ("nodes", "nodes_used", "mesh_nodes"):
+        v = getattr(res, name, None)
+        if isinstance(v, (int, np.integer)) and v > 0:
+            return int(v)
+    return int(res.numerics.nodes)
+
+
+def bench_step_over_matvec(plan: BenchPlan) -> dict:
+    """Time per step over the time of one dense N x N mat-vec at the mesh's N."""
+    from .scene import Numerics, Scene
+    scene = Scene(**plan.matvec_scene)
+    out = {}
+    for N in plan.matvec_nodes:
+        num = Numerics.preset(plan.matvec_preset, **existing(dict(nodes=N, pull_off_rtol=0.0)))
+        row = step_cost(scene, num, plan.repeat)
+        row["matvec_s"] = matvec_seconds(row["nodes"])
+        row["ratio"] = row["step_s"] / row["matvec_s"]
+        out[str(N)] = row
+    return out
+
+
+def bench_prony_speedup(plan: BenchPlan) -> dict:
+    """Prony recursion vs exact convolution on the same scene and (about) the same steps.
+
+    The step is set so that the run takes the requested number of steps (the radius
+    control is off: ``da_max`` huge, so both integrators take the same fixed steps; uniform
+    mesh, no second error-check solve). The
+    speed-up is the ratio of wall time per step (whole runs, setup included).
+    """
+    from .scene import Numerics, Scene
+    from .solver import simulate
+    scene = Scene(**plan.prony_scene)
+    base = existing({"mesh": "uniform", "pull_off_rtol": 0.0, **plan.prony_numerics})
+    probe = simulate(scene, Numerics(**base, step=0.1))
+    travel = probe.steps * 0.1                     # indentation to pull-off, units of h0
+    out = {}
+    for target in plan.prony_steps:
+        step = travel / target
+        num = Numerics(**base, step=step, min_step=min(1e-4, step))
+        prony = min((simulate(scene, num) for _ in range(plan.repeat)), key=lambda r: r.wall_s)
+        exact = simulate(scene, dataclasses.replace(num, exact=True))
+        out[str(target)] = {
+            "step_h0": step, "prony_steps": prony.steps, "exact_steps": exact.steps,
+            "prony_wall_s": prony.wall_s, "exact_wall_s": exact.wall_s,
+            "prony_status": prony.status, "exact_status": exact.status,
+            "pull_off_rel_diff": prony.pull_off / exact.pull_off - 1.0,
+            "speedup": (exact.wall_s / max(exact.steps, 1)) / (prony.wall_s / max(prony.steps, 1))}
+    return out
+
+
+def campaign_subset(config, stride: int):
+    """Every ``stride``-th scene of a sweep config (its task order), as a config whose grid
+    lists them one by one: a sample with the campaign's own mix of n, a0 and rate."""
+    from .config import AXES, config_from_dict
+
+    data = config.to_dict()
+    picked = [scene.to_dict() for _, scene in config.tasks()[::max(int(stride), 1)]]
+    grid = [{k: v for k, v in d.items() if k in AXES and v is not None} for d in picked]
+    return config_from_dict({**data, "grid": grid, "name": f"{config.name}_every{stride}"})
+
+
+def bench_campaign(plan: BenchPlan) -> dict:
+    """Scenes per minute of the campaign's numerics on a sample of its grid (every
+    ``campaign_stride``-th scene), at -j1 and -j{jobs} with warm workers (a first, untimed
+    sweep of the sample's first scenes starts them and loads their caches)."""
+    from .config import config_from_dict, load_config
+    from .scheduler import run_sweep
+    from .solver import warm_up
+    from .store import load
+
+    cfg = load_config(ROOT / plan.campaign)
+    sub_cfg = campaign_subset(cfg, plan.campaign_stride)
+    tasks = sub_cfg.tasks()
+    n = len(tasks)
+    warm_up()
+    tmp = Path(tempfile.mkdtemp(prefix="bench-campaign-"))
+    walls = {}
+    t = time.perf_counter()
+    rep = run_sweep(sub_cfg, jobs=1, out=tmp / "j1.h5", progress="none", resume=False)
+    walls["j1"] = time.perf_counter() - t
+    if plan.jobs > 1:
+        data = sub_cfg.to_dict()
+        warm = config_from_dict({**data, "grid": data["grid"][:2 * plan.jobs], "name": "warm"})
+        run_sweep(warm, jobs=plan.jobs, out=tmp / "warm.h5", progress="none", resume=False)
+    t = time.perf_counter()
+    repj = run_sweep(sub_cfg, jobs=plan.jobs, out=tmp / "jN.h5", progress="none", resume=False)
+    walls[f"j{plan.jobs}"] = time.perf_counter() - t
+    df = load(tmp / "jN.h5")
+    statuses = df.status.value_counts().to_dict()
+    return {"config": plan.campaign, "stride": plan.campaign_stride, "scenes": n,
+            "campaign_scenes": len(cfg.tasks()),
+            "numerics": sub_cfg.numerics.to_dict(), "ran": [rep.ran, repj.ran],
+            "status_counts": {str(k): int(v) for k, v in statuses.items()},
+            "scene_wall_s": {"mean": float(df.wall_s.mean()), "max": float(df.wall_s.max())},
+            "wall_s": walls, "jobs": plan.jobs,
+            "scenes_per_minute_j1": 60.0 * n / walls["j1"],
+            f"scenes_per_minute_j{plan.jobs}": 60.0 * n / walls[f"j{plan.jobs}"],
+            "campaign_minutes_estimate": len(cfg.tasks()) * walls[f"j{plan.jobs}"] / n / 60.0,
+            "parallel_speedup": walls["j1"] / walls[f"j{plan.jobs}"],
+            "loadavg": os.getloadavg()}
+
+
+def _bracket(engine_err: float, plain_rows: list[dict]) -> dict:
+    """The plain runs on either side of the engine's error: the most accurate one whose
+    error is still >= the engine's (equal or worse: its time is a lower bound of what the
+    plain solver needs for the engine's accuracy) and the cheapest one at least as accurate."""
+    ok = [r for r in plain_rows if r["status"] == "ok" and math.isfinite(r["err_pull_off"])]
+    worse = [r for r in ok if r["err_pull_off"] >= engine_err]
+    better = [r for r in ok if r["err_pull_off"] < engine_err]
+    return {"equal_or_worse": min(worse, key=lambda r: r["err_pull_off"]) if worse else None,
+            "better": min(better, key=lambda r: r["wall_s"]) if better else None}
+
+
+def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
+    """Engine vs the plain numpy solver (:mod:`sweep.plain_solver`) on the issue's scenes.
+
+    Errors are relative pull-off errors against the stored converged reference of each scene
+    (see :mod:`sweep.tradeoff`). The engine's time is the best of ``repeat`` calls in this
+    process (per-scene caches warm, as in a sweep); its first call is reported too. The plain
+    solver climbs its ladder of (N, step) until it is more accurate than every engine
+    configuration (or a run exceeds ``plain_time_limit_s``). ``ratio`` = plain time at equal
+    or worse error / engine time: a lower bound of the speed-up at equal accuracy;
+    ``ratio_better`` uses the cheapest plain run at least as accurate (an upper estimate).
+    """
+    from .plain_solver import plain_unload
+    from .scene import Numerics, Scene
+    from .solver import simulate
+    from .tradeoff import load_references, reference_for, relative_error
+
+    refs = load_references()
+    fallback = Numerics(**plan.reference_fallback) if plan.reference_fallback else None
+    out = {}
+    for name, sdict in plan.vs_numpy_scenes.items():
+        scene = Scene(**sdict)
+        ref = reference_for(name, sdict, refs, fallback)
+        engine = {}
+        for label, ov in plan.engine_numerics.items():
+            num = _numerics(ov)
+            runs = [simulate(scene, num) for _ in range(max(plan.repeat, 1))]
+            best = min(runs, key=lambda r: r.wall_s)
+            engine[label] = {"wall_s": best.wall_s, "first_call_wall_s": runs[0].wall_s,
+                             "status": best.status, "pull_off": best.pull_off,
+                             "err_pull_off": relative_error(best.pull_off, ref["pull_off"]),
+                             "steps": best.steps, "nodes": _nodes_used(best)}
+            progress(f"vs_numpy {name} engine {label}: {best.wall_s:.3f} s, "
+                     f"err {engine[label]['err_pull_off']:.2e}")
+        target = min(e["err_pull_off"] for e in engine.values())
+        plain = []
+        for N, step in plan.plain_ladder:
+            pr = plain_unload(scene, N, ref["domain"], step)
+            row = {"nodes": N, "step": step, "status": pr.status, "reason": pr.reason,
+                   "pull_off": pr.pull_off, "wall_s": pr.wall_s,
+                   "influence_s": pr.influence_s, "steps": pr.steps,
+                   "factorizations": pr.factorizations,
+                   "err_pull_off": relative_error(pr.pull_off, ref["pull_off"])}
+            plain.append(row)
+            progress(f"vs_numpy {name} plain N={N} step={step}: {pr.status} "
+                     f"{pr.wall_s:.2f} s, err {row['err_pull_off']:.2e}")
+            if row["err_pull_off"] < target or pr.wall_s > plan.plain_time_limit_s:
+                break
+        for label, e in engine.items():
+            b = _bracket(e["err_pull_off"], plain)
+            w, bt = b["equal_or_worse"], b["better"]
+            e["plain_equal_or_worse"] = w
+            e["plain_better"] = bt
+            e["ratio"] = w["wall_s"] / e["wall_s"] if w else None
+            e["ratio_better"] = bt["wall_s"] / e["wall_s"] if bt else None
+        out[name] = {"scene": sdict, "reference": {k: ref.get(k) for k in (
+                         "pull_off", "source", "uncertainty_pull_off", "domain")},
+                     "engine": engine, "plain_ladder": plain}
+    return out
+
+
+def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
+    """Every figure of ``results/bench.json`` (issue 9, item 7)."""
+    from .solver import warm_up
+    plan = plan or BenchPlan()
+    t0 = time.perf_counter()
+    report = {"kind": "bench", "machine": {**_machine(), "loadavg_before": os.getloadavg()},
+              "plan": dataclasses.asdict(plan)}
+    report["compile_s"] = None
+    if plan.compile:
+        c = compile_seconds()
+        report["compile_s"] = {k: v["warm_up_s"] for k, v in c.items()}
+        report["compile_detail"] = c
+    progress(f"compile_s: {report['compile_s']}")
+    warm_up()
+    som = bench_step_over_matvec(plan)
+    report["step_over_matvec"] = {k: v["ratio"] for k, v in som.items()}
+    report["step_over_matvec_detail"] = som
+    progress(f"step_over_matvec: {report['step_over_matvec']}")
+    ps = bench_prony_speedup(plan)
+    report["prony_speedup"] = {k: v["speedup"] for k, v in ps.items()}
+    report["prony_speedup_detail"] = ps
+    progress(f"prony_speedup: {report['prony_speedup']}")
+    camp = bench_campaign(plan)
+    report["scenes_per_minute"] = camp[f"scenes_per_minute_j{plan.jobs}"]
+    report["parallel_speedup"] = camp["parallel_speedup"]
+    report["campaign_detail"] = camp
+    progress(f"scenes_per_minute: {report['scenes_per_minute']:.1f}, "
+             f"parallel_speedup {report['parallel_speedup']:.2f}")
+    vs = bench_vs_numpy(plan, progress)
+    report["vs_numpy"] = {name: {label: {"engine_s": e["wall_s"], "engine_err": e["err_pull_off"],
+                                         "numpy_s": (e["plain_equal_or_worse"] or {}).get("wall_s"),
+                                         "numpy_err": (e["plain_equal_or_worse"] or {}).get("err_pull_off"),
+                                         "ratio": e["ratio"]}
+                                 for label, e in d["engine"].items()}
+                         for name, d in vs.items()}
+    report["vs_numpy_detail"] = vs
+    report["machine"]["loadavg_after"] = os.getloadavg()
+    report["wall_s"] = time.perf_counter() - t0
+    report["definitions"] = {
+        "step_over_matvec": "marginal wall per step (full run minus the run cut at 10 steps, "
+                            "over the step difference) / median wall of one dense N x N "
+                            "mat-vec in Numba; scene PAPER_SCENE, preset matvec_preset at N nodes",
+        "prony_speedup": "exact-convolution wall per step / Prony wall per step, same scene, "
+                         "same fixed steps (radius control off), key = number of steps",
+        "compile_s": "warm_up() seconds in a fresh interpreter: cold = empty NUMBA_CACHE_DIR, "
+                     "cached = the same directory afterwards",
+        "scenes_per_minute": "the campaign's default numerics on every campaign_stride-th "
+                             "scene of its grid, run_sweep with jobs workers (warm), scenes "
+                             "per wall minute",
+        "parallel_speedup": "run_sweep wall at -j1 / at -j{jobs} (warm workers), same subset",
+        "vs_numpy": "per scene and engine configuration: engine wall (best of repeat, caches "
+                    "warm) and relative pull-off error vs the scene's converged reference; "
+                    "the plain numpy solver's most accurate ladder run whose error is still "
+                    ">= the engine's (numpy_s, numpy_err); ratio = numpy_s / engine_s, a lower "
+                    "bound of the speed-up at equal accuracy (details: vs_numpy_detail)",
+    }
+    return report
+
+
+def _git_commit() -> str | None:
+    try:
+        return subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
+                              text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
 def _write(report: dict, out: str | None) -> None:
     text = json.dumps(report, indent=2)
     if out:
@@ -419,6 +739,50 @@ def scene_cmd(repeat, compile_, out):
 def convergence_cmd(mu, nodes, out):
     """Mesh convergence of the elastic pull-off (spacing domain/(N-1), domain 5)."""
     _write(bench_convergence(mu=mu, nodes=tuple(int(x) for x in nodes.split(","))), out)
+
+
+@bench.command("all")
+@click.option("--tiny", is_flag=True, help="Seconds-long configuration (harness check).")
+@click.option("--out", default="results/bench.json", show_default=True, help="JSON report path.")
+def all_cmd(tiny, out):
+    """Every figure of issue 9: step/matvec, Prony speed-up, compile, campaign, vs numpy."""
+    report = bench_all(BenchPlan.tiny() if tiny else BenchPlan(),
+                       progress=lambda m: click.echo(m, err=True))
+    _write(report, out)
+
+
+@bench.command("reference")
+@click.option("--only", default=None, help="Comma-separated scene names (default: all).")
+@click.option("--out", default=str(REFERENCES), show_default=True)
+def reference_cmd(only, out):
+    """Converged references of the tradeoff and vs-numpy scenes (slow: minutes per scene)."""
+    path = Path(out)
+    data = json.loads(path.read_text()) if path.exists() else {"scenes": {}}
+    scenes = {**TRADEOFF_SCENES, **VS_NUMPY_SCENES}
+    names = only.split(",") if only else list(scenes)
+    for name in names:
+        if name not in scenes:
+            raise click.BadParameter(f"unknown scene {name!r} (allowed: {', '.join(scenes)})",
+                                     param_hint="--only")
+    for name in names:
+        ref = compute_reference(scenes[name])
+        ref["engine_commit"] = _git_commit()
+        data["scenes"][name] = ref
+        data["definition"] = ("pull_off, crack_speed: the engine with the accurate preset and "
+                              f"{REFERENCE_OVERRIDES}; uncertainty_*: relative difference to "
+                              "the accurate preset")
+        path.write_text(json.dumps(data, indent=2) + "\n")
+        click.echo(f"{name}: pull-off {ref['pull_off']:.8g} (+-{ref['uncertainty_pull_off']:.1e}),"
+                   f" crack speed {ref['crack_speed']:.6g}, {ref['wall_s']:.0f} s", err=True)
+
+
+@bench.command("tradeoff")
+@click.option("--quick", is_flag=True, help="A few points on two scenes (smoke test).")
+@click.option("--out", default="results/tradeoff", show_default=True, help="Output directory.")
+def tradeoff_cmd(quick, out):
+    """Accuracy vs wall time over a grid of numerics: table.csv, pareto.png, presets.json."""
+    report = write_tradeoff(out, quick=quick, progress=lambda m: click.echo(m, err=True))
+    click.echo(json.dumps(report["presets"], indent=2, default=str))
 
 
 @bench.command("presets")

@@ -1,0 +1,128 @@
+"""The measurement harness of issue 9: Pareto fronts, preset suggestion, the plain numpy
+solver against the engine's exact integrator, and the keys of bench.json (tiny plan).
+
+No timing is asserted anywhere: only the logic that turns timings into figures."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from sweep import Numerics, Scene, simulate
+from sweep.benchmarks import BenchPlan, _bracket, bench_all
+from sweep.plain_solver import plain_unload
+from sweep.tradeoff import (PRESETS, grid, numerics_fields, pareto_front, plot_pareto,
+                            relative_error, suggest_presets, to_numerics, write_table)
+
+
+def test_pareto_front_keeps_only_points_nothing_beats():
+    cost = [1.0, 2.0, 3.0, 4.0, 0.5, 2.5]
+    err = [1e-2, 1e-3, 2e-3, 1e-4, math.inf, 1e-3]
+    front = pareto_front(cost, err)
+    assert front == [0, 1, 3]            # 2 and 5 are beaten by 1; 4 failed (inf)
+    # brute force: a point is on the front iff no other point is <= in both and < in one
+    rng = np.random.default_rng(3)
+    c, e = rng.random(40), rng.random(40)
+    brute = sorted((i for i in range(40) if not any(
+        (c[j] <= c[i] and e[j] <= e[i] and (c[j] < c[i] or e[j] < e[i])) for j in range(40))),
+        key=lambda i: c[i])
+    assert pareto_front(c, e) == brute
+
+
+def test_relative_error_of_missing_values_is_infinite():
+    assert relative_error(1.01, 1.0) == pytest.approx(0.01)
+    assert relative_error(math.nan, 1.0) == math.inf
+    assert relative_error(None, 1.0) == math.inf
+
+
+def test_bracket_picks_plain_runs_on_either_side_of_the_engine_error():
+    rows = [{"status": "ok", "err_pull_off": e, "wall_s": w}
+            for e, w in ((5e-3, 0.1), (1e-3, 0.5), (2e-4, 2.0), (5e-5, 9.0))]
+    rows.append({"status": "failed", "err_pull_off": math.inf, "wall_s": 0.01})
+    b = _bracket(3e-4, rows)
+    assert b["equal_or_worse"]["err_pull_off"] == 1e-3     # closest from above
+    assert b["better"]["err_pull_off"] == 2e-4             # cheapest below
+    assert _bracket(1e-6, rows)["better"] is None
+    assert _bracket(1e-2, rows)["equal_or_worse"] is None
+
+
+def test_suggested_presets_are_cheapest_under_each_worst_case_target():
+    rows = []
+    for label, errs, wall in (("a", (1e-2, 2e-3), 0.1), ("b", (5e-4, 8e-4), 0.5),
+                              ("c", (5e-5, 9e-5), 3.0), ("d", (1e-5, math.inf), 0.2)):
+        for scene, e in zip(("s1", "s2"), errs):
+            rows.append({"scene": scene, "label": label, "err_pull_off": e,
+                         "err_crack_speed": e, "wall_s": wall})
+    rows.append({"scene": "s1", "label": "only_one_scene", "err_pull_off": 0.0,
+                 "err_crack_speed": 0.0, "wall_s": 0.0})
+    s = suggest_presets(rows, targets=(1e-2, 1e-3, 1e-4, 1e-6))["suggested"]
+    assert s["0.01"]["label"] == "a"
+    assert s["0.001"]["label"] == "b"
+    assert s["0.0001"]["label"] == "c"    # d fails on s2, "only_one_scene" is incomplete
+    assert s["1e-06"] is None
+    assert s["0.001"]["total_wall_s"] == pytest.approx(1.0)
+
+
+def test_grid_has_the_presets_first_and_only_existing_fields():
+    g = grid()
+    assert [p["label"] for p in g[:len(PRESETS)]] == list(PRESETS)
+    labels = [p["label"] for p in g]
+    assert len(labels) == len(set(labels))
+    have = numerics_fields() | {"preset"}
+    assert all(set(p["overrides"]) <= have for p in g)
+    dicts = [json.dumps(to_numerics(p["overrides"]).to_dict(), sort_keys=True) for p in g]
+    assert len(dicts) == len(set(dicts))                     # no duplicate numerics
+    assert any(to_numerics(p["overrides"]).exact for p in g)
+    assert len(grid(quick=True)) < len(g)
+
+
+def test_table_and_pareto_png_are_written(tmp_path):
+    rows = [{"scene": s, "label": lab, "err_pull_off": e, "err_crack_speed": 2 * e,
+             "wall_s": w, "status": "ok"}
+            for s in ("s1", "s2") for lab, e, w in (("fast", 1e-3, 0.1), ("x", 1e-4, 1.0),
+                                                    ("y", math.inf, 0.5))]
+    write_table(rows, tmp_path / "t.csv")
+    lines = (tmp_path / "t.csv").read_text().splitlines()
+    assert len(lines) == 1 + len(rows) and lines[0].startswith("scene,label")
+    plot_pareto(rows, tmp_path / "p.png", {"s1": {"uncertainty_pull_off": 1e-5}})
+    assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plain_solver_solves_the_same_discrete_problem_as_the_engine_exact_mode():
+    """Same mesh, domain, fixed steps and exact hereditary integral: the two solvers (chord
+    Newton in numpy, the engine's Woodbury Newton) must agree to the Newton tolerance."""
+    scene = Scene(n=0.8, k=0.5, mu=3.24, delta0=1.0, rate=10.0)
+    N, domain, step = 60, 2.5, 0.5
+    plain = plain_unload(scene, N, domain, step, tol=1e-10)
+    eng = simulate(scene, Numerics(nodes=N, domain=domain, step=step, exact=True,
+                                   da_max=1e6, tol=1e-10, mesh="uniform", pull_off_rtol=0.0))
+    assert plain.status == "ok" and eng.ok
+    assert plain.steps == eng.steps
+    assert plain.pull_off == pytest.approx(eng.pull_off, rel=1e-7)
+    assert plain.crack_speed == pytest.approx(eng.crack_speed, rel=1e-5)
+
+
+def test_plain_solver_needs_delta0():
+    with pytest.raises(ValueError, match="delta0"):
+        plain_unload(Scene(n=0.8, rate=1.0, a0=2.0), 60, 2.5, 0.5)
+
+
+def test_bench_json_keys_with_a_tiny_plan():
+    plan = BenchPlan.tiny()
+    rep = bench_all(plan, progress=lambda m: None)
+    json.dumps(rep, default=str)
+    assert set(rep["step_over_matvec"]) == {str(n) for n in plan.matvec_nodes}
+    assert set(rep["prony_speedup"]) == {str(n) for n in plan.prony_steps}
+    assert rep["compile_s"] is None                          # tiny: no fresh processes
+    assert rep["scenes_per_minute"] > 0 and rep["parallel_speedup"] > 0
+    assert set(rep["vs_numpy"]) == set(plan.vs_numpy_scenes)
+    for by_cfg in rep["vs_numpy"].values():
+        assert set(by_cfg) == set(plan.engine_numerics)
+        for v in by_cfg.values():
+            assert {"engine_s", "engine_err", "numpy_s", "numpy_err", "ratio"} <= set(v)
+            if v["ratio"] is not None:                        # plain at equal or worse error
+                assert v["numpy_err"] >= v["engine_err"]
+                assert v["ratio"] == pytest.approx(v["numpy_s"] / v["engine_s"])
+    d = rep["prony_speedup_detail"][str(plan.prony_steps[0])]
+    assert d["prony_steps"] == d["exact_steps"]               # same fixed steps
+    assert abs(d["pull_off_rel_diff"]) < 1e-2
