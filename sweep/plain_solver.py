@@ -13,7 +13,7 @@ converge to the same pull-off: the comparison is between algorithms, not between
 influence matrix depends only on N (it scales with the spacing) and is assembled once per N
 and cached, as a sweep would; :func:`plain_unload` reports its assembly time apart.
 
-Units: DESIGN.md section 2 (lengths a_ref, gaps and indentation d_ref, load pi dg R, time
+Units: docs/design.md section 2 (lengths a_ref, gaps and indentation d_ref, load pi dg R, time
 tau0); the sign convention of :mod:`kernels.solve` (F = h - g - A (C sigma(h) - H)).
 """
 from __future__ import annotations

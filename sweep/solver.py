@@ -32,7 +32,7 @@ from . import units
 from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
 from .postprocess import crack_speed_at, refine_minimum
-from .problem import Problem, Refused, lj_constants, material_of, prepare  # noqa: F401
+from .problem import Problem, Refused, lj_constants, material_of, prepare  # noqa: F401 (re-exported)
 from .scene import Numerics, Result, Scene
 
 #: Newton iterations per solve: a good step converges in 2-5 (quadratic predictor); a solve

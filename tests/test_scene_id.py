@@ -12,7 +12,6 @@ import dataclasses
 import shutil
 
 import h5py
-import pytest
 
 from tests import reference
 from sweep import Numerics, Scene, scene_id

@@ -194,6 +194,10 @@ def test_different_config_refused_and_file_untouched(tmp_path):
     st.finish()
     before = path.read_bytes()
     other = make(path, config_hash="h2")
+    # the same config text whose scenes hash differently: a preset's meaning changed
+    with pytest.raises(InputError, match="same config when its numerics meant other values"):
+        other.prepare(resume=True)
+    other.meta["config_text"] = "name: t2\n"
     with pytest.raises(InputError, match="different config.*--fresh.*--out"):
         other.prepare(resume=True)
     assert path.read_bytes() == before
