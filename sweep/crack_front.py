@@ -321,7 +321,6 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     # pinned phase: the edge stays at a0 until g(a0, delta) reaches Gamma(0)
     d1 = a0 * a0 - math.sqrt(2.0 * a0 * g_th) if g_th > 1.0 else delta0
     t1 = (d1 - delta0) / ddot
-    capped = [False]
 
     def delta_of(t):
         return delta0 + ddot * t

@@ -36,7 +36,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import units
-from .crack_front import (GentSchultzLaw, constant_gamma_pull_off, pb_law_for_scene, unload)
+from .crack_front import GentSchultzLaw, pb_law_for_scene, unload
 from .si import SIScene
 from .theory import A_PULL_OFF_FORCE, gent_schultz, paper_v_vs_r_fit, pb_gamma_eff
 
