@@ -218,7 +218,7 @@ def pb_vs_bem_figure(points: pd.DataFrame, comp: dict, out) -> Path:
         ax.set_title(f"{title}\nMPL scenes within 15 %: {100 * c['share_within_15pct']:.0f} % "
                      f"of {c['n_points']}, median error {100 * c['median_abs_error']:.1f} %",
                      fontsize=9)
-        ticks = [t for t in (1, 1.5, 2, 3, 5, 10, 15, 20, 30, 50, 100, 150) if lo <= t <= hi]
+        ticks = [t for t in (1, 1.5, 2, 3, 5, 10, 20, 30, 50, 100) if lo <= t <= hi]
         _plain_log_ticks(ax, x=ticks, y=ticks)
         ax.set_xlabel(r"$\hat\Gamma_{eff}$ Persson-Brener (eq. PBmodel2, $\alpha = \pi/9$)")
         ax.set_ylabel(r"$\hat\Gamma_{eff} = \hat P_{po}/1.5$ BEM")
