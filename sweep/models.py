@@ -123,20 +123,14 @@ def bem_nodes_needed(scene, numerics=None) -> int:
     import dataclasses
 
     from .mesh import scene_mesh
-    from .problem import auto_domain
+    from .problem import initial_estimates
     from .scene import Numerics
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
-    if scene.a0 is not None:
-        d_est = scene.a0**2 - math.sqrt(2.0 * scene.a0)
-    else:
-        d_est = scene.delta0
-    domain = numerics.domain if numerics.domain is not None else \
-        auto_domain(scene, numerics, d_est)
+    _, a_est, domain = initial_estimates(scene, numerics)
     l0 = units.l0_hat(scene.mu)
     if numerics.mesh == "uniform":
         return int(math.ceil(domain * numerics.zone_nodes / l0)) + 1
-    a_est = scene.a0 if scene.a0 is not None else max(d_est, 0.0) ** 0.5
     mesh = scene_mesh(dataclasses.replace(numerics, nodes=None), l0, a_est, domain,
                       pull_off_only=scene.stop == "pulloff")
     return mesh.nodes

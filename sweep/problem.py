@@ -144,6 +144,18 @@ class Problem:
         return 0 if self.scene.stop == "pulloff" else 1
 
 
+def initial_estimates(scene: Scene, numerics: Numerics) -> tuple[float, float, float]:
+    """(indentation, contact radius, mesh radius) a scene's mesh is sized from: the JKR
+    estimates of the initial state (d_ref, a_ref, a_ref) and the automatic (or given) domain."""
+    if scene.delta0 is not None:
+        d_est = scene.delta0
+    else:
+        d_est = scene.a0**2 - math.sqrt(2 * scene.a0)
+    a_est = scene.a0 if scene.a0 is not None else max(jkr_radius(d_est), 0.0)
+    domain = numerics.domain if numerics.domain is not None else auto_domain(scene, numerics, d_est)
+    return d_est, a_est, domain
+
+
 def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Problem:
     """Derive a scene's numbers once. Raises :class:`Refused` when the mesh cannot do.
 
@@ -157,12 +169,7 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"elastic or auto, large contacts the crack-front model (model crack)")
     h0, c = lj_constants(scene.mu)
     l0 = units.l0_hat(scene.mu)
-    if scene.delta0 is not None:
-        d_est = scene.delta0
-    else:
-        d_est = scene.a0**2 - math.sqrt(2 * scene.a0)
-    a_est = scene.a0 if scene.a0 is not None else max(jkr_radius(d_est), 0.0)
-    domain = numerics.domain if numerics.domain is not None else auto_domain(scene, numerics, d_est)
+    d_est, a_est, domain = initial_estimates(scene, numerics)
     mesh = scene_mesh(numerics, l0, a_est, domain, pull_off_only=scene.stop == "pulloff",
                       band=band)
     zone = l0 / mesh.spacing
