@@ -454,20 +454,33 @@ def load(sigma, wP):
 
 
 @njit(cache=True)
-def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times,
+def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io,
            step_max, step_min, da_max, tol, max_iter, max_steps, stop_mode, min_travel,
            tip_lo, tip_hi, Jinv, d_base, W, slot_of, node_of, state, c_base,
            t_out, d_out, P_out, a_out, ai_out, h_out, stats):
-    """Unload at constant rate from the relaxed state ``h_init`` with the Prony recursion.
+    """Unload at constant rate from the state ``h_init`` with the Prony recursion.
+
+    Resumable: a run may be continued (in chunks of ``max_steps``, or on another mesh after
+    the state arrays were carried over) by passing back its gap, modal state ``q``, step
+    ``step_io`` and records.
 
     Parameters (dimensionless, docs/design.md section 2)
     ----------
     A : (N, N) influence matrix of the mesh.
     r : (N,) node positions (a_ref units), r[0] = 0.
     wP : (N,) load weights, P = 2 pi wP . sigma.
-    h_init : (N,) relaxed gap at indentation ``delta0`` (elastic LJ solution).
+    h_init : (N,) gap at indentation ``delta0``: the relaxed elastic LJ solution at the
+        start, the last accepted state when resuming.
+    delta0 : indentation of ``h_init`` (d_ref units). Used only when ``n0 == 0``; a resumed
+        run takes the time and indentation of its last record.
     rate : r-hat; d delta/dt = -rate h0.
     weights, times : Prony modes of Chat (times may be inf: lumped glassy constant).
+    q : (M, N) modal history state of the hereditary integral, in/out: zeros for the
+        relaxed start; on return the modes of the last accepted step.
+    n0 : records already in the output arrays. 0: a new run, record 0 is the initial
+        state; n0 >= 1: continue after record n0 - 1 (the stop rule sees all records).
+    step_io : (1,) indentation step (units of h0), in/out: <= 0 starts at ``step_max``;
+        on return the step the run would take next.
     step_max, step_min : indentation steps in units of h0.
     da_max : largest contact-radius change per step (a_ref units).
     stop_mode : 0 stop after pull-off and load recovery, 1 follow to separation.
@@ -491,7 +504,6 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times,
     r2half = np.empty(N)
     for i in range(N):
         r2half[i] = 0.5 * r[i] ** 2
-    q = np.zeros((M, N))
     e = np.empty(M)
     b = np.empty(M)
     H = np.empty(N)
@@ -504,18 +516,24 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times,
     sig_new = np.empty(N)
     lj_traction(h, h0, c, sigma)
 
-    t = 0.0
-    delta = delta0
     a_cur = crossing_radius(h, r, hm)
-    t_out[0] = 0.0
-    d_out[0] = delta
-    P_out[0] = load(sigma, wP)
-    a_out[0] = a_cur
-    ai_out[0] = crossing_radius(h, r, h0)
-    n = 1
-    P_min = P_out[0]
+    if n0 == 0:
+        t_out[0] = 0.0
+        d_out[0] = delta0
+        P_out[0] = load(sigma, wP)
+        a_out[0] = a_cur
+        ai_out[0] = crossing_radius(h, r, h0)
+        n = 1
+    else:
+        n = n0
+    t = t_out[n - 1]
+    delta = d_out[n - 1]
     i_min = 0
-    dd = step_max * h0
+    for i in range(1, n):
+        if P_out[i] < P_out[i_min]:
+            i_min = i
+    P_min = P_out[i_min]
+    dd = step_io[0] * h0 if step_io[0] > 0.0 else step_max * h0
     dd_min = step_min * h0
     dt_prev = 0.0
     dt_prev2 = 0.0
@@ -523,6 +541,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times,
     while True:
         if n > max_steps:
             h_out[:] = h
+            step_io[0] = dd / h0
             return STATUS_STEP_LIMIT, n
         dt = dd / (rate * h0)
         ceff = step_coefficients(weights, times, dt, e, b)
@@ -570,6 +589,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times,
                 ok = relax(hp, g, A, ceff, H, h0, c, tol * h0, RELAX_MAX_ITER, stats)
             if not ok:
                 h_out[:] = h
+                step_io[0] = dd / h0
                 return STATUS_NEWTON_FAILED, n
         a_new = crossing_radius(hp, r, hm)
         if ok and abs(a_new - a_cur) > da_max and dd > dd_min * 1.0001:
@@ -605,12 +625,15 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times,
         n += 1
         if a_new >= r[N - 1]:
             h_out[:] = h
+            step_io[0] = dd / h0
             return STATUS_DOMAIN, n
         if a_new > tip_hi or a_new < tip_lo:
             h_out[:] = h
+            step_io[0] = dd / h0
             return STATUS_LEFT_BAND, n
         if stop_reached(P_out, a_out, n, i_min, stop_mode, min_travel):
             h_out[:] = h
+            step_io[0] = dd / h0
             return STATUS_DONE, n
         da = abs(a_new - a_cur)
         a_cur = a_new

@@ -177,7 +177,9 @@ def _simulate(pb: Problem, res: Result) -> str | None:
                                  min_travel, out, stats)
     else:
         status, n = unload(pb.A, r, pb.wP, h_init, delta0, scene.rate, pb.h0, pb.c,
-                           pb.prony_weights, pb.prony_times, numerics.step, numerics.min_step,
+                           pb.prony_weights, pb.prony_times,
+                           np.zeros((pb.prony_weights.size, mesh.nodes)), 0, np.zeros(1),
+                           numerics.step, numerics.min_step,
                            numerics.da_max * dr, numerics.tol, MAX_NEWTON_ITER,
                            numerics.max_steps, pb.stop_mode, min_travel, *pb.tip_range,
                            *el.cache, *out, np.empty(mesh.nodes), stats)
