@@ -273,6 +273,10 @@ class Numerics:
         Newton tolerance on the gap, in units of h0 (max norm of the residual).
     max_steps : int
         Hard cap on the number of time steps (a run that hits it is ``failed``).
+    time_budget_s : float
+        Wall-time budget of one scene, in seconds (0: none). A run that exceeds it ends
+        ``failed`` with reason "time budget ..." and what it would need, rather than
+        thrashing; the budget is checked between chunks of time steps.
     exact : bool
         Use the exact hereditary integral (integrated compliance, O(steps^2 N)) instead
         of the Prony recursion. For validation on small problems.
@@ -299,6 +303,7 @@ class Numerics:
     grading: float = 1.1
     max_nodes: int = 2000
     pull_off_rtol: float = 0.02
+    time_budget_s: float = 300.0
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
@@ -318,6 +323,7 @@ class Numerics:
         set_("prony_rtol", check_range("prony_rtol", self.prony_rtol, 1e-9, 0.1))
         set_("tol", check_range("tol", self.tol, 1e-14, 1e-3))
         set_("max_steps", check_int("max_steps", self.max_steps, 10, 10_000_000))
+        set_("time_budget_s", check_range("time_budget_s", self.time_budget_s, 0.0, 1e7))
         if not isinstance(self.exact, (bool, np.bool_)):
             raise InputError(f"exact must be true or false (got {self.exact!r})")
         set_("exact", bool(self.exact))

@@ -73,11 +73,12 @@ def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
     if not isinstance(numerics, Numerics):
         raise TypeError("numerics must be a sweep.Numerics")
     t_start = time.perf_counter()
-    res = _attempt(scene, numerics)
+    deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
+    res = _attempt(scene, numerics, deadline)
     if res.ok and numerics.pull_off_rtol > 0 and not numerics.exact:
         res.error_estimate = resolution_error(res.spacing, units.l0_hat(scene.mu))
         if res.error_estimate > CHECK_FRACTION * numerics.pull_off_rtol:
-            _check_resolution(res, _attempt(scene, coarser(numerics)))
+            _check_resolution(res, _attempt(scene, coarser(numerics), deadline))
     res.wall_s = time.perf_counter() - t_start
     return res
 
@@ -92,7 +93,7 @@ def resolution_error(spacing: float, l0: float) -> float:
     return RESOLUTION_ERROR_K * (spacing / l0) ** 2
 
 
-def _attempt(scene: Scene, numerics: Numerics) -> Result:
+def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Result:
     """One solve; where the crack tip leaves the fine band of a graded mesh, again (twice at
     most) on the mesh with the band widened on that side by its width."""
     band = None
@@ -100,7 +101,7 @@ def _attempt(scene: Scene, numerics: Numerics) -> Result:
         res = Result(scene=scene, numerics=numerics)
         try:
             pb = prepare(scene, numerics, band)
-            left = _simulate(pb, res)
+            left = _simulate(pb, res, deadline)
         except Refused as exc:
             res.reason = str(exc)
             return res
@@ -143,9 +144,63 @@ def _check_resolution(res: Result, coarse: Result) -> None:
                       f"{res.pull_off:.5g}); refine the mesh (band_resolution or nodes)")
 
 
-def _simulate(pb: Problem, res: Result) -> str | None:
+#: the unloading kernel runs in chunks of this many steps; the wall-time budget is checked
+#: between chunks (a resumed chunk restarts the step predictor: a few Newton iterations)
+CHUNK_STEPS = 2000
+#: status of a run stopped by ``Numerics.time_budget_s`` (beside the kernel's STATUS_*)
+STATUS_TIME_BUDGET = -1
+
+
+@dataclasses.dataclass
+class UnloadingState:
+    """Everything an unloading run carries between kernel calls (all arrays on one mesh):
+    the gap ``h``, the Prony modal state ``q`` (M, N), the records (t, delta, P, a,
+    a_inner) of which the first ``n`` are filled, the next step (units of h0) ``step``,
+    the Jacobian cache and the solver counters ``stats``."""
+
+    h: np.ndarray
+    delta0: float
+    q: np.ndarray
+    records: list
+    n: int
+    step: np.ndarray
+    cache: tuple
+    stats: np.ndarray
+
+    @classmethod
+    def start(cls, pb: Problem, h_init, delta0: float, cache, stats) -> "UnloadingState":
+        """The state at the start of unloading from the relaxed gap ``h_init``."""
+        N = pb.mesh.nodes
+        return cls(h=np.asarray(h_init, float).copy(), delta0=float(delta0),
+                   q=np.zeros((pb.prony_weights.size, N)),
+                   records=[np.empty(pb.numerics.max_steps + 1) for _ in range(5)], n=0,
+                   step=np.zeros(1), cache=cache, stats=stats)
+
+
+def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int:
+    """Continue the unloading ``run`` on ``pb``'s mesh by at most ``steps`` time steps (in
+    place); returns the kernel's status (STATUS_STEP_LIMIT: the chunk ended, call again).
+
+    ``tip_range`` (a_ref) bounds the crack tip (STATUS_LEFT_BAND when it leaves). The state
+    may be carried to another mesh between calls (its arrays interpolated) and continued.
+    """
+    numerics = pb.numerics
+    h_out = np.empty(pb.mesh.nodes)
+    limit = min(run.n + steps, numerics.max_steps)
+    status, run.n = unload(pb.A, pb.mesh.r, pb.wP, run.h, run.delta0, pb.scene.rate, pb.h0,
+                           pb.c, pb.prony_weights, pb.prony_times, run.q, run.n, run.step,
+                           numerics.step, numerics.min_step, numerics.da_max * pb.mesh.spacing,
+                           numerics.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
+                           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *tip_range, *run.cache,
+                           *run.records, h_out, run.stats)
+    run.h = h_out
+    return int(status)
+
+
+def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | None:
     """Solve the prepared problem into ``res``. Returns "inner"/"outer" when the crack tip
-    left the fine band on that side (``res`` then says so), else None."""
+    left the fine band on that side (``res`` then says so), else None. ``deadline``
+    (time.perf_counter() seconds) ends the unloading with the time-budget status."""
     scene, numerics, mesh = pb.scene, pb.numerics, pb.mesh
     r, dr = mesh.r, mesh.spacing
     res.spacing, res.domain_used, res.nodes_used = dr, mesh.domain, mesh.nodes
@@ -176,13 +231,15 @@ def _simulate(pb: Problem, res: Result) -> str | None:
                                  material_of(scene) if scene.k < 1.0 else None, pb.stop_mode,
                                  min_travel, out, stats)
     else:
-        status, n = unload(pb.A, r, pb.wP, h_init, delta0, scene.rate, pb.h0, pb.c,
-                           pb.prony_weights, pb.prony_times,
-                           np.zeros((pb.prony_weights.size, mesh.nodes)), 0, np.zeros(1),
-                           numerics.step, numerics.min_step,
-                           numerics.da_max * dr, numerics.tol, MAX_NEWTON_ITER,
-                           numerics.max_steps, pb.stop_mode, min_travel, *pb.tip_range,
-                           *el.cache, *out, np.empty(mesh.nodes), stats)
+        run = UnloadingState.start(pb, h_init, delta0, el.cache, stats)
+        while True:
+            status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
+            if status != STATUS_STEP_LIMIT or run.n > numerics.max_steps:
+                break
+            if time.perf_counter() > deadline:
+                status = STATUS_TIME_BUDGET
+                break
+        n, out = run.n, run.records
     t, delta, P, a, a_inner = (x[:n].copy() for x in out)
     res.trajectory = {"t": t, "delta": delta, "P": P, "a": a, "a_inner": a_inner}
     res.steps = n - 1
@@ -199,6 +256,11 @@ def _simulate(pb: Problem, res: Result) -> str | None:
 def _finish(res, scene, status, t, delta, P, a, a_inner, dr):
     i, t_star, P_star = refine_minimum(t, P)
     passed = stop_reached(P, a, len(P), i, 0, STOP_TRAVEL_SPACINGS * dr)
+    if status == STATUS_TIME_BUDGET:
+        res.reason = (f"time budget: {res.numerics.time_budget_s:g} s spent after {len(t) - 1} "
+                      f"steps (a = {a[-1]:.4g}, pull-off not reached); give it more "
+                      f"(numerics time_budget_s) or cheaper numerics (preset fast, fewer nodes)")
+        return
     if status == STATUS_DOMAIN:
         res.reason = "contact reached the mesh edge: increase numerics.domain"
         return

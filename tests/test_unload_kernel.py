@@ -53,3 +53,24 @@ def test_unloading_resumed_in_chunks_reproduces_one_run():
     assert abs(d1[P1.argmin()] - d2[P2.argmin()]) < 2 * NUMERICS.step * prepare(SCENE, NUMERICS).h0
     # the records of a resumed run continue in time
     assert np.all(np.diff(t2) > 0)
+
+
+def test_solver_in_small_chunks_gives_the_same_result(monkeypatch):
+    from sweep import solver
+    one = solver.simulate(SCENE, NUMERICS)
+    monkeypatch.setattr(solver, "CHUNK_STEPS", 4)
+    chunked = solver.simulate(SCENE, NUMERICS)
+    assert one.ok and chunked.ok
+    assert abs(one.pull_off - chunked.pull_off) < 1e-7 * one.pull_off
+    assert chunked.steps == one.steps
+
+
+def test_time_budget_ends_a_run_failed_with_the_reason(monkeypatch):
+    import dataclasses
+
+    from sweep import solver
+    monkeypatch.setattr(solver, "CHUNK_STEPS", 2)
+    res = solver.simulate(SCENE, dataclasses.replace(NUMERICS, time_budget_s=1e-6))
+    assert res.status == "failed"
+    assert res.reason.startswith("time budget") and "time_budget_s" in res.reason
+    assert res.steps <= 2 * solver.CHUNK_STEPS
