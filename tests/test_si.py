@@ -160,3 +160,38 @@ def test_sweep_runs_the_scene_models(tmp_path):
     df = sweep.load(tmp_path / "c.h5")
     assert len(df) == 4 and set(df.model_used) == {"crack", "pb"}
     assert (df.status == "ok").all()
+
+
+def test_si_config_runs_and_gives_rows_back_in_si(tmp_path, capsys):
+    """`units: si` end to end: sweep run, then the rows in both systems from the file alone
+    (si_table and `sweep info --si`); pull_off_N = pull_off pi dg R, 1.5 pi dg R closed form."""
+    from sweep.si import si_table
+
+    p = tmp_path / "si.yaml"
+    p.write_text("name: si\nunits: si\ngrid:\n  model: [crack, pb]\n  R: 5.19e-3\n"
+                 "  E0: 1.458e+6\n  Einf: 1.458e+7\n  nu: 0.5\n  n: 0.8\n  tau0: 0.01876\n"
+                 "  dg: 0.1523\n  h0: 30.8e-9\n  preload: 1.5e-3\n  speed: [1.0e-6, 1.0e-4]\n"
+                 f"output: {tmp_path / 'si.h5'}\n")
+    assert main(["run", str(p), "-j", "1", "--progress", "none"]) == 0
+    df = si_table(tmp_path / "si.h5")
+    assert len(df) == 4 and (df.status == "ok").all()
+    assert set(df.model_used) == {"crack", "pb"}
+    R, dg = 5.19e-3, 0.1523
+    assert df.jkr_pull_off_N.to_numpy() == pytest.approx(1.5 * math.pi * dg * R, rel=1e-12)
+    assert df.pull_off_N.to_numpy() == pytest.approx(df.pull_off * math.pi * dg * R, rel=1e-12)
+    assert df.mu.to_numpy() == pytest.approx(pdms(speed=1e-6).mu, rel=1e-12)
+    assert sorted(df.si_speed.unique()) == [1e-6, 1e-4]
+    for model in ("crack", "pb"):          # faster unloading, larger pull-off
+        d = df[df.model_used == model].sort_values("si_speed")
+        assert d.pull_off_N.iloc[1] > d.pull_off_N.iloc[0] > 0.99 * d.jkr_pull_off_N.iloc[0]
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "si.h5"), "--si"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 5 and "pull_off[mN]" in out[0]
+    # a file of a dimensionless config: one line, exit 2
+    q = tmp_path / "d.yaml"
+    q.write_text(f"name: d\ngrid: {{n: 0.8, a0: 3.0, rate: 1, model: pb}}\noutput: {tmp_path / 'd.h5'}\n")
+    assert main(["run", str(q), "-j", "1", "--progress", "none"]) == 0
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "d.h5"), "--si"]) == 2
+    assert "was not written by a `units: si` config" in capsys.readouterr().err
