@@ -86,10 +86,10 @@ def merged(res: dict, extra=()) -> dict:
     ``agreement_mu*.json``) appended, sorted by mu; a0-scan rows are merged the same way."""
     out = {"a0_scan": list(res.get("a0_scan", [])), "mu_scan": list(res.get("mu_scan", [])),
            "sources": [], "wall_s": res.get("wall_s", math.nan)}
-    out["commits"] = [res.get("git_commit", "before 4e9c183 (uniform mesh)")]
+    out["commits"] = [res.get("git_commit", "before 4e9c183 (the mesh of then)")]
     for path in extra:
         other = json.loads(Path(path).read_text())
-        out["commits"].append(other.get("git_commit", "before 4e9c183 (uniform mesh)"))
+        out["commits"].append(other.get("git_commit", "before 4e9c183 (the mesh of then)"))
         out["a0_scan"] += other.get("a0_scan", [])
         out["mu_scan"] += other.get("mu_scan", [])
         out["sources"].append(Path(path).name)
