@@ -195,3 +195,25 @@ def test_si_config_runs_and_gives_rows_back_in_si(tmp_path, capsys):
     capsys.readouterr()
     assert main(["info", str(tmp_path / "d.h5"), "--si"]) == 2
     assert "was not written by a `units: si` config" in capsys.readouterr().err
+
+
+def test_shipped_pdms_config_runs_and_matches_make_pdms(tmp_path):
+    """`sweep run configs/pdms.yaml` end to end (in-process), against sweep.pdms, which runs
+    the same case through its own SI conversion (PDMS_CASE) at a tighter tolerance."""
+    from pathlib import Path
+
+    from sweep import pdms
+    from sweep.si import si_table
+
+    cfg = Path(__file__).resolve().parents[1] / "configs" / "pdms.yaml"
+    out = tmp_path / "p.h5"
+    assert main(["run", str(cfg), "--out", str(out), "-j", "1", "--progress", "none"]) == 0
+    df = si_table(out)
+    assert len(df) == 18 and (df.status == "ok").all()
+    assert df.jkr_pull_off_N.to_numpy() == pytest.approx(3.7248e-3, rel=1e-4)
+    for model, name in (("crack", "crack_pb"), ("pb", "pb_estimate")):
+        d = df[df.model_used == model].sort_values("si_speed")
+        assert (d.pull_off_N.diff().dropna() > 0).all()
+        ends = d.si_speed.to_numpy()[[0, -1]] * 1e6
+        want = pdms.model_pull_off(name, ends)["pull_off_mN"]
+        assert d.pull_off_N.to_numpy()[[0, -1]] * 1e3 == pytest.approx(want, rel=1e-5)
