@@ -161,3 +161,21 @@ def test_gs_over_linear_ratio(res):
     np.testing.assert_allclose(np.array(g["gamma_gs"]) / np.array(g["gamma_lin"]), g["ratio"])
     v = np.array(g["crack_speed_um_s"])
     np.testing.assert_allclose(g["paper_fit"], 1 + np.sqrt(v / 1e4))
+
+
+def test_full_amplification_at_the_pdms_k_against_the_small_tau_asymptote():
+    """The huge vhat ~ 2e22 at the PDMS's own k is the PB theory, not a solver artefact: for
+    Gamma/(2 pi vhat) = c -> 0, 1 - I = c^n J(n)/Gamma(n) with
+    J(n) = int_0^inf s^(n-1) (1 - (sqrt(1+s^2) - 1)/s) ds (the MPL spectrum's small-tau end),
+    so Gamma = f/k at c = ((f^-1 - 1) k/(1-k) Gamma(n)/J)^(1/n), vhat = f/(k 2 pi c)."""
+    from scipy.integrate import quad
+
+    n, k, f = PDMS_CASE["n"], 4.72e-4, PDMS_CASE["full_amplification_fraction"]
+
+    def g(s):
+        return s ** (n - 1) * (1.0 - (math.sqrt(s * s + 1.0) - 1.0) / s)
+
+    J = quad(g, 0, 1)[0] + quad(g, 1, math.inf, limit=200)[0]
+    c = ((1.0 / f - 1.0) * k / (1.0 - k) * math.gamma(n) / J) ** (1.0 / n)
+    assert full_amplification_vhat(n, k, f) == pytest.approx(f / k / (2 * math.pi * c),
+                                                              rel=1e-4)
