@@ -19,6 +19,7 @@ import argparse
 import json
 import math
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -65,7 +66,10 @@ def run(a0s=A0S, rates=RATES, mus=MUS) -> dict:
     for mu in mus:
         mu_rows.append(_row(Scene(n=0.8, k=0.1, mu=mu, a0=3.0, rate=10**2.5)))
         print(_fmt(mu_rows[-1]), flush=True)
-    return {"a0_scan": rows, "mu_scan": mu_rows, "wall_s": time.perf_counter() - t0}
+    from .store import provenance
+
+    return {"a0_scan": rows, "mu_scan": mu_rows, "wall_s": time.perf_counter() - t0,
+            "git_commit": provenance()["git_commit"]}
 
 
 def _fmt(r: dict) -> str:
@@ -75,6 +79,67 @@ def _fmt(r: dict) -> str:
             f"({100 * r['pb_vs_bem']:+.1f} %)  v_a BEM {r['bem_crack_speed']:.4g} "
             f"crack {r['crack_crack_speed']:.4g}  wall BEM {r['bem_wall_s']:.2f} s "
             f"crack {r['crack_wall_s']:.3f} s")
+
+
+def merged(res: dict, extra=()) -> dict:
+    """``res`` with the mu-scan rows of other runs (e.g. the costly high-mu points, stored in
+    ``agreement_mu*.json``) appended, sorted by mu; a0-scan rows are merged the same way."""
+    out = {"a0_scan": list(res.get("a0_scan", [])), "mu_scan": list(res.get("mu_scan", [])),
+           "sources": [], "wall_s": res.get("wall_s", math.nan)}
+    out["commits"] = [res.get("git_commit", "before 4e9c183 (the mesh of then)")]
+    for path in extra:
+        other = json.loads(Path(path).read_text())
+        out["commits"].append(other.get("git_commit", "before 4e9c183 (the mesh of then)"))
+        out["a0_scan"] += other.get("a0_scan", [])
+        out["mu_scan"] += other.get("mu_scan", [])
+        out["sources"].append(Path(path).name)
+    out["mu_scan"].sort(key=lambda r: (r["mu"], r["a0"], r["rate"]))
+    return out
+
+
+def _reach(res: dict) -> str:
+    """Why the mu scan stops where it does: the highest mu measured, its BEM cost, and the
+    nodes the BEM's range end (sweep.problem.BEM_MU_RANGE) would need with today's mesh."""
+    from .models import bem_node_budget, bem_nodes_needed
+    from .problem import BEM_MU_RANGE
+
+    top = max(res["mu_scan"], key=lambda r: r["mu"], default=None)
+    if top is None:
+        return ""
+    mu_end = BEM_MU_RANGE[1]
+    end = Scene(n=top["n"], k=top["k"], mu=mu_end, a0=top["a0"], rate=top["rate"])
+    num = _numerics(end)
+    return (f"The highest mu measured, {top['mu']:g}, cost the BEM {top['bem_wall_s']:.0f} s "
+            f"({top['bem_nodes']} nodes); the end of the BEM's range, mu = {mu_end:g}, needs "
+            f"{bem_nodes_needed(end, num)} nodes on today's balanced mesh (budget "
+            f"{bem_node_budget(num)}), beyond this machine's time for the check.")
+
+
+def summary(res: dict) -> str:
+    """The agreement in a few lines: crack-front and PB estimate against the BEM, per rate
+    over the a0 scan (finite-size effects at a0 < 3) and along mu."""
+    def pct(rows, key):
+        v = [100 * r[key] for r in rows if math.isfinite(r[key])]
+        if not v:
+            return "--"
+        lo, hi = min(v), max(v)
+        return f"{lo:+.1f} %" if abs(hi - lo) < 0.05 else f"{lo:+.1f} .. {hi:+.1f} %"
+
+    L = ["| scenes | crack/BEM - 1 | pb/BEM - 1 |", "| --- | --- | --- |"]
+    a0s = res["a0_scan"]
+    for rate in sorted({r["rate"] for r in a0s}):
+        at = [r for r in a0s if r["rate"] == rate]
+        for label, sel in (("a0 >= 3", [r for r in at if r["a0"] >= 3]),
+                           ("a0 < 3", [r for r in at if r["a0"] < 3])):
+            if sel:
+                a0_list = ", ".join(f"{r['a0']:g}" for r in sel)
+                L.append(f"| mu = {sel[0]['mu']:g}, rate {rate:.4g}, {label} (a0 = {a0_list}) "
+                         f"| {pct(sel, 'crack_vs_bem')} | {pct(sel, 'pb_vs_bem')} |")
+    for r in res["mu_scan"]:
+        L.append(f"| mu = {r['mu']:g}, a0 = {r['a0']:g}, rate {r['rate']:.4g} "
+                 f"({r['bem_nodes']} BEM nodes) | {pct([r], 'crack_vs_bem')} | "
+                 f"{pct([r], 'pb_vs_bem')} |")
+    return "\n".join(L) + "\n"
 
 
 def table(res: dict) -> str:
@@ -108,6 +173,10 @@ def main(argv=None) -> int:
     out = Path(args.out)
     os.makedirs(out.parent, exist_ok=True)
     if args.table_only:
+        if not out.is_file():
+            print(f"error: --out: no such file {str(out)!r} (run without --table-only first)",
+                  file=sys.stderr)
+            return 2
         res = json.loads(out.read_text())
     else:
         mus = MUS if args.mus is None else tuple(float(x) for x in args.mus.split(","))
@@ -115,9 +184,21 @@ def main(argv=None) -> int:
         tmp = out.with_suffix(".json.tmp")
         tmp.write_text(json.dumps(res, indent=1) + "\n")
         os.replace(tmp, out)
+    # the default file gathers the costly high-mu points measured apart (agreement_mu*.json)
+    extra = sorted(p for p in out.parent.glob("agreement_mu*.json") if p != out) \
+        if out.name == "agreement.json" else []
+    full = merged(res, extra)
     md = out.with_suffix(".md")
+    src = (f" Rows of {', '.join(full['sources'])} (measured apart: `make agreement-high-mu`) "
+           "are merged into the mu scan." if full["sources"] else "")
     md.write_text("# Model agreement: BEM vs crack-front model vs PB estimate "
-                  "(n = 0.8, k = 0.1; `make agreement`)\n" + table(res))
+                  "(n = 0.8, k = 0.1; `make agreement`)\n\n"
+                  "Same scene, three models: the BEM (balanced preset), the crack-front model "
+                  "(JKR edge with the Persson-Brener Gamma(v) of the MPL spectrum, the mu -> "
+                  "infinity limit) and the paper's closed-form PB estimate (v-r fit made at "
+                  "mu = 3.24)." + src + " " + _reach(full) + " Measured at commit(s) "
+                  + ", ".join(dict.fromkeys(full["commits"])) + ".\n\n"
+                  "## Summary\n\n" + summary(full) + table(full))
     print(out)
     print(md)
     return 0

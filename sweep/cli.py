@@ -7,7 +7,9 @@ and exits with code 2 (runtime failures exit 1). No traceback is shown.
 from __future__ import annotations
 
 import json
+import math
 import sys
+from pathlib import Path
 
 import click
 import numpy as np
@@ -367,10 +369,33 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
 @click.argument("results")
 @click.option("--slowest", type=int, default=5, show_default=True,
               help="How many of the slowest scenes to list.")
-def info_cmd(results, slowest):
+@click.option("--si", "as_si", is_flag=True,
+              help="A file of a `units: si` config: one line per scene in SI units (speed, "
+                   "mu, l0, pull-off and the relaxed JKR pull-off 1.5 pi dg R).")
+@click.option("--csv", "csv_out", default=None, metavar="PATH",
+              help="With --si: also write every SI and dimensionless column as CSV.")
+def info_cmd(results, slowest, as_si, csv_out):
     """Summarize a results file: counts by status, parameter ranges, slowest scenes."""
     from .store import summary
 
+    if not Path(results).exists():
+        raise InputError(f"no results at {results}")
+    if as_si:
+        from .si import si_table
+
+        df = si_table(results)
+        if csv_out:
+            df.to_csv(csv_out, index=False)
+        click.echo("scene_id          model  status  speed[um/s]  mu       l0[nm]  "
+                   "pull_off[mN]  jkr_pull_off[mN]  crack_speed[um/s]")
+        for r in df.sort_values(["model_used", "si_speed"]).to_dict("records"):
+            cs = r["crack_speed_m_s"]
+            click.echo(f"{r['scene_id']}  {r['model_used']:<5}  {r['status']:<6}  "
+                       f"{r['si_speed'] * 1e6:<11.4g}  {r['mu']:<7.4g}  {r['l0_m'] * 1e9:<6.4g}  "
+                       f"{(r['pull_off_N'] or math.nan) * 1e3:<12.5g}  "
+                       f"{r['jkr_pull_off_N'] * 1e3:<16.5g}  "
+                       f"{(cs if cs is not None else math.nan) * 1e6:.4g}")
+        return
     try:
         text = summary(results, slowest=slowest)
     except FileNotFoundError:

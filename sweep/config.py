@@ -4,6 +4,7 @@ Format (all keys; unknown keys are errors)::
 
     name: threshold                 # required; letters, digits, "-", "_", "."
     description: free text          # optional
+    units: dimensionless            # optional: or "si" (grid in SI fields, see below)
     grid:                           # required: one grid, or a list of grids (see below)
       n: [0.4, 0.6, 0.8, 1.6]       # a list of values ...
       k: 0.1                        # ... or a single value ...
@@ -24,6 +25,12 @@ sub-grids, de-duplicated by scene id (first occurrence kept, order preserved). E
 of a sweep uses the same ``numerics`` (default: the "balanced" preset); ``numerics`` may
 combine a ``preset`` with explicit overrides (``{preset: fast, nodes: 120}``).
 ``output`` defaults to ``results/<name>.h5``.
+
+``units: si``: the grid holds the SI fields of :data:`sweep.si.SI_AXES` (``R, E0, Einf, nu,
+n, tau0, dg, h0, speed`` and one of ``preload``, ``a0``, ``indentation``) besides ``model``,
+``material``, ``stop``; every point becomes a :class:`sweep.si.SIScene` and its
+dimensionless :class:`Scene` (the one hashed, stored and run; :meth:`SweepConfig.si_tasks`
+maps ids back to the SI points, :func:`sweep.si.si_table` gives stored rows in SI).
 
 YAML 1.1 reads ``1e6`` as a string; numeric strings such as ``"1e6"`` are accepted as
 numbers wherever a number is expected. Configs are read with a safe loader (no Python
@@ -50,7 +57,11 @@ from .scene import AXES as SCENE_AXIS_INFO
 from .scene import Numerics, Scene, scene_id
 
 #: Top-level keys of a config file.
-TOP_KEYS = ("name", "description", "grid", "numerics", "store", "output")
+TOP_KEYS = ("name", "description", "units", "grid", "numerics", "store", "output")
+#: Values of ``units``: the grid in the dimensionless Scene axes, or in SI (sweep.si.SI_AXES).
+UNITS = ("dimensionless", "si")
+#: Categorical Scene axes an SI grid takes as they are.
+SI_SCENE_AXES = ("model", "material", "stop")
 #: Grid axes, in the order the Cartesian product iterates them (last varies fastest).
 #: Grid axes in the order of expansion (the last varies fastest): the Scene fields by their
 #: ``order`` metadata.
@@ -81,6 +92,7 @@ class SweepConfig:
     description: str = ""
     text: str = field(default="", repr=False, compare=False)
     source: str = field(default="<dict>", compare=False)
+    units: str = "dimensionless"
 
     def scenes(self) -> list[Scene]:
         """The scenes of the sweep, de-duplicated by scene id, in grid order."""
@@ -90,18 +102,35 @@ class SweepConfig:
         """``(scene_id, scene)`` pairs of the sweep, de-duplicated, in grid order."""
         return list(self._tasks)
 
+    def si_tasks(self) -> list:
+        """``(scene_id, SIScene)`` pairs of a ``units: si`` sweep (empty otherwise): the SI
+        point that made each scene (the first one, if several give the same scene)."""
+        return [(sid, si) for sid, (_, si) in self._expanded.items() if si is not None]
+
     @cached_property
     def _tasks(self) -> tuple:
+        return tuple((sid, scene) for sid, (scene, _) in self._expanded.items())
+
+    @cached_property
+    def _expanded(self) -> dict:
         # the grid is expanded and hashed once per config object (a frozen value)
-        seen: dict[str, Scene] = {}
-        for grid in self.grids:
-            names = [a for a in AXES if a in grid]
-            for values in itertools.product(*(grid[a] for a in names)):
-                scene = Scene(**dict(zip(names, values)))
+        seen: dict[str, tuple] = {}
+        for gi, grid in enumerate(self.grids):
+            if self.units == "si":
+                order = sorted(grid, key=_si_order)
+            else:
+                order = [a for a in AXES if a in grid]
+            for values in itertools.product(*(grid[a] for a in order)):
+                point = dict(zip(order, values))
+                si = None
+                if self.units == "si":
+                    si, scene = _si_point(point, f"grid[{gi}]" if len(self.grids) > 1 else "grid")
+                else:
+                    scene = Scene(**point)
                 sid = scene_id(scene, self.numerics)
                 if sid not in seen:
-                    seen[sid] = scene
-        return tuple(seen.items())
+                    seen[sid] = (scene, si)
+        return seen
 
     @cached_property
     def config_hash(self) -> str:
@@ -128,6 +157,7 @@ class SweepConfig:
         return {
             "name": self.name,
             "description": self.description,
+            **({"units": self.units} if self.units != "dimensionless" else {}),
             "grid": grids[0] if len(grids) == 1 else grids,
             "numerics": self.numerics.to_dict(),
             "store": {"trajectories": self.trajectories},
@@ -194,9 +224,10 @@ def _fmt_choices(items) -> str:
     return ", ".join(items)
 
 
-def _axis_values(where: str, axis: str, spec, problems: list[str]) -> tuple | None:
-    """Expand one axis spec into a tuple of validated values (None on error)."""
-    info = SCENE_AXIS_INFO[axis]
+def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) -> tuple | None:
+    """Expand one axis spec into a tuple of validated values (None on error); ``info`` is the
+    axis (default the Scene's)."""
+    info = info or SCENE_AXIS_INFO[axis]
     if not info.numeric:
         allowed = info.choices
         vals = spec if isinstance(spec, list) else [spec]
@@ -294,6 +325,58 @@ def _check_grid(where: str, grid, problems: list[str]) -> dict | None:
     return out if len(problems) == n_before else None
 
 
+def _si_order(name: str) -> int:
+    from .si import SI_AXES
+
+    return SI_AXES[name].order if name in SI_AXES else SCENE_AXIS_INFO[name].order
+
+
+def _si_point(point: dict, where: str):
+    """The SIScene and the Scene of one point of an SI grid (InputError naming the point)."""
+    from .si import SIScene
+
+    extra = {a: point[a] for a in SI_SCENE_AXES if a in point and a != "material"}
+    phys = {a: v for a, v in point.items() if a not in SI_SCENE_AXES}
+    try:
+        si = SIScene(**phys, material=point.get("material", "mpl"))
+        return si, si.to_scene(**extra)
+    except InputError as exc:
+        desc = ", ".join(f"{a}={v:g}" for a, v in phys.items())
+        raise InputError(f"{where} (SI point {desc}): {exc}") from None
+
+
+def _check_si_grid(where: str, grid, problems: list[str]) -> dict | None:
+    """Validate a ``units: si`` grid: SI fields (sweep.si.SI_AXES) and model/material/stop."""
+    from .si import SI_AXES, SI_INITIAL
+
+    allowed = (*SI_SCENE_AXES, *SI_AXES)
+    if not isinstance(grid, dict):
+        problems.append(f"{where}: must be a mapping of SI fields ({_fmt_choices(allowed)}) "
+                        f"(got {type(grid).__name__})")
+        return None
+    n_before = len(problems)
+    for key in grid:
+        if key not in allowed:
+            problems.append(f"{where}.{key}: unknown SI field (allowed: "
+                            f"{_fmt_choices(allowed)})")
+    for name, info in SI_AXES.items():
+        if info.required and name not in grid:
+            problems.append(f"{where}.{name}: required SI field is missing ({info.help}"
+                            f"{', ' + info.unit if info.unit else ''})")
+    if sum(a in grid for a in SI_INITIAL) != 1:
+        problems.append(f"{where}: give exactly one of preload [N], a0 [m] and indentation [m]")
+    out = {}
+    for name in allowed:
+        if name in grid:
+            vals = _axis_values(f"{where}.{name}", name, grid[name], problems,
+                                SI_AXES.get(name))
+            if vals is not None:
+                out[name] = vals
+        elif name in SI_SCENE_AXES:
+            out[name] = (AXIS_DEFAULTS[name],)
+    return out if len(problems) == n_before else None
+
+
 def _check_numerics(spec, problems: list[str]) -> Numerics | None:
     if spec is None:
         return Numerics.preset("balanced")
@@ -353,6 +436,12 @@ def config_from_dict(data, text: str | None = None, source: str = "<dict>") -> S
     if not isinstance(description, str):
         problems.append(f"description: must be a string (got {description!r})")
 
+    units = data.get("units", "dimensionless")
+    if units not in UNITS:
+        problems.append(f"units: must be one of {_fmt_choices(UNITS)} (got {units!r})")
+        units = "dimensionless"
+    check_grid = _check_si_grid if units == "si" else _check_grid
+
     grids: list[dict] = []
     if "grid" not in data:
         problems.append("grid: required key is missing (a mapping of axes, or a list of them)")
@@ -362,11 +451,11 @@ def config_from_dict(data, text: str | None = None, source: str = "<dict>") -> S
             if not g:
                 problems.append("grid: must not be an empty list")
             for i, sub in enumerate(g):
-                checked = _check_grid(f"grid[{i}]", sub, problems)
+                checked = check_grid(f"grid[{i}]", sub, problems)
                 if checked is not None:
                     grids.append(checked)
         else:
-            checked = _check_grid("grid", g, problems)
+            checked = check_grid("grid", g, problems)
             if checked is not None:
                 grids.append(checked)
 
@@ -418,12 +507,12 @@ def config_from_dict(data, text: str | None = None, source: str = "<dict>") -> S
 
     cfg = SweepConfig(name=name, grids=tuple(grids), numerics=numerics,
                       trajectories=trajectories, output=output, description=description,
-                      text=text or "", source=source)
+                      text=text or "", source=source, units=units)
     if text is None:
         cfg = dataclasses.replace(cfg, text=yaml.safe_dump(cfg.to_dict(), sort_keys=False))
     try:
-        cfg.tasks()  # Scene-level checks (should all have passed above)
-    except InputError as exc:  # pragma: no cover - defensive
+        cfg.tasks()  # Scene-level checks (an SI grid's derived scenes are checked here)
+    except InputError as exc:
         raise InputError(f"{source}: {exc}") from None
     return cfg
 
@@ -446,6 +535,4 @@ def scale_grid(config: SweepConfig, axis: str, values) -> SweepConfig:
     g = dict(grids[0])
     g[axis] = tuple(values)
     grids[0] = g
-    return SweepConfig(name=config.name, grids=tuple(grids), numerics=config.numerics,
-                       trajectories=config.trajectories, output=config.output,
-                       description=config.description, text=config.text, source=config.source)
+    return dataclasses.replace(config, grids=tuple(grids))

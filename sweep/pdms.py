@@ -1,13 +1,14 @@
 r"""The paper's PDMS experiment in SI units (sections "Experimental adhesion tests" and
 "Discussion"): predicted pull-off force versus unloading speed, the Gent-Schultz comparison
-and the discussion's estimates, recomputed with this project's models.
+and the discussion's estimates, recomputed with this project's models and fits.
 
 ``python -m sweep.pdms --out results/pdms`` (``make pdms``) writes ``pdms.json``, ``pdms.png``
 and ``REPORT.md``. The case (:data:`PDMS_CASE`): glass lens R = 5.19 mm on Sylgard 184 with the
 paper's MPL constants (E0 = 1.458 MPa, Einf = 3089 MPa, n = 0.2207, tau0 = 0.01876 s, nu = 0.5),
 dg = 152.3 mJ/m^2, h0 = 30.8 nm, preload 1.5 mN after full relaxation, unloading speeds
-1 .. 1e4 um/s. These are the paper's fitted INPUTS (no DMA data ship with the project; with a
-master curve, ``sweep fit-dma`` gives the constants to put here).
+1e-6 .. 1e4 um/s (the paper's 1 .. 1e4 and six decades below, to show the approach to the
+relaxed JKR pull-off). These are the paper's fitted INPUTS (no DMA data ship with the project;
+with a master curve, ``sweep fit-dma`` gives the constants to put here).
 
 Models (all in :mod:`sweep.crack_front` / :mod:`sweep.models`):
 
@@ -20,8 +21,16 @@ Models (all in :mod:`sweep.crack_front` / :mod:`sweep.models`):
 * ``pb_estimate_l0`` -- the same with rhat = r tau0/l0, the convention the paper uses in its
   PDMS discussion (it turns vhat = 1e9 into 31.4 m/s).
 
+The discussion's estimates (:func:`discussion`) use THIS project's fits, read from
+``results/threshold/fit.json`` (collapse P_po = A a0t^B, ``make threshold``) and
+``results/vr/fit.json`` (vhat = A rhat^B, ``make vr``) by :func:`own_fits`; the paper's fits
+(tests/data/paper_values.yaml) go through the same functions only for the comparison column.
+The paper's vhat ~ 1e9 for the full amplification is read off its Fig. PB_BEM, which is drawn
+for k = 0.1 (n = 0.2 curve); at the PDMS's own k = 4.7e-4 the Persson-Brener Gamma reaches
+0.9/k only at vhat ~ 2e22. Both are reported, each labelled.
+
 The BEM is not run: at mu = 103 the process zone l0 = 30 nm is 1.6e-4 a_ref, beyond the
-uniform mesh (the Scene refuses mu > 20).
+BEM's meshes (the Scene refuses mu > 20).
 """
 from __future__ import annotations
 
@@ -37,20 +46,33 @@ from scipy.optimize import brentq
 
 from . import units
 from .crack_front import GentSchultzLaw, pb_law_for_scene, unload
+from .errors import InputError
 from .si import SIScene
 from .theory import A_PULL_OFF_FORCE, gent_schultz, paper_v_vs_r_fit, pb_gamma_eff
 
-#: The PDMS case of the paper (SI). ``threshold_collapse`` is the paper's BEM collapse fit
-#: P_po = 0.3 a0t^2.7 (its Fig. Threshold), used for the discussion's threshold radius.
+ROOT = Path(__file__).resolve().parent.parent
+
+#: The PDMS case of the paper (SI). ``pb_figure_k``: the k of the paper's Fig. PB_BEM, off
+#: which its Discussion reads the crack speed for the full amplification.
 PDMS_CASE = {
     "R": 5.19e-3, "E0": 1.458e6, "Einf": 3.089e9, "nu": 0.5, "n": 0.2207, "tau0": 0.01876,
     "dg": 0.1523, "h0": 30.8e-9, "preload": 1.5e-3,
-    "speeds_um_s": {"log10": [0.0, 4.0, 17]},
+    "speeds_um_s": {"log10": [-6.0, 4.0, 41]},
     "gent_schultz": {"v0_um_s": 213.5, "xi": 0.4154},
     "gs_over_linear": {"v1_um_s": 1.0e4, "exponent": 0.5},
-    "threshold_collapse": {"prefactor": 0.3, "exponent": 2.7},
     "full_amplification_fraction": 0.9,
+    "pb_figure_k": 0.1,
+    "slow_limit_tolerance": 0.02,
 }
+
+#: Integrator tolerance of the crack-front runs: at 1e-6 um/s the pull-off is 1.5 (1 + 9e-6),
+#: so the default 1e-8 (error ~5e-6 there) would blur the monotonic growth.
+CRACK_RTOL = 1e-11
+
+#: Where this project's own fits live (written by ``make threshold`` and ``make vr``).
+OWN_FIT_FILES = {"threshold": "results/threshold/fit.json", "v_vs_r": "results/vr/fit.json"}
+
+MODELS = ("crack_pb", "crack_gs", "pb_estimate", "pb_estimate_l0")
 
 
 def _speeds(spec) -> np.ndarray:
@@ -64,42 +86,185 @@ def pdms_scene(speed_m_s: float, case=PDMS_CASE) -> SIScene:
                    speed=speed_m_s)
 
 
-def compute(case=PDMS_CASE) -> dict:
-    """Every number of the PDMS report (SI unless the key says otherwise)."""
-    t0 = time.perf_counter()
-    speeds_um = _speeds(case["speeds_um_s"])
+def own_fits(root=ROOT) -> dict:
+    """This project's collapse fit and v-r fit (``prefactor``, ``exponent``, ``source``).
+
+    Read from :data:`OWN_FIT_FILES` under ``root``; InputError if one is missing.
+    """
+    out = {}
+    for key, rel in OWN_FIT_FILES.items():
+        p = Path(root) / rel
+        if not p.is_file():
+            raise InputError(f"{rel}: missing; run `make threshold` and `make vr` first")
+        d = json.loads(p.read_text())
+        out[key] = {"prefactor": float(d["prefactor"]), "exponent": float(d["exponent"]),
+                    "source": rel}
+    return out
+
+
+def paper_fits() -> dict:
+    """The paper's collapse fit, v-r fit and vhat reading (tests/data/paper_values.yaml),
+    for the comparison column only."""
+    import yaml
+
+    p = ROOT / "tests" / "data" / "paper_values.yaml"
+    if not p.is_file():
+        return {}
+    pv = yaml.safe_load(p.read_text())
+    vr = pv["pb_theory"]["v_vs_r_fit"]
+    col = pv["threshold_radius"]["collapse_fit"]
+    return {"threshold": {"prefactor": float(col["prefactor"]), "exponent": float(col["exponent"])},
+            "v_vs_r": {"prefactor": float(vr["prefactor"]), "exponent": float(vr["exponent"])},
+            "vhat_full_amplification":       # PyYAML reads "1.0e9" as a string
+                float(pv["pdms_experiment"]["max_amplification_rate_estimate"]["v_hat"])}
+
+
+def threshold_radius_hat(k, prefactor, exponent) -> float:
+    """Threshold radius [a_ref] for the full amplification: ``A a0t^B = 1.5/k``."""
+    return (1.5 / k / prefactor) ** (1.0 / exponent)
+
+
+def full_amplification_vhat(n, k, fraction) -> float:
+    """Crack speed vhat = v tau0/l0 at which the MPL Persson-Brener Gamma reaches fraction/k."""
+    def f(x):
+        return float(pb_gamma_eff(n, k, math.exp(x))) * k - fraction
+
+    return math.exp(brentq(f, math.log(1e-3), math.log(1e40), xtol=1e-10))
+
+
+def unloading_speed_for_vhat(vhat, length, tau0, prefactor, exponent) -> float:
+    """Unloading speed [m/s] for which the v-r fit ``vhat = A rhat^B`` gives ``vhat``.
+
+    ``rhat = r tau0 / length``: ``length = l0`` is the paper's reading in its Discussion
+    (vhat = 1e9 -> 31.4 m/s), ``length = d_ref`` the project's (docs/design.md section 2).
+    """
+    return (vhat / prefactor) ** (1.0 / exponent) * length / tau0
+
+
+def _context(case) -> dict:
+    """Scales, initial state and Gamma(v) laws of the case (everything but the speed)."""
     si0 = pdms_scene(1e-6, case)
     sc = si0.scale
-    tau0, k, n, mu = si0.tau0, si0.k, si0.n, si0.mu
     d0 = si0.dimensionless()
-    a0 = d0["a0"]
-    law_pb = pb_law_for_scene(n, k, mu)
     gs = case["gent_schultz"]
-    v0_hat = float(sc.crack_speed_hat(gs["v0_um_s"] * 1e-6, tau0))
-    law_gs = GentSchultzLaw(v0_hat, gs["xi"])
-    l0_hat = units.l0_hat(mu)
-    out_models = {}
-    for name, law in (("crack_pb", law_pb), ("crack_gs", law_gs)):
-        rows = [unload(law, rate=pdms_scene(v * 1e-6, case).rate, mu=mu, a0=a0) for v in speeds_um]
-        out_models[name] = {
-            "pull_off_mN": [float(sc.load_physical(r.pull_off)) * 1e3 for r in rows],
-            "crack_speed_um_s": [float(sc.crack_speed_physical(r.crack_speed, tau0)) * 1e6
-                                 for r in rows],
-            "gamma_pulloff": [r.gamma_pulloff for r in rows],
-            "status": [r.status for r in rows],
-        }
-    rates = np.array([pdms_scene(v * 1e-6, case).rate for v in speeds_um])
+    return {"si0": si0, "sc": sc, "tau0": si0.tau0, "k": si0.k, "n": si0.n, "mu": si0.mu,
+            "a0": d0["a0"], "law_pb": pb_law_for_scene(si0.n, si0.k, si0.mu),
+            "law_gs": GentSchultzLaw(float(sc.crack_speed_hat(gs["v0_um_s"] * 1e-6, si0.tau0)),
+                                     gs["xi"])}
+
+
+def model_pull_off(model, speeds_um, case=PDMS_CASE, ctx=None) -> dict:
+    """Pull-off [mN], crack speed at pull-off [um/s], Gamma there and status of one model.
+
+    Parameters
+    ----------
+    model : {"crack_pb", "crack_gs", "pb_estimate", "pb_estimate_l0"}
+    speeds_um : array_like
+        Unloading speeds [um/s].
+    """
+    ctx = ctx or _context(case)
+    sc, tau0, mu = ctx["sc"], ctx["tau0"], ctx["mu"]
+    speeds_um = np.atleast_1d(np.asarray(speeds_um, dtype=float))
+    rates = np.array([float(sc.rate_hat(v * 1e-6, tau0)) for v in speeds_um])
+    if model in ("crack_pb", "crack_gs"):
+        law = ctx["law_pb"] if model == "crack_pb" else ctx["law_gs"]
+        rows = [unload(law, rate=r, mu=mu, a0=ctx["a0"], rtol=CRACK_RTOL) for r in rates]
+        return {"pull_off_mN": [float(sc.load_physical(r.pull_off)) * 1e3 for r in rows],
+                "crack_speed_um_s": [float(sc.crack_speed_physical(r.crack_speed, tau0)) * 1e6
+                                     for r in rows],
+                "gamma_pulloff": [r.gamma_pulloff for r in rows],
+                "status": [r.status for r in rows]}
+    if model not in MODELS:
+        raise InputError(f"model must be one of {', '.join(MODELS)} (got {model!r})")
     # the paper's closed-form chain with the two rhat conventions
-    for name, rhat in (("pb_estimate", units.rhat_pb(rates, mu)),
-                       ("pb_estimate_l0", speeds_um * 1e-6 * tau0 / sc.l0)):
-        vhat = paper_v_vs_r_fit(rhat)
-        g = pb_gamma_eff(n, k, vhat)
-        out_models[name] = {
-            "pull_off_mN": list(1.5 * g * sc.load_ref * 1e3),
-            "crack_speed_um_s": list(vhat * sc.l0 / tau0 * 1e6),
-            "gamma_pulloff": list(g),
-            "status": ["ok"] * speeds_um.size,
-        }
+    rhat = units.rhat_pb(rates, mu) if model == "pb_estimate" else speeds_um * 1e-6 * tau0 / sc.l0
+    vhat = paper_v_vs_r_fit(rhat)
+    g = np.atleast_1d(pb_gamma_eff(ctx["n"], ctx["k"], vhat))
+    return {"pull_off_mN": [float(x) for x in 1.5 * g * sc.load_ref * 1e3],
+            "crack_speed_um_s": [float(x) for x in vhat * sc.l0 / tau0 * 1e6],
+            "gamma_pulloff": [float(x) for x in g], "status": ["ok"] * speeds_um.size}
+
+
+def slow_limit(case=PDMS_CASE, ctx=None, lo=-9.0, hi=4.0) -> dict:
+    """Per model: the unloading speed [um/s] below which the pull-off is within
+    ``slow_limit_tolerance`` of the relaxed JKR 1.5 pi dg R (root of P = (1 + tol) P_JKR in
+    log10 speed on [lo, hi]; NaN if not bracketed)."""
+    ctx = ctx or _context(case)
+    tol = case["slow_limit_tolerance"]
+    p_jkr = 1.5 * ctx["sc"].load_ref * 1e3
+    out = {}
+    for m in MODELS:
+        def f(x, m=m):
+            return model_pull_off(m, [10.0**x], case, ctx)["pull_off_mN"][0] / p_jkr - 1.0 - tol
+
+        ok = f(lo) < 0 < f(hi)
+        out[m] = 10.0 ** brentq(f, lo, hi, xtol=1e-3) if ok else math.nan
+    return out
+
+
+def discussion(case=PDMS_CASE, fits=None, ctx=None) -> dict:
+    """The Discussion's two estimates with the given fits (default: :func:`own_fits`).
+
+    Returns ``a0t_hat``/``a0t_mm`` (threshold radius for the full amplification 1.5/k from the
+    collapse fit), ``vhat_full_amplification`` (Gamma_PB(n, k_fig) = f/k_fig with the k of
+    the paper's Fig. PB_BEM, as the paper reads it), ``speed_full_amplification_m_s`` (the
+    v-r fit inverted with rhat = r tau0/l0, as the paper), ``..._dref_m_s`` (rhat = r
+    tau0/d_ref), and the same at the PDMS's own k (``..._pdms_k``).
+    """
+    ctx = ctx or _context(case)
+    fits = fits or own_fits()
+    sc, tau0, k, n = ctx["sc"], ctx["tau0"], ctx["k"], ctx["n"]
+    thr, vr = fits["threshold"], fits["v_vs_r"]
+    f = case["full_amplification_fraction"]
+    a0t = threshold_radius_hat(k, thr["prefactor"], thr["exponent"])
+    vhat = full_amplification_vhat(n, case["pb_figure_k"], f)
+    vhat_k = full_amplification_vhat(n, k, f)
+
+    def speed(v, length):
+        return unloading_speed_for_vhat(v, length, tau0, vr["prefactor"], vr["exponent"])
+
+    return {"fits": fits, "a0t_hat": a0t, "a0t_mm": a0t * sc.a_ref * 1e3,
+            "vhat_full_amplification": vhat,
+            "speed_full_amplification_m_s": speed(vhat, sc.l0),
+            "speed_full_amplification_dref_m_s": speed(vhat, sc.d_ref),
+            "vhat_full_amplification_pdms_k": vhat_k,
+            "speed_full_amplification_pdms_k_m_s": speed(vhat_k, sc.l0),
+            "crack_speed_full_amplification_pdms_k_m_s": vhat_k * sc.l0 / tau0}
+
+
+def _crack_front_full_amplification(ctx, f) -> dict:
+    """The crack-front model's own answer at the PDMS's k: the unloading speed whose pull-off
+    is f * 1.5/k, from a0 = 2 x its pinned threshold radius 1.040 k^(-1/3)."""
+    k, sc = ctx["k"], ctx["sc"]
+    a0t_cf = A_PULL_OFF_FORCE * k ** (-1.0 / 3.0)
+    a_big = 2.0 * a0t_cf
+
+    def short(log_r):
+        return unload(ctx["law_pb"], rate=10.0**log_r, mu=ctx["mu"], a0=a_big).pull_off * k \
+            / 1.5 - f
+
+    lo, hi = 0.0, 23.0       # beyond ~1e23 the PB table's speed cap is reached
+    ok = short(lo) < 0 < short(hi)
+    log_rate = brentq(short, lo, hi, xtol=1e-4) if ok else math.nan
+    return {"a0t_crack_front_hat": a0t_cf, "a0t_crack_front_mm": a0t_cf * sc.a_ref * 1e3,
+            "crack_front_a0_for_full_amplification_hat": a_big,
+            "speed_full_amplification_crack_front_m_s":
+                float(sc.rate_physical(10.0**log_rate, ctx["tau0"])) if ok else math.nan}
+
+
+def compute(case=PDMS_CASE, fits=None) -> dict:
+    """Every number of the PDMS report (SI unless the key says otherwise).
+
+    ``fits``: the collapse and v-r fits for the discussion's estimates (default
+    :func:`own_fits`); the paper's go into the ``paper`` entry for comparison.
+    """
+    t0 = time.perf_counter()
+    ctx = _context(case)
+    sc, tau0, k, n, mu, a0 = (ctx[x] for x in ("sc", "tau0", "k", "n", "mu", "a0"))
+    speeds_um = _speeds(case["speeds_um_s"])
+    out_models = {m: model_pull_off(m, speeds_um, case, ctx) for m in MODELS}
+    rates = [float(sc.rate_hat(v * 1e-6, tau0)) for v in speeds_um]
+    gs = case["gent_schultz"]
     # Gent-Schultz over the linear (PB) effective surface energy, against crack speed
     v_um = np.logspace(0.0, 4.0, 41)
     g_lin = pb_gamma_eff(n, k, v_um * 1e-6 * tau0 / sc.l0)
@@ -107,43 +272,46 @@ def compute(case=PDMS_CASE) -> dict:
     v1 = case["gs_over_linear"]
     paper_ratio = 1.0 + (v_um / v1["v1_um_s"]) ** v1["exponent"]
     ratio = g_gs / g_lin
-    # the same ratio along the unloading speeds, from the two crack-front pull-offs
+    # the same ratio along the unloading speeds >= 1 um/s, from the two crack-front pull-offs
     # (P = 1.5 pi R dg_eff), against the PB crack-front's crack speed at pull-off
-    p_gs = np.array(out_models["crack_gs"]["pull_off_mN"])
-    p_lin = np.array(out_models["crack_pb"]["pull_off_mN"])
-    v_cf = np.array(out_models["crack_pb"]["crack_speed_um_s"])
+    sel = speeds_um >= 1.0 - 1e-9
+    p_gs = np.array(out_models["crack_gs"]["pull_off_mN"])[sel]
+    p_lin = np.array(out_models["crack_pb"]["pull_off_mN"])[sel]
+    v_cf = np.array(out_models["crack_pb"]["crack_speed_um_s"])[sel]
     paper_cf = 1.0 + (v_cf / v1["v1_um_s"]) ** v1["exponent"]
-    # threshold radius for the full amplification 1.5/k
-    col = case["threshold_collapse"]
-    a0t_hat = (1.5 / k / col["prefactor"]) ** (1.0 / col["exponent"])
-    a0t_cf_hat = A_PULL_OFF_FORCE * k ** (-1.0 / 3.0)      # crack-front, pinned glassy limit
-    # speed for the full amplification (fraction f of 1/k)
     f = case["full_amplification_fraction"]
-    vhat_full = math.exp(brentq(lambda x: float(pb_gamma_eff(n, k, math.exp(x))) * k - f,
-                                math.log(1e-3), math.log(1e24), xtol=1e-10))
-    rhat_full = (vhat_full / 2.887) ** (1.0 / 1.171)
-    speed_full_l0 = rhat_full * sc.l0 / tau0                 # paper's convention r tau0/l0
-    speed_full_dref = rhat_full * sc.d_ref / tau0            # DESIGN's r tau0/d_ref
-    # the crack-front model's own answer: unloading speed for f * 1.5/k with a0 = 2 a0t_cf
-    a_big = 2.0 * a0t_cf_hat
-
-    def short(log_r):
-        return unload(law_pb, rate=10.0**log_r, mu=mu, a0=a_big).pull_off * k / 1.5 - f
-
-    lo, hi = 0.0, 23.0       # beyond ~1e23 the PB table's speed cap is reached
-    cf_ok = short(lo) < 0 < short(hi)
-    log_rate_full = brentq(short, lo, hi, xtol=1e-4) if cf_ok else math.nan
-    speed_full_cf = float(sc.rate_physical(10.0**log_rate_full, tau0)) if cf_ok else math.nan
+    ours = discussion(case, fits, ctx)
+    pf = paper_fits()
+    paper = {}
+    if pf:
+        a0t_p = threshold_radius_hat(k, pf["threshold"]["prefactor"], pf["threshold"]["exponent"])
+        vr_p = pf["v_vs_r"]
+        paper = {
+            "fits": pf, "a0t_hat": a0t_p, "a0t_mm": a0t_p * sc.a_ref * 1e3,
+            "vhat_full_amplification": pf["vhat_full_amplification"],
+            "speed_full_amplification_m_s": unloading_speed_for_vhat(
+                pf["vhat_full_amplification"], sc.l0, tau0, vr_p["prefactor"], vr_p["exponent"]),
+            # our vhat reading through the paper's v-r fit (isolates the fit's share)
+            "speed_full_amplification_our_vhat_m_s": unloading_speed_for_vhat(
+                ours["vhat_full_amplification"], sc.l0, tau0, vr_p["prefactor"],
+                vr_p["exponent"]),
+        }
+    p_jkr = 1.5 * sc.load_ref * 1e3
     return {
-        "case": {**{k_: v for k_, v in case.items() if not isinstance(v, dict)},
-                 **{k_: v for k_, v in case.items() if isinstance(v, dict)}},
+        "case": dict(case),
         "mu": mu, "k": k, "l0_nm": sc.l0 * 1e9, "a_ref_mm": sc.a_ref * 1e3,
-        "d_ref_um": sc.d_ref * 1e6, "l0_over_a_ref": l0_hat,
+        "d_ref_um": sc.d_ref * 1e6, "l0_over_a_ref": units.l0_hat(mu),
         "a0_preload_mm": a0 * sc.a_ref * 1e3, "a0_preload_hat": a0,
-        "jkr_pull_off_mN": 1.5 * sc.load_ref * 1e3,
-        "speeds_um_s": list(speeds_um), "rate_hat": list(rates),
+        "jkr_pull_off_mN": p_jkr,
+        "speeds_um_s": list(speeds_um), "rate_hat": rates,
         "pull_off_mN": {m: d["pull_off_mN"] for m, d in out_models.items()},
         "models": out_models,
+        "slow_limit": {
+            "tolerance": case["slow_limit_tolerance"],
+            "speed_within_tolerance_um_s": slow_limit(case, ctx),
+            "pull_off_over_jkr_at_slowest": {
+                m: out_models[m]["pull_off_mN"][0] / p_jkr for m in MODELS},
+            "slowest_speed_um_s": float(speeds_um[0])},
         "bem": "not run: mu = 103 is outside the BEM's reach (Scene mu <= 20; l0 = 1.6e-4 a_ref)",
         "gs_over_linear": {
             "crack_speed_um_s": list(v_um), "gamma_lin": list(g_lin), "gamma_gs": list(g_gs),
@@ -155,15 +323,10 @@ def compute(case=PDMS_CASE) -> dict:
             "pull_off_ratio_crack_speed_um_s": list(v_cf),
             "pull_off_ratio_paper_fit": list(paper_cf),
         },
-        "a0t_hat": a0t_hat, "a0t_mm": a0t_hat * sc.a_ref * 1e3,
-        "a0t_crack_front_hat": a0t_cf_hat, "a0t_crack_front_mm": a0t_cf_hat * sc.a_ref * 1e3,
-        "full_amplification_fraction": f,
-        "vhat_full_amplification": vhat_full,
-        "speed_full_amplification_m_s": speed_full_l0,
-        "speed_full_amplification_dref_m_s": speed_full_dref,
-        "crack_speed_full_amplification_m_s": vhat_full * sc.l0 / tau0,
-        "speed_full_amplification_crack_front_m_s": speed_full_cf,
-        "crack_front_a0_for_full_amplification_hat": a_big,
+        **{key: v for key, v in ours.items()},
+        "full_amplification_fraction": f, "pb_figure_k": case["pb_figure_k"],
+        **_crack_front_full_amplification(ctx, f),
+        "paper": paper,
         "wall_s": time.perf_counter() - t0,
     }
 
@@ -181,10 +344,14 @@ def plot(res: dict, out) -> Path:
               "pb_estimate": ("b:", "PB estimate, rhat = r tau0/d_ref"),
               "pb_estimate_l0": ("c-.", "PB estimate, rhat = r tau0/l0")}
     for name, (st, label) in styles.items():
-        ax1.semilogx(v, res["pull_off_mN"][name], st, marker="o", ms=3, label=label)
+        ax1.loglog(v, res["pull_off_mN"][name], st, marker="o", ms=2, label=label)
     ax1.axhline(res["jkr_pull_off_mN"], color="0.5", lw=0.8, label="relaxed JKR 1.5 pi dg R")
+    ax1.axvspan(1.0, 1e4, color="y", alpha=0.1, label="the paper's speeds")
     ax1.set_xlabel("unloading speed r [um/s]")
     ax1.set_ylabel("pull-off force [mN]")
+    ax1.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+    ax1.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax1.set_yticks([3, 4, 5, 7, 10, 15, 20, 30])
     ax1.set_title(f"PDMS, preload 1.5 mN, mu = {res['mu']:.1f}, l0 = {res['l0_nm']:.1f} nm")
     ax1.legend(fontsize=8)
     ax1.grid(True, which="both", alpha=0.3)
@@ -217,35 +384,60 @@ def _paper_values():
     """The paper's printed numbers (tests/data/paper_values.yaml), for the comparison column."""
     import yaml
 
-    p = Path(__file__).resolve().parent.parent / "tests" / "data" / "paper_values.yaml"
+    p = ROOT / "tests" / "data" / "paper_values.yaml"
     return yaml.safe_load(p.read_text())["pdms_experiment"] if p.is_file() else {}
+
+
+def _fit_str(fit) -> str:
+    return f"{fit['prefactor']:.4g} x^{fit['exponent']:.4g}" if fit else "--"
 
 
 def report(res: dict, out) -> Path:
     pv = _paper_values()
+    pp = res.get("paper") or {}
+    pfit = pp.get("fits", {})
+    thr_p = pv.get("threshold_radius_estimate", {})
+    amp_p = pv.get("max_amplification_rate_estimate", {})
     speeds = res["speeds_um_s"]
-    pick = [i for i, s in enumerate(speeds) if any(math.isclose(s, x) for x in (1, 10, 100, 1e3, 1e4))]
+    f = res["full_amplification_fraction"]
+    kf = res["pb_figure_k"]
+    sl = res["slow_limit"]
+    pick = [i for i, s in enumerate(speeds) if abs(math.log10(s) - round(math.log10(s))) < 1e-9]
     L = ["# PDMS: pull-off force vs unloading speed (generated by `make pdms`)", "",
          "Glass lens on Sylgard 184 with the paper's constants (sweep/pdms.py `PDMS_CASE`). "
-         "Paper values in the last column are for comparison only (tests/data/paper_values.yaml).",
+         "Every number in the column 'this project' is computed by this code, the discussion's "
+         "estimates with this project's own fits (results/threshold/fit.json, "
+         "results/vr/fit.json); the paper's printed values (tests/data/paper_values.yaml) and "
+         "the paper's fits pushed through the same code are for comparison only.",
          "", "| quantity | this project | paper |", "| --- | --- | --- |",
          f"| Tabor parameter mu | {res['mu']:.2f} | about 103 (h0 = {pv.get('h0_fit_nm')} nm) |",
          f"| l0 [nm] | {res['l0_nm']:.2f} | {pv.get('l0_nm')} |",
          f"| k = E0/Einf | {res['k']:.4g} | {pv.get('k')} |",
          f"| relaxed JKR pull-off [mN] | {res['jkr_pull_off_mN']:.4f} | 3.725 (1.5 pi dg R) |",
          f"| a0 at 1.5 mN preload [mm] | {res['a0_preload_mm']:.4f} ({res['a0_preload_hat']:.3f} a_ref) | -- |",
-         f"| threshold radius a0t, paper's collapse with our k [a_ref / mm] | "
-         f"{res['a0t_hat']:.2f} / {res['a0t_mm']:.2f} | "
-         f"{pv.get('threshold_radius_estimate', {}).get('a0t_hat')} / "
-         f"{pv.get('threshold_radius_estimate', {}).get('a0t_mm')} |",
+         f"| collapse fit P_po = A a0t^B | {_fit_str(res['fits']['threshold'])} "
+         f"(`make threshold`) | {_fit_str(pfit.get('threshold'))} |",
+         f"| threshold radius a0t for 1.5/k from the collapse fit [a_ref / mm] | "
+         f"{res['a0t_hat']:.2f} / {res['a0t_mm']:.2f} | {thr_p.get('a0t_hat')} / "
+         f"{thr_p.get('a0t_mm')} (paper's fit through this code: {pp.get('a0t_hat', math.nan):.2f}"
+         f" / {pp.get('a0t_mm', math.nan):.2f}) |",
          f"| threshold radius, crack-front model 1.040 k^(-1/3) [a_ref / mm] | "
          f"{res['a0t_crack_front_hat']:.2f} / {res['a0t_crack_front_mm']:.2f} | -- |",
-         f"| vhat where Gamma_PB = {res['full_amplification_fraction']:g}/k | "
-         f"{res['vhat_full_amplification']:.3g} | about 1e9 (read off Fig. PB_BEM) |",
-         f"| unloading speed for it, v-r fit with r tau0/l0 [m/s] | "
-         f"{res['speed_full_amplification_m_s']:.3g} | "
-         f"{pv.get('max_amplification_rate_estimate', {}).get('r_m_s')} |",
-         f"| same, v-r fit with r tau0/d_ref [m/s] | {res['speed_full_amplification_dref_m_s']:.3g} | -- |",
+         f"| v-r fit vhat = A rhat^B | {_fit_str(res['fits']['v_vs_r'])} (`make vr`) | "
+         f"{_fit_str(pfit.get('v_vs_r'))} |",
+         f"| vhat where Gamma_PB(n = {res['case']['n']}, k = {kf:g}) = {f:g}/k (Fig. PB_BEM's k) | "
+         f"{res['vhat_full_amplification']:.3g} | about {amp_p.get('v_hat')} "
+         "(read off Fig. PB_BEM) |",
+         f"| unloading speed for it, v-r fit inverted with rhat = r tau0/l0 [m/s] | "
+         f"{res['speed_full_amplification_m_s']:.3g} | {amp_p.get('r_m_s')} (paper's fit and "
+         f"vhat through this code: {pp.get('speed_full_amplification_m_s', math.nan):.3g}; "
+         f"paper's fit with our vhat: {pp.get('speed_full_amplification_our_vhat_m_s', math.nan):.3g}) |",
+         f"| same, rhat = r tau0/d_ref [m/s] | {res['speed_full_amplification_dref_m_s']:.3g} | -- |",
+         f"| vhat where Gamma_PB(n, k = {res['k']:.3g}) = {f:g}/k (the PDMS's own k) | "
+         f"{res['vhat_full_amplification_pdms_k']:.3g} | -- |",
+         f"| unloading speed for it, rhat = r tau0/l0 [m/s] | "
+         f"{res['speed_full_amplification_pdms_k_m_s']:.3g} (crack speed "
+         f"{res['crack_speed_full_amplification_pdms_k_m_s']:.2g} m/s) | -- |",
          f"| same, crack-front model (a0 = {res['crack_front_a0_for_full_amplification_hat']:.1f} a_ref) [m/s] | "
          f"{res['speed_full_amplification_crack_front_m_s']:.3g} | -- |",
          f"| GS/lin ratio at v1 = 1e4 um/s | {res['gs_over_linear']['ratio_at_v1']:.3f} | 2 (1 + (v/v1)^(1/2)) |",
@@ -259,21 +451,43 @@ def report(res: dict, out) -> Path:
          "| --- | --- | --- | --- | --- | --- |"]
     for i in pick:
         p = res["pull_off_mN"]
-        L.append(f"| {speeds[i]:g} | {p['crack_pb'][i]:.3f} | {p['crack_gs'][i]:.3f} | "
-                 f"{p['pb_estimate'][i]:.3f} | {p['pb_estimate_l0'][i]:.3f} | "
+        L.append(f"| {speeds[i]:g} | {p['crack_pb'][i]:.4f} | {p['crack_gs'][i]:.4f} | "
+                 f"{p['pb_estimate'][i]:.4f} | {p['pb_estimate_l0'][i]:.4f} | "
                  f"{res['models']['crack_pb']['crack_speed_um_s'][i]:.3g} |")
+    names = {"crack_pb": "crack front, PB", "crack_gs": "crack front, GS",
+             "pb_estimate": "PB estimate (d_ref)", "pb_estimate_l0": "PB estimate (l0)"}
+    L += ["", "## Slow limit", "",
+          f"Speed below which each model's pull-off is within {100 * sl['tolerance']:g} % of the "
+          f"relaxed JKR {res['jkr_pull_off_mN']:.4f} mN, and its pull-off / JKR at the slowest "
+          f"speed {sl['slowest_speed_um_s']:g} um/s:", "",
+          "| model | speed for P < 1.02 P_JKR [um/s] | P/P_JKR at the slowest speed |",
+          "| --- | --- | --- |"]
+    for m, name in names.items():
+        L.append(f"| {name} | {sl['speed_within_tolerance_um_s'][m]:.3g} | "
+                 f"{sl['pull_off_over_jkr_at_slowest'][m]:.6f} |")
     L += ["", "![pull-off and effective surface energy](pdms.png)", "",
           "## Notes", "",
-          "* BEM: " + res["bem"] + ".",
-          "* The crack-front model's crack speed at pull-off is about 16-20 times the unloading "
-          "speed (JKR geometry, da/d(delta) ~ R/a_ref / 1.4 at a = 1.04 a_ref), so with l0 = 30 nm "
-          "even 1 um/s gives vhat ~ 10 and Gamma_PB ~ 1.8: the linear crack-front prediction does "
-          "NOT approach the relaxed JKR 3.725 mN at 1 um/s.",
+          "* BEM: " + res["bem"] + ". Where the BEM reaches, it is checked against the "
+          "crack-front model and the PB estimate in results/agreement/agreement.md "
+          "(`make agreement`).",
+          "* The pull-off at 1 um/s (crack front, PB: 6.7 mN) is physics, not a bug: the crack "
+          "speed at pull-off is about 16 times the unloading speed (JKR geometry), so with "
+          "l0 = 30 nm and tau0 = 0.019 s, 1 um/s gives vhat ~ 10, inside the broad (n = 0.22) "
+          "transition, where Gamma_PB ~ 1.8. The relaxed JKR 3.725 mN is approached only "
+          "below ~1e-2 um/s (table above); the crack-front model tends to it (its constant-Gamma "
+          "limit) and agrees with the BEM within 3 % at rate 1, mu = 3.24 "
+          "(results/agreement/agreement.md).",
           "* The paper's v-r fit was made at mu = 3.24; transferred to mu = 103 the two readings of "
           "rhat_PB differ by the factor d_ref/l0 = "
           f"{res['d_ref_um'] * 1e3 / res['l0_nm']:.0f}, hence the two PB-estimate columns.",
-          f"* Full amplification is defined here as Gamma_PB = {res['full_amplification_fraction']:g}/k; "
-          "for n = 0.22 the approach to 1/k is slow (1/k - Gamma ~ vhat^(-n)).",
+          f"* Full amplification is defined here as Gamma_PB = {f:g}/k. The paper's vhat ~ 1e9 "
+          f"is where the n = 0.2 curve of its Fig. PB_BEM (drawn for k = {kf:g}) nears 1/k; "
+          "for the PDMS's own k = 4.7e-4, Persson-Brener reaches 0.9/k only at vhat ~ "
+          f"{res['vhat_full_amplification_pdms_k']:.1g} (1/k - Gamma ~ vhat^(-n) with n = 0.22): "
+          "unloading and crack speeds far beyond any physical speed, i.e. the linear theory "
+          "puts the full amplification of PDMS out of reach. The headline speed "
+          "(`speed_full_amplification_m_s`) follows the paper's reading (k of Fig. PB_BEM) "
+          "so that it compares with its 31.4 m/s.",
           f"* Wall time {res['wall_s']:.1f} s."]
     Path(out).write_text("\n".join(L) + "\n")
     return Path(out)

@@ -212,6 +212,40 @@ def _campaign_table(root: Path) -> list[str]:
     return lines
 
 
+def _pdms_section(root: Path) -> list[str]:
+    """The PDMS experiment (`make pdms`) and the model agreement (`make agreement`), cited
+    from their own reports with the headline numbers beside the paper's."""
+    res = _read(root / "pdms" / "pdms.json")
+    lines = ["## The PDMS experiment in SI units and the model agreement "
+             "(`make pdms`, `make agreement`)", ""]
+    if not res:
+        return lines + ["Not run.", ""]
+    pp = res.get("paper") or {}
+    sl = res["slow_limit"]["speed_within_tolerance_um_s"]
+    p = res["pull_off_mN"]
+    i1 = min(range(len(res["speeds_um_s"])), key=lambda i: abs(res["speeds_um_s"][i] - 1.0))
+    lines += [
+        "Details: [pdms/REPORT.md](pdms/REPORT.md); where the BEM reaches (mu <= 15 here), the "
+        "crack-front model and the PB estimate are checked against it in "
+        "[agreement/agreement.md](agreement/agreement.md).", "",
+        "| quantity | this project | paper (its fits through this code) |", "| --- | --- | --- |",
+        f"| mu, l0 [nm] | {_g(res['mu'])}, {_g(res['l0_nm'])} | 103, 30.0 |",
+        f"| relaxed JKR pull-off 1.5 pi dg R [mN] | {_g(res['jkr_pull_off_mN'])} | 3.725 |",
+        f"| pull-off at 1 um/s, crack front (PB Gamma) [mN] | {_g(p['crack_pb'][i1])} | -- |",
+        f"| speed below which the crack-front pull-off is within 2 % of the relaxed JKR [um/s] "
+        f"| {_g(sl['crack_pb'], 3)} | -- |",
+        f"| threshold radius for 1.5/k, our collapse fit [a_ref / mm] | {_g(res['a0t_hat'])} / "
+        f"{_g(res['a0t_mm'], 3)} | 30.9 / 5.8 ({_g(pp.get('a0t_hat', math.nan))} / "
+        f"{_g(pp.get('a0t_mm', math.nan), 3)}) |",
+        f"| unloading speed for the full amplification, our v-r fit [m/s] | "
+        f"{_g(res['speed_full_amplification_m_s'], 3)} | 31.4 "
+        f"({_g(pp.get('speed_full_amplification_m_s', math.nan), 3)}) |",
+        f"| same at the PDMS's own k (PB Gamma = 0.9/k at vhat = "
+        f"{res['vhat_full_amplification_pdms_k']:.2g}) [m/s] | "
+        f"{res['speed_full_amplification_pdms_k_m_s']:.2g} | -- |", ""]
+    return lines
+
+
 def build_report(root, paper: dict, commit: str) -> str:
     """The Markdown text of REPORT.md for the results directory ``root``.
 
@@ -268,5 +302,6 @@ def build_report(root, paper: dict, commit: str) -> str:
             out.append(f"| {r['n']:g} | {r['q1']:.4f} | {r['q1_limit']:.4f} | "
                        f"{-0.0125 + 3.136 * r['n']:.4f} | {r['q2']:.4g} | {r['m2']:.4f} |")
         out.append("")
+    out += _pdms_section(root)
     out += _campaign_table(root)
     return "\n".join(out) + "\n"

@@ -23,9 +23,41 @@ from .errors import InputError, check_choice, check_positive, check_range
 from .theory import jkr_contact_radius, jkr_pull_off
 from .units import PhysicalScale
 
-__all__ = ["SIScene", "run_si", "SI_MODELS"]
+__all__ = ["SIScene", "run_si", "SI_MODELS", "SI_AXES", "si_table"]
 
 SI_MODELS = ("bem", "crack", "pb", "auto")
+
+
+def _si_axis(name, unit, help, lo=0.0, hi=None, lo_open=True, required=True, order=0):
+    from .scene import Axis
+
+    return Axis(name=name, default=None, required=required, help=help, unit=unit,
+                limits=(lo, hi), lo_open=lo_open, choices=None, label=name, order=order,
+                plot_group=True, cli_default=None)
+
+
+#: The SI fields of a ``units: si`` config grid (and of :class:`SIScene`), in the order of
+#: expansion (the last varies fastest); ``model``, ``material`` and ``stop`` are the Scene's.
+#: Exactly one of ``preload``, ``a0``, ``indentation`` is given.
+SI_AXES = {a.name: a for a in (
+    _si_axis("R", "m", "sphere radius", order=3),
+    _si_axis("E0", "Pa", "relaxed Young's modulus", order=4),
+    _si_axis("Einf", "Pa", "glassy Young's modulus (>= E0)", order=5),
+    _si_axis("nu", "", "Poisson's ratio", hi=0.5, lo_open=False, order=6),
+    _si_axis("n", "", "MPL exponent", hi=5.0, order=7),
+    _si_axis("tau0", "s", "MPL time", order=8),
+    _si_axis("dg", "J/m^2", "work of adhesion", order=9),
+    _si_axis("h0", "m", "LJ equilibrium distance", order=10),
+    _si_axis("preload", "N", "compressive preload after full relaxation (or a0 or "
+             "indentation)", lo_open=False, required=False, order=11),
+    _si_axis("a0", "m", "initial contact radius (or preload or indentation)",
+             required=False, order=12),
+    _si_axis("indentation", "m", "initial indentation (or preload or a0)", lo=None,
+             lo_open=False, required=False, order=13),
+    _si_axis("speed", "m/s", "unloading speed", order=14),
+)}
+#: The initial-state fields of an SI grid: exactly one is given.
+SI_INITIAL = ("preload", "a0", "indentation")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -194,6 +226,12 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
         model = choose_model(si.to_scene(), numerics) if lo <= d["mu"] <= hi else "crack"
     res = {"model": model}
     if model == "bem":
+        from .problem import BEM_MU_RANGE
+
+        lo, hi = BEM_MU_RANGE
+        if d["k"] < 1.0 and not lo <= d["mu"] <= hi:
+            raise InputError(f"mu must be in [{lo:g}, {hi:g}] for the BEM (got {d['mu']:.6g}): "
+                             "outside the BEM's scene ranges; use model crack or pb")
         try:
             scene = si.to_scene()
         except InputError as exc:
@@ -222,3 +260,49 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
     res["si"] = si.to_dict()
     res.update(_si_of(si, dim))
     return res
+
+
+def si_row(si: SIScene, row) -> dict:
+    """SI inputs and outputs of one stored row (a mapping with the Result columns)."""
+    def get(key):
+        v = row.get(key)
+        return None if v is None or (isinstance(v, float) and math.isnan(v)) else v
+
+    dim = {"pull_off": get("pull_off"), "a_pulloff": get("a_pulloff"),
+           "delta_pulloff": get("delta_pulloff"), "crack_speed": get("crack_speed"),
+           "t_pulloff": get("t_pulloff"), "a0": get("a0_result"),
+           "delta0": get("delta0_result")}
+    out = {f"si_{k}": v for k, v in si.to_dict().items() if v is not None and k != "material"}
+    out.update(_si_of(si, dim))
+    return out
+
+
+def si_table(results) -> "pandas.DataFrame":  # noqa: F821 - annotation only
+    """The rows of a results file written by a ``units: si`` config, in both systems.
+
+    The SI inputs of each scene come from the config the file records (``config_text``),
+    expanded again: columns ``scene_id``, ``model_used``, ``status``, the SI inputs
+    (``si_R``, ``si_speed``, ...), ``mu``, ``k``, ``rate``, ``l0_m``, ``a_ref_m``,
+    ``d_ref_m``, ``load_ref_N``, ``jkr_pull_off_N``, ``pull_off_N``, ``a_pulloff_m``,
+    ``crack_speed_m_s``, ... and the dimensionless ``pull_off``. InputError if the file was
+    not written by an SI config.
+    """
+    import pandas as pd
+
+    from .config import parse_config
+    from .store import load, read_attrs
+
+    text = str(read_attrs(results).get("config_text", ""))
+    cfg = parse_config(text, source=str(results)) if text else None
+    if cfg is None or cfg.units != "si":
+        raise InputError(f"results: {results} was not written by a `units: si` config")
+    by_id = dict(cfg.si_tasks())
+    rows = []
+    for row in load(results).to_dict("records"):
+        si = by_id.get(row["scene_id"])
+        if si is None:
+            continue
+        rows.append({"scene_id": row["scene_id"], "model_used": row.get("model_used"),
+                     "status": row.get("status"), "pull_off": row.get("pull_off"),
+                     **si_row(si, row)})
+    return pd.DataFrame(rows)

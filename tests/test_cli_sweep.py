@@ -112,12 +112,18 @@ BAD_CONFIGS = {
     "malformed": ("name: x\ngrid: {n: [0.4, 1.6\n", "not valid YAML at line"),
     "types": ("name: x\ngrid: {n: abc, rate: [1], a0: 2}\nstore: {trajectories: 3}\n",
               "2 problems: grid.n must be a number (got 'abc'); store.trajectories"),
-    "range": ("name: x\ngrid: {n: 0.8, rate: 1, a0: 2, mu: 500}\n",
-              "grid.mu must be in [0.01, 100] (got 500)"),
+    "range": ("name: x\ngrid: {n: 0.8, rate: 1, a0: 2, mu: 5000}\n",
+              "grid.mu must be in [0.01, 1000] (got 5000)"),
     "unknown": ("name: x\ngrid: {n: 0.8, rate: 1, a0: 2, speed: 3}\n",
                 "grid.speed: unknown axis (allowed:"),
     "code": ("name: !!python/object/apply:os.getcwd []\ngrid: {n: 0.8, rate: 1, a0: 2}\n",
              "not valid YAML"),
+    "si_nu": ("name: x\nunits: si\ngrid: {R: 5e-3, E0: 1e6, Einf: 1e9, nu: 0.7, n: 0.2, "
+              "tau0: 0.02, dg: 0.15, h0: 3e-8, preload: 1e-3, speed: 1e-6}\n",
+              "grid.nu must be in [0, 0.5] (got 0.7)"),
+    "si_missing": ("name: x\nunits: si\ngrid: {R: 5e-3, E0: 1e6, Einf: 1e9, nu: 0.5, n: 0.2, "
+                   "tau0: 0.02, h0: 3e-8, preload: 1e-3, speed: 1e-6}\n",
+                   "grid.dg: required SI field is missing (work of adhesion, J/m^2)"),
 }
 
 

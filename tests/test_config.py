@@ -131,7 +131,7 @@ def test_every_problem_reported_at_once():
 @pytest.mark.parametrize("over, needle", [
     ({"grid": {"n": 6, "rate": 1, "a0": 2}}, "grid.n must be in (0, 5] (got 6)"),
     ({"grid": {"n": 0.8, "rate": 0, "a0": 2}}, "grid.rate must be in (0, 1e+12]"),
-    ({"grid": {"n": 0.8, "rate": 1, "a0": 2, "mu": 0.001}}, "grid.mu must be in [0.01, 100]"),
+    ({"grid": {"n": 0.8, "rate": 1, "a0": 2, "mu": 0.001}}, "grid.mu must be in [0.01, 1000]"),
     ({"grid": {"n": 0.8, "rate": 1, "a0": 2, "delta0": 1}}, "exactly one of the axes a0"),
     ({"grid": {"n": 0.8, "rate": 1}}, "exactly one of the axes a0"),
     ({"grid": {"rate": 1, "a0": 2}}, "grid.n: required axis is missing"),
@@ -262,3 +262,86 @@ def test_to_dict_round_trip():
     again = config_from_dict(cfg.to_dict())
     assert again.config_hash == cfg.config_hash
     assert isinstance(Scene.from_dict(cfg.scenes()[0].to_dict()), Scene)
+
+
+# ----------------------------------------------------------------------------- units: si
+PDMS_SI = {"R": 5.19e-3, "E0": 1.458e6, "Einf": 3.089e9, "nu": 0.5, "n": 0.2207,
+           "tau0": 0.01876, "dg": 0.1523, "h0": 30.8e-9, "preload": 1.5e-3}
+
+
+def si_base(**over):
+    grid = {"model": "pb", **PDMS_SI, "speed": [1e-6, 1e-4]}
+    grid.update(over)
+    return {"name": "si", "units": "si", "grid": {k: v for k, v in grid.items() if v is not None}}
+
+
+def test_si_grid_becomes_the_dimensionless_scenes():
+    """Closed forms, computed here: E0* = E0/(1 - nu^2), mu = (R dg^2/(E0*^2 h0^3))^(1/3),
+    rate = speed tau0/h0, k = E0/Einf, a0 the relaxed JKR radius at the preload."""
+    from sweep.theory import jkr_load
+
+    cfg = config_from_dict(si_base())
+    assert cfg.units == "si"
+    tasks = cfg.tasks()
+    assert len(tasks) == 2
+    e0s = PDMS_SI["E0"] / (1 - PDMS_SI["nu"] ** 2)
+    mu = (PDMS_SI["R"] * PDMS_SI["dg"] ** 2 / (e0s**2 * PDMS_SI["h0"] ** 3)) ** (1 / 3)
+    for (sid, s), speed in zip(tasks, (1e-6, 1e-4)):
+        assert s.model == "pb" and s.material == "mpl" and s.n == PDMS_SI["n"]
+        assert s.mu == pytest.approx(mu, rel=1e-12)
+        assert s.k == pytest.approx(PDMS_SI["E0"] / PDMS_SI["Einf"], rel=1e-12)
+        assert s.rate == pytest.approx(speed * PDMS_SI["tau0"] / PDMS_SI["h0"], rel=1e-12)
+        load_hat = -PDMS_SI["preload"] / (math.pi * PDMS_SI["dg"] * PDMS_SI["R"])
+        assert float(jkr_load(s.a0)) == pytest.approx(-load_hat, rel=1e-9)
+        assert sid == scene_id(s, Numerics.preset("balanced"))
+    si = dict(cfg.si_tasks())
+    assert [si[sid].speed for sid, _ in tasks] == [1e-6, 1e-4]
+    # the same scenes given in the dimensionless axes have the same ids (no new id form)
+    s0 = tasks[0][1]
+    dim = config_from_dict({"name": "d", "grid": {"model": "pb", "n": s0.n, "k": s0.k,
+                                                   "mu": s0.mu, "a0": s0.a0, "rate": s0.rate}})
+    assert dim.tasks()[0][0] == tasks[0][0]
+
+
+def test_si_config_round_trips_through_to_dict_and_yaml():
+    cfg = config_from_dict(si_base(speed={"log10": [-6, -4, 3]}))
+    again = config_from_dict(cfg.to_dict())
+    assert again.units == "si" and again.config_hash == cfg.config_hash
+    assert parse_config(cfg.text).config_hash == cfg.config_hash
+
+
+@pytest.mark.parametrize("over, needle", [
+    ({"R": -1}, "grid.R must be > 0 (got -1)"),
+    ({"nu": 0.6}, "grid.nu must be in [0, 0.5] (got 0.6)"),
+    ({"E0": None}, "grid.E0: required SI field is missing (relaxed Young's modulus, Pa)"),
+    ({"speed": None}, "grid.speed: required SI field is missing"),
+    ({"a0": 1e-4}, "grid: give exactly one of preload [N], a0 [m] and indentation [m]"),
+    ({"Einf": 1e6}, "Einf must be >= E0"),
+    ({"rate": 3}, "grid.rate: unknown SI field"),
+    ({"h0": "abc"}, "grid.h0 must be a number (got 'abc')"),
+    ({"model": "fem"}, "grid.model must be one of"),
+])
+def test_bad_si_grid_one_line_naming_the_field(over, needle):
+    with pytest.raises(InputError) as exc:
+        config_from_dict(si_base(**over))
+    text = str(exc.value)
+    assert needle in text and "\n" not in text
+
+
+def test_units_must_be_known():
+    with pytest.raises(InputError, match="units: must be one of dimensionless, si"):
+        config_from_dict({**base(), "units": "cgs"})
+
+
+def test_shipped_pdms_config_is_the_papers_case():
+    from tests.reference import paper_values
+
+    pv = paper_values()["pdms_experiment"]
+    cfg = load_config(CONFIGS / "pdms.yaml")
+    sis = [si for _, si in cfg.si_tasks()]
+    speeds_um = sorted({si.speed * 1e6 for si in sis})
+    assert speeds_um[0] == pytest.approx(float(pv["rate_range_um_s"][0]))
+    assert speeds_um[-1] == pytest.approx(float(pv["rate_range_um_s"][1]))
+    assert all(si.preload == pytest.approx(pv["preload_mN"] * 1e-3) for si in sis)
+    assert {s.model for s in cfg.scenes()} <= {"crack", "pb", "auto"}
+    assert cfg.scenes()[0].mu == pytest.approx(103, abs=0.5)

@@ -160,3 +160,60 @@ def test_sweep_runs_the_scene_models(tmp_path):
     df = sweep.load(tmp_path / "c.h5")
     assert len(df) == 4 and set(df.model_used) == {"crack", "pb"}
     assert (df.status == "ok").all()
+
+
+def test_si_config_runs_and_gives_rows_back_in_si(tmp_path, capsys):
+    """`units: si` end to end: sweep run, then the rows in both systems from the file alone
+    (si_table and `sweep info --si`); pull_off_N = pull_off pi dg R, 1.5 pi dg R closed form."""
+    from sweep.si import si_table
+
+    p = tmp_path / "si.yaml"
+    p.write_text("name: si\nunits: si\ngrid:\n  model: [crack, pb]\n  R: 5.19e-3\n"
+                 "  E0: 1.458e+6\n  Einf: 1.458e+7\n  nu: 0.5\n  n: 0.8\n  tau0: 0.01876\n"
+                 "  dg: 0.1523\n  h0: 30.8e-9\n  preload: 1.5e-3\n  speed: [1.0e-6, 1.0e-4]\n"
+                 f"output: {tmp_path / 'si.h5'}\n")
+    assert main(["run", str(p), "-j", "1", "--progress", "none"]) == 0
+    df = si_table(tmp_path / "si.h5")
+    assert len(df) == 4 and (df.status == "ok").all()
+    assert set(df.model_used) == {"crack", "pb"}
+    R, dg = 5.19e-3, 0.1523
+    assert df.jkr_pull_off_N.to_numpy() == pytest.approx(1.5 * math.pi * dg * R, rel=1e-12)
+    assert df.pull_off_N.to_numpy() == pytest.approx(df.pull_off * math.pi * dg * R, rel=1e-12)
+    assert df.mu.to_numpy() == pytest.approx(pdms(speed=1e-6).mu, rel=1e-12)
+    assert sorted(df.si_speed.unique()) == [1e-6, 1e-4]
+    for model in ("crack", "pb"):          # faster unloading, larger pull-off
+        d = df[df.model_used == model].sort_values("si_speed")
+        assert d.pull_off_N.iloc[1] > d.pull_off_N.iloc[0] > 0.99 * d.jkr_pull_off_N.iloc[0]
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "si.h5"), "--si"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 5 and "pull_off[mN]" in out[0]
+    # a file of a dimensionless config: one line, exit 2
+    q = tmp_path / "d.yaml"
+    q.write_text(f"name: d\ngrid: {{n: 0.8, a0: 3.0, rate: 1, model: pb}}\noutput: {tmp_path / 'd.h5'}\n")
+    assert main(["run", str(q), "-j", "1", "--progress", "none"]) == 0
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "d.h5"), "--si"]) == 2
+    assert "was not written by a `units: si` config" in capsys.readouterr().err
+
+
+def test_shipped_pdms_config_runs_and_matches_make_pdms(tmp_path):
+    """`sweep run configs/pdms.yaml` end to end (in-process), against sweep.pdms, which runs
+    the same case through its own SI conversion (PDMS_CASE) at a tighter tolerance."""
+    from pathlib import Path
+
+    from sweep import pdms
+    from sweep.si import si_table
+
+    cfg = Path(__file__).resolve().parents[1] / "configs" / "pdms.yaml"
+    out = tmp_path / "p.h5"
+    assert main(["run", str(cfg), "--out", str(out), "-j", "1", "--progress", "none"]) == 0
+    df = si_table(out)
+    assert len(df) == 18 and (df.status == "ok").all()
+    assert df.jkr_pull_off_N.to_numpy() == pytest.approx(3.7248e-3, rel=1e-4)
+    for model, name in (("crack", "crack_pb"), ("pb", "pb_estimate")):
+        d = df[df.model_used == model].sort_values("si_speed")
+        assert (d.pull_off_N.diff().dropna() > 0).all()
+        ends = d.si_speed.to_numpy()[[0, -1]] * 1e6
+        want = pdms.model_pull_off(name, ends)["pull_off_mN"]
+        assert d.pull_off_N.to_numpy()[[0, -1]] * 1e3 == pytest.approx(want, rel=1e-5)
