@@ -7,14 +7,11 @@ Each time step solves, for the nodal gaps h (docs/design.md sections 2 and 4),
 where A is the influence matrix (already scaled by the node spacing), sigma the
 Lennard-Jones law and (C_eff, H) the hereditary-integral coefficients of the step.
 
-Newton's Jacobian is J = I - C_eff A diag(d), d = sigma'(h). Its inverse J_b^-1 is kept
-from step to step; the nodes whose stiffness d moved away from the factorized d_b (the
-crack-tip region) are corrected exactly by the Woodbury identity, with one column
-J_b^-1 A[:, i] per corrected node, so every iteration is a true Newton step at the cost
-of about two matrix-vector products. When the correction set fills up it is merged into
-the inverse (a rank-k update); a fresh inverse is taken when C_eff changes (the step
-size changed), after MAX_MERGES merges, or when a line search fails with a stale one.
-The line search (on |F|_2) keeps every gap positive.
+Newton's Jacobian J = I - C_eff A diag(sigma'(h)) is factorized on the interacting nodes
+only and kept from step to step, corrected by low rank where the stiffness moved
+(:mod:`kernels.jacobian`); it is refactorized when the corrections outgrow their cache,
+when an iteration contracts the residual poorly, or when a line search fails with a
+stale factorization. The line search (on |F|_2) keeps every gap positive.
 
 On a coarse mesh the discrete equilibrium path can fold (the crack tip snaps from node to
 node); the loop then looks for the snapped state (:func:`snap`, :func:`relax`).
@@ -31,6 +28,10 @@ from numba import njit
 
 from .history import history_vector, step_coefficients, update_modes
 from .interface import crossing_radius, lj_traction, lj_traction_and_stiffness
+from .jacobian import (CACHE_COLUMNS, CACHE_E_BASE, CACHE_FACTOR, CACHE_NODE_OF,  # noqa: F401
+                       CACHE_PARAMS, CACHE_SLOT_OF, CACHE_STATE, PARAM_ETA, STATE_SLOTS,
+                       STATE_SUBSET, STATE_VALID, apply_base, factorize, invalidate,
+                       new_jacobian_cache, newton_direction)
 
 STATUS_DONE = 0
 STATUS_NEWTON_FAILED = 1
@@ -38,21 +39,23 @@ STATUS_STEP_LIMIT = 2
 STATUS_DOMAIN = 3
 STATUS_LEFT_BAND = 4
 
-# stats vector layout
-STAT_ITER = 0
-STAT_FACTOR = 1
-STAT_REJECTED = 2
-STAT_FAILED_SOLVES = 3
-STAT_COLUMNS = 4
-STAT_REFACTOR_OVERFLOW = 5
-STAT_REFACTOR_LINESEARCH = 6
-STAT_JUMPS = 7
-STAT_MERGES = 8
-N_STATS = 9
+# stats vector layout (counters, incremented)
+STAT_ITER = 0                 # Newton iterations
+STAT_FACTOR = 1               # factorizations (restricted base or dense fallback)
+STAT_REJECTED = 2             # steps rejected by the step control
+STAT_FAILED_SOLVES = 3        # Newton solves that did not converge
+STAT_COLUMNS = 4              # low-rank correction columns J_b^-1 A[:, i]
+STAT_REFACTOR_OVERFLOW = 5    # refactorizations: the corrections outgrew the cache
+STAT_REFACTOR_LINESEARCH = 6  # refactorizations: a line search failed with a stale base
+STAT_JUMPS = 7                # folds of the discrete path (snap / relax)
+STAT_SUBSET = 8               # sum of |S| (factorized nodes) over the factorizations
+STAT_RESIDUALS = 9            # residual evaluations (one N x N mat-vec each)
+STAT_REFACTOR_SLOW = 10       # refactorizations: an iteration contracted poorly
+N_STATS = 11
 
-#: rank-k merges of the corrections into the inverse before a fresh factorization
-#: (bounds the round-off that repeated updates accumulate)
-MAX_MERGES = 8
+#: an iteration with a stale factorization that reduces |F|_2 by less than this factor
+#: refactorizes before the next one
+SLOW_CONTRACTION = 0.5
 
 #: the pull-off is past once the load has recovered by this fraction of |P_min| ...
 RECOVERY = 0.05
@@ -94,50 +97,6 @@ SNAP_STEP_FRACTION = 1.0 / 8.0
 #: pseudo-time iterations allowed for one snap of the crack tip at a fold
 RELAX_MAX_ITER = 300
 
-#: a node joins the low-rank correction when its Jacobian diagonal moved by more than this
-#: fraction, C A_ii |d_i - d_base_i| / max(|J_b,ii|, 1); smaller changes are left out, which
-#: makes Newton slightly inexact (linear convergence with about this factor)
-WOODBURY_ETA = 0.02
-#: most corrected nodes before the Jacobian is refactorized
-WOODBURY_MAX = 96
-
-
-#: The Jacobian cache is a tuple of arrays (Numba passes it unpacked); its parts by position:
-CACHE_INVERSE = 0      # Jinv (N, N): inverse of J_b = I - C_b A diag(d_b)
-CACHE_D_BASE = 1       # d_b (N): the stiffness sigma'(h_b) Jinv was built with
-CACHE_COLUMNS = 2      # W (N, kmax): columns J_b^-1 A[:, i] of the corrected nodes
-CACHE_SLOT_OF = 3      # slot_of (N): slot of a corrected node in W, or -1
-CACHE_NODE_OF = 4      # node_of (kmax): node of each slot
-CACHE_STATE = 5        # state (3, int64), indexed by the STATE_* constants
-CACHE_C_BASE = 6       # c_base (2, float), indexed by the CBASE_* constants
-#: state[STATE_VALID]: 1 when Jinv holds a factorization, 0 to refactorize at the next solve
-STATE_VALID = 0
-#: state[STATE_SLOTS]: slots of W in use
-STATE_SLOTS = 1
-#: state[STATE_MERGES]: rank-k merges since the last factorization
-STATE_MERGES = 2
-#: c_base[CBASE_CEFF]: C_eff of the factorization (a step of another size refactorizes)
-CBASE_CEFF = 0
-#: c_base[CBASE_ETA]: relative stiffness change above which a node is corrected
-CBASE_ETA = 1
-
-
-def new_jacobian_cache(N, kmax=WOODBURY_MAX, eta=WOODBURY_ETA):
-    """Work arrays that carry a factorized Jacobian and its low-rank corrections between steps.
-
-    Returns the tuple (Jinv, d_base, W, slot_of, node_of, state, c_base), positions named by
-    the CACHE_* constants, ``state`` indexed by STATE_*, ``c_base`` by CBASE_*.
-    """
-    kmax = min(int(kmax), N)
-    return (np.empty((N, N)), np.zeros(N), np.empty((N, kmax)), np.full(N, -1, np.int64),
-            np.full(kmax, -1, np.int64), np.zeros(3, np.int64), np.array([0.0, eta]))
-
-
-def invalidate(cache):
-    """Mark the factorization in ``cache`` stale: the next solve refactorizes."""
-    cache[CACHE_STATE][STATE_VALID] = 0
-
-
 @njit(cache=True)
 def residual(h, g, A, ceff, H, h0, c, sig, w, F):
     """F = h - g - A (ceff sigma(h) - H); returns max |F|. sig, w are work arrays."""
@@ -174,136 +133,23 @@ def _norm2(F):
 
 
 @njit(cache=True)
-def factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base):
-    """Jinv <- inverse of J = I - ceff A diag(sigma'(h)); clears the low-rank corrections."""
-    N = h.size
-    sig = np.empty(N)
-    lj_traction_and_stiffness(h, h0, c, sig, d_base)
-    J = np.empty((N, N))
-    for i in range(N):
-        for j in range(N):
-            J[i, j] = -ceff * A[i, j] * d_base[j]
-        J[i, i] += 1.0
-    Jinv[:, :] = np.linalg.inv(J)
-    for i in range(N):
-        slot_of[i] = -1
-    state[STATE_VALID] = 1
-    state[STATE_SLOTS] = 0
-    state[STATE_MERGES] = 0
-    c_base[CBASE_CEFF] = ceff
+def _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats, reason):
+    m = factorize(h, A, ceff, h0, c, factor, e_base, slot_of, state)
+    stats[STAT_FACTOR] += 1
+    stats[STAT_SUBSET] += m
+    if reason >= 0:
+        stats[reason] += 1
 
 
 @njit(cache=True)
-def merge_corrections(d, Jinv, d_base, W, slot_of, node_of, state, c_base):
-    """Fold the corrections of every slotted node into Jinv (one rank-k Woodbury update).
-
-    With S the slotted nodes, Delta = d_S - d_b,S and K = I - C W_SS Delta:
-    J^-1 = J_b^-1 + C W Delta K^-1 E_S^T J_b^-1, exact; then d_b,S <- d_S and the slots are
-    freed. Costs a k x k solve with N right-hand sides and one N x k x N product, about a
-    fifth of a new inverse for k ~ 100 at N = 500.
-    """
-    k = state[STATE_SLOTS]
-    N = Jinv.shape[0]
-    ceff = c_base[CBASE_CEFF]
-    nodes = node_of[:k].copy()
-    delta = np.empty(k)
-    for b in range(k):
-        delta[b] = d[nodes[b]] - d_base[nodes[b]]
-    K = np.empty((k, k))
-    for a in range(k):
-        for b in range(k):
-            K[a, b] = -ceff * W[nodes[a], b] * delta[b]
-        K[a, a] += 1.0
-    rows = np.empty((k, N))
-    for a in range(k):
-        rows[a, :] = Jinv[nodes[a], :]
-    M1 = np.linalg.solve(K, rows)
-    Wd = np.empty((N, k))
-    for r in range(N):
-        for b in range(k):
-            Wd[r, b] = ceff * W[r, b] * delta[b]
-    Jinv += Wd @ M1
-    for b in range(k):
-        d_base[nodes[b]] = d[nodes[b]]
-        slot_of[nodes[b]] = -1
-    state[STATE_SLOTS] = 0
-    state[STATE_MERGES] += 1
-
-
-@njit(cache=True)
-def newton_direction(F, d, A, ceff, eta, Jinv, d_base, W, slot_of, node_of, state, stats):
-    """Newton step dh = -J(h)^-1 F with J(h) = J_b - ceff A_S diag(d_S - d_b,S) E_S^T.
-
-    S holds the nodes whose stiffness moved away from the factorized one; the correction
-    is exact for them (Woodbury identity), nodes outside S differ by less than
-    WOODBURY_ETA. Returns (dh, ok); ok is False when S outgrew the cache (refactorize).
-    """
-    N = F.size
-    kmax = W.shape[1]
-    c_base0 = ceff
-    S = np.empty(N, np.int64)
-    k = 0
-    for i in range(N):
-        jb = abs(1.0 - c_base0 * A[i, i] * d_base[i])
-        if ceff * A[i, i] * abs(d[i] - d_base[i]) > eta * max(jb, 1.0):
-            S[k] = i
-            k += 1
-    if k > kmax:
-        return np.empty(0), False
-    # new columns W[:, slot] = J_b^-1 A[:, i], all at once (one matrix-matrix product)
-    new = np.empty(k, np.int64)
-    m = 0
-    for a in range(k):
-        if slot_of[S[a]] < 0:
-            new[m] = S[a]
-            m += 1
-    if m > 0:
-        if state[STATE_SLOTS] + m > kmax:
-            return np.empty(0), False
-        cols = np.empty((N, m))
-        for r in range(N):
-            for b in range(m):
-                cols[r, b] = A[r, new[b]]
-        Wn = Jinv @ cols
-        for b in range(m):
-            slot = state[STATE_SLOTS]
-            state[STATE_SLOTS] += 1
-            for r in range(N):
-                W[r, slot] = Wn[r, b]
-            slot_of[new[b]] = slot
-            node_of[slot] = new[b]
-        stats[STAT_COLUMNS] += m
-    y = Jinv @ F
-    if k == 0:
-        return -y, True
-    K = np.empty((k, k))
-    delta = np.empty(k)
-    rhs = np.empty(k)
-    for b in range(k):
-        delta[b] = d[S[b]] - d_base[S[b]]
-    for a in range(k):
-        rhs[a] = y[S[a]]
-        for b in range(k):
-            K[a, b] = -ceff * W[S[a], slot_of[S[b]]] * delta[b]
-        K[a, a] += 1.0
-    z = np.linalg.solve(K, rhs)
-    dh = -y
-    for b in range(k):
-        coef = ceff * delta[b] * z[b]
-        sl = slot_of[S[b]]
-        for r in range(N):
-            dh[r] -= coef * W[r, sl]
-    return dh, True
-
-
-@njit(cache=True)
-def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, node_of,
-           state, c_base, stats):
+def newton(h, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, node_of,
+           state, params, stats):
     """Solve F(h) = 0 in place, starting from ``h``. Returns True on convergence.
 
-    The Jacobian factorization in (Jinv, d_base, ...) is reused and corrected (see
-    :func:`newton_direction`); it is rebuilt when C_eff changed, when too many nodes need
-    a correction, or when a line search fails with a reused factorization.
+    The Jacobian factorization in the cache (:func:`kernels.jacobian.new_jacobian_cache`)
+    is reused and corrected (:func:`kernels.jacobian.newton_direction`); it is rebuilt when
+    too many nodes need a correction, when a stale one contracts the residual by less than
+    SLOW_CONTRACTION, or when a line search fails with a stale one.
     """
     N = h.size
     sig = np.empty(N)
@@ -313,48 +159,45 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, nod
     Ft = np.empty(N)
     ht = np.empty(N)
     norm = residual(h, g, A, ceff, H, h0, c, sig, w, F)
+    stats[STAT_RESIDUALS] += 1
     if norm <= tol:
         return True
-    if state[STATE_VALID] == 0 or abs(ceff - c_base[CBASE_CEFF]) > 1e-12 * abs(ceff):
-        factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
-        stats[STAT_FACTOR] += 1
-    fresh = True
+    fresh = False
+    if state[STATE_VALID] == 0:
+        _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats, -1)
+        fresh = True
     for it in range(max_iter):
         stats[STAT_ITER] += 1
         lj_traction_and_stiffness(h, h0, c, sig, d)
-        dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of, node_of,
-                                 state, stats)
-        if not ok and state[STATE_MERGES] < MAX_MERGES and state[STATE_SLOTS] > 0:
-            # the correction set is full: fold it into the inverse and try again
-            merge_corrections(d, Jinv, d_base, W, slot_of, node_of, state, c_base)
-            stats[STAT_MERGES] += 1
-            dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of,
-                                      node_of, state, stats)
+        dh, ok = newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of, state,
+                                  params, stats, STAT_COLUMNS)
         if not ok:
-            factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
-            stats[STAT_FACTOR] += 1
-            stats[STAT_REFACTOR_OVERFLOW] += 1
-            dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of,
-                                      node_of, state, stats)
+            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
+                         STAT_REFACTOR_OVERFLOW)
+            fresh = True
+            dh, ok = newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of,
+                                      state, params, stats, STAT_COLUMNS)
         lam = positive_step(h, dh)
         # backtracking on the merit |F|_2 (Newton directions descend it); the max norm
         # decides convergence
         accepted = False
         n2 = _norm2(F)
+        nt2 = n2
         for _ls in range(16):
             for i in range(N):
                 ht[i] = h[i] + lam * dh[i]
             nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
-            if _norm2(Ft) < (1.0 - 1e-4 * lam) * n2:
+            stats[STAT_RESIDUALS] += 1
+            nt2 = _norm2(Ft)
+            if nt2 < (1.0 - 1e-4 * lam) * n2:
                 accepted = True
                 break
             lam *= 0.5
         if not accepted:
             if fresh:        # a line search failed on an exact Jacobian: give up
                 return False
-            factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
-            stats[STAT_FACTOR] += 1
-            stats[STAT_REFACTOR_LINESEARCH] += 1
+            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
+                         STAT_REFACTOR_LINESEARCH)
             fresh = True
             continue
         for i in range(N):
@@ -363,7 +206,12 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, nod
         norm = nt
         if norm <= tol:
             return True
-        fresh = False
+        if not fresh and nt2 > SLOW_CONTRACTION * n2:
+            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
+                         STAT_REFACTOR_SLOW)
+            fresh = True
+        else:
+            fresh = False
     return False
 
 
@@ -420,8 +268,8 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
 
 
 @njit(cache=True)
-def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, Jinv, d_base, W, slot_of, node_of,
-         state, c_base, stats):
+def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, factor, e_base, W, slot_of,
+         node_of, state, params, stats):
     """Newton from the gap profile outside the crack tip shifted inward by 1 to 6 nodes.
 
     Near a fold of the discrete path the stable state the tip snaps to is, locally, the
@@ -440,8 +288,8 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, Jinv, d_base, W, slo
                 hp[i] = h[i + shift]
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
-        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, node_of,
-                  state, c_base, stats):
+        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, node_of,
+                  state, params, stats):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -456,7 +304,7 @@ def load(sigma, wP):
 @njit(cache=True)
 def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io,
            step_max, step_min, da_max, tol, max_iter, max_steps, stop_mode, min_travel,
-           tip_lo, tip_hi, Jinv, d_base, W, slot_of, node_of, state, c_base,
+           tip_lo, tip_hi, factor, e_base, W, slot_of, node_of, state, params,
            t_out, d_out, P_out, a_out, ai_out, h_out, stats):
     """Unload at constant rate from the state ``h_init`` with the Prony recursion.
 
@@ -488,7 +336,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         :func:`stop_reached`.
     tip_lo, tip_hi : radii the crack tip must stay within (the well-resolved band of a
         graded mesh); leaving them ends the run with STATUS_LEFT_BAND.
-    Jinv, d_base, W, slot_of, node_of, state, c_base : Jacobian cache arrays
+    factor, e_base, W, slot_of, node_of, state, params : Jacobian cache arrays
         (:func:`new_jacobian_cache`); may carry the factorization of the initial solve.
     t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
     h_out : (N,) receives the gap of the last accepted step.
@@ -568,8 +416,8 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         else:
             for i in range(N):
                 hp[i] = h[i]
-        ok = newton(hp, g, A, ceff, H, h0, c, tol * h0, max_iter, Jinv, d_base, W, slot_of,
-                    node_of, state, c_base, stats)
+        ok = newton(hp, g, A, ceff, H, h0, c, tol * h0, max_iter, factor, e_base, W, slot_of,
+                    node_of, state, params, stats)
         if not ok:
             stats[STAT_FAILED_SOLVES] += 1
             state[STATE_VALID] = 0
@@ -581,8 +429,8 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
             # for the snapped state by Newton from the profile shifted inward by 1..3 nodes,
             # else by pseudo-transient relaxation from the last state
             stats[STAT_JUMPS] += 1
-            ok = snap(h, hp, g, A, ceff, H, h0, c, tol * h0, max_iter, r, hm, Jinv, d_base, W,
-                      slot_of, node_of, state, c_base, stats)
+            ok = snap(h, hp, g, A, ceff, H, h0, c, tol * h0, max_iter, r, hm, factor, e_base, W,
+                      slot_of, node_of, state, params, stats)
             if not ok:
                 for i in range(N):
                     hp[i] = h[i]

@@ -5,7 +5,7 @@ This is the interface a tip-following mesh and a wall-time budget build on.
 """
 import numpy as np
 
-from kernels.solve import STATUS_DONE, STATUS_STEP_LIMIT, new_jacobian_cache, unload
+from kernels.solve import N_STATS, STATUS_DONE, STATUS_STEP_LIMIT, new_jacobian_cache, unload
 from sweep.initial import ElasticSolver, relaxed_state
 from sweep.problem import prepare
 from sweep.scene import Numerics, Scene
@@ -23,7 +23,7 @@ def _run(chunk):
     N, M = pb.mesh.nodes, pb.prony_weights.size
     q, step = np.zeros((M, N)), np.zeros(1)
     out = [np.empty(NUMERICS.max_steps + 1) for _ in range(5)]
-    stats = np.zeros(9, np.int64)
+    stats = np.zeros(N_STATS, np.int64)
     cache = new_jacobian_cache(N)
     n, calls = 0, 0
     while True:
