@@ -208,7 +208,8 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
 
     el = ElasticSolver(pb.A, r, pb.h0, pb.c, numerics.tol)
     try:
-        h_init, delta0 = relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
+        h_init, delta0 = relaxed_state(el, delta0=scene.delta0, a0=scene.a0,
+                                       mesh_key=(mesh.key, mesh.spacing))
     except RuntimeError as exc:
         res.reason = f"initial state: {exc}"
         return

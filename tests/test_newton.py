@@ -92,3 +92,27 @@ def test_newton_solves_the_discrete_equilibrium():
     lj_traction_and_stiffness(hs, h0, c, sig, d)
     assert np.max(np.abs(hs - g - A @ (ceff * sig - H))) < 1e-10 * h0
     assert np.max(np.abs(hs - h_start)) > 1e-3 * h0          # it did move
+
+
+def test_relaxed_state_is_cached_per_mesh_and_reused_unchanged():
+    from sweep.initial import ElasticSolver, relaxed_state
+    A, _, h0, c, _ = _problem(N=100, seed=4)
+    r = np.arange(100) * 3.0 / 99
+    key = ("test-mesh", 100, 3.0 / 99)
+    el = ElasticSolver(A, r, h0, c, 1e-10)
+    h1, d1 = relaxed_state(el, a0=1.2, mesh_key=key)
+    solved = el.stats.copy()
+    assert solved[ks.STAT_ITER] > 0
+    el2 = ElasticSolver(A, r, h0, c, 1e-10)
+    h2, d2 = relaxed_state(el2, a0=1.2, mesh_key=key)
+    assert el2.stats[ks.STAT_ITER] == 0                     # nothing solved again
+    np.testing.assert_array_equal(h1, h2)
+    assert d1 == d2 and h2 is not h1
+    h2[:] = 0.0                                             # a copy: the cache is untouched
+    h3, _ = relaxed_state(el2, a0=1.2, mesh_key=key)
+    np.testing.assert_array_equal(h3, h1)
+    # another initial state is solved (its radius within a node spacing of the target: on
+    # this coarse mesh a(delta) jumps from node to node)
+    h4, _ = relaxed_state(el2, a0=1.4, mesh_key=key)
+    assert el2.stats[ks.STAT_ITER] > 0
+    assert abs(el2.radius(h4) - 1.4) < r[1]
