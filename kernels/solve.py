@@ -301,9 +301,78 @@ def load(sigma, wP):
     return 2.0 * np.pi * np.dot(wP, sigma)
 
 
+#: steps in a row whose contact-radius change is below EASY_DA_FRACTION * da_max before
+#: the step doubles (steps change by factors of 2 only)
+EASY_STEPS = 8
+EASY_DA_FRACTION = 0.3
+#: a step rejected for its radius change is halved until the change, assumed proportional
+#: to the step, is below this fraction of da_max
+REJECT_TARGET = 0.8
+#: where the load evolves smoothly the step grows beyond step_max, up to this factor, while
+#: the predictor's load error stays below step_tol and the crack tip moves by less than
+#: SMOOTH_DA_FRACTION da_max per step
+SMOOTH_STEP_FACTOR = 8.0
+SMOOTH_DA_FRACTION = 0.6
+#: the predictor never puts a gap below this fraction of the last accepted one
+PREDICT_FLOOR = 0.5
+
+
+@njit(cache=True)
+def predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp):
+    """Starting gap of the next solve: quadratic (Lagrange) extrapolation through the last
+    three accepted states (linear after one, constant at the start), floored at
+    PREDICT_FLOOR of the last gap. Returns True when the extrapolation was quadratic (its
+    distance to the solution is then the step-error estimate)."""
+    N = h.size
+    if dt_prev2 > 0.0:
+        t1 = -dt_prev
+        t2 = -dt_prev - dt_prev2
+        l0 = (dt - t1) * (dt - t2) / (t1 * t2)
+        l1 = dt * (dt - t2) / (t1 * (t1 - t2))
+        l2 = dt * (dt - t1) / (t2 * (t2 - t1))
+        for i in range(N):
+            hp[i] = max(l0 * h[i] + l1 * h_prev[i] + l2 * h_prev2[i], PREDICT_FLOOR * h[i])
+        return True
+    if dt_prev > 0.0:
+        s = dt / dt_prev
+        for i in range(N):
+            hp[i] = max(h[i] + s * (h[i] - h_prev[i]), PREDICT_FLOOR * h[i])
+        return False
+    hp[:] = h
+    return False
+
+
+@njit(cache=True)
+def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
+    """Step control after an accepted step: (next indentation step, easy-step count).
+
+    Up to ``dd_max`` the step doubles after EASY_STEPS steps in a row that moved the crack
+    tip by less than EASY_DA_FRACTION da_max. Beyond it (up to SMOOTH_STEP_FACTOR dd_max)
+    it doubles after EASY_STEPS steps in a row while a doubled step would keep the tip
+    motion below SMOOTH_DA_FRACTION da_max and the predictor's load error ``err``, 8 err
+    for a doubled step (third order), below ``step_tol``; it is halved back as soon as
+    either bound is exceeded.
+    """
+    if dd > dd_max * 1.0001:
+        if da > SMOOTH_DA_FRACTION * da_max or err > step_tol:
+            return max(0.5 * dd, dd_max), 0
+        easy += 1
+    elif da < EASY_DA_FRACTION * da_max:
+        easy += 1
+    else:
+        easy = 0
+    if easy >= EASY_STEPS:
+        if dd < dd_max * 0.9999:
+            return min(2.0 * dd, dd_max), 0
+        if (2.0 * da < SMOOTH_DA_FRACTION * da_max and 8.0 * err < step_tol
+                and dd < SMOOTH_STEP_FACTOR * dd_max * 0.9999):
+            return min(2.0 * dd, SMOOTH_STEP_FACTOR * dd_max), 0
+    return dd, easy
+
+
 @njit(cache=True)
 def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io,
-           step_max, step_min, da_max, tol, max_iter, max_steps, stop_mode, min_travel,
+           step_max, step_min, da_max, step_tol, tol, max_iter, max_steps, stop_mode, min_travel,
            tip_lo, tip_hi, factor, e_base, W, slot_of, node_of, state, params,
            t_out, d_out, P_out, a_out, ai_out, h_out, stats):
     """Unload at constant rate from the state ``h_init`` with the Prony recursion.
@@ -331,6 +400,9 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         on return the step the run would take next.
     step_max, step_min : indentation steps in units of h0.
     da_max : largest contact-radius change per step (a_ref units).
+    step_tol : relative load error of the step predictor, |P(predicted) - P| / max(|P|, 1),
+        below which the step may grow beyond ``step_max`` (up to SMOOTH_STEP_FACTOR
+        times) where the load evolves smoothly; 0 keeps every step <= step_max.
     stop_mode : 0 stop after pull-off and load recovery, 1 follow to separation.
     min_travel : crack-tip recession after the minimum required to stop (a_ref), see
         :func:`stop_reached`.
@@ -360,6 +432,8 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
     h_prev = h_init.copy()
     h_prev2 = h_init.copy()
     hp = np.empty(N)
+    h_pred = np.empty(N)
+    sigma_pred = np.empty(N)
     sigma = np.empty(N)
     sig_new = np.empty(N)
     lj_traction(h, h0, c, sigma)
@@ -380,117 +454,96 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
     for i in range(1, n):
         if P_out[i] < P_out[i_min]:
             i_min = i
-    P_min = P_out[i_min]
-    dd = step_io[0] * h0 if step_io[0] > 0.0 else step_max * h0
+    # units converted once: steps and tolerances in d_ref from here on
+    dd_max = step_max * h0
     dd_min = step_min * h0
+    tol_gap = tol * h0
+    tol_step = step_tol * h0
+    dd = step_io[0] * h0 if step_io[0] > 0.0 else dd_max
     dt_prev = 0.0
     dt_prev2 = 0.0
     easy = 0
-    while True:
-        if n > max_steps:
-            h_out[:] = h
-            step_io[0] = dd / h0
-            return STATUS_STEP_LIMIT, n
+    status = STATUS_STEP_LIMIT
+    while n <= max_steps:
+        # -- predict
         dt = dd / (rate * h0)
         ceff = step_coefficients(weights, times, dt, e, b)
         history_vector(weights, e, b, q, sigma, H)
         for i in range(N):
             g[i] = -(delta - dd) + h0 + r2half[i]
-        if dt_prev2 > 0.0:
-            # quadratic (Lagrange) extrapolation through the last three accepted states
-            t1 = -dt_prev
-            t2 = -dt_prev - dt_prev2
-            l0 = (dt - t1) * (dt - t2) / (t1 * t2)
-            l1 = dt * (dt - t2) / (t1 * (t1 - t2))
-            l2 = dt * (dt - t1) / (t2 * (t2 - t1))
-            for i in range(N):
-                hp[i] = l0 * h[i] + l1 * h_prev[i] + l2 * h_prev2[i]
-                if hp[i] < 0.5 * h[i]:
-                    hp[i] = 0.5 * h[i]
-        elif dt_prev > 0.0:
-            s = dt / dt_prev
-            for i in range(N):
-                hp[i] = h[i] + s * (h[i] - h_prev[i])
-                if hp[i] < 0.5 * h[i]:
-                    hp[i] = 0.5 * h[i]
-        else:
-            for i in range(N):
-                hp[i] = h[i]
-        ok = newton(hp, g, A, ceff, H, h0, c, tol * h0, max_iter, factor, e_base, W, slot_of,
+        quadratic = predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp)
+        h_pred[:] = hp
+        # -- solve
+        ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, factor, e_base, W, slot_of,
                     node_of, state, params, stats)
         if not ok:
             stats[STAT_FAILED_SOLVES] += 1
             state[STATE_VALID] = 0
             easy = 0
-            if dd > max(dd_min, SNAP_STEP_FRACTION * step_max * h0) * 1.0001:
+            if dd > max(dd_min, SNAP_STEP_FRACTION * dd_max) * 1.0001:
                 dd = max(0.5 * dd, dd_min)
                 continue
             # the equilibrium path folds here (the crack tip snaps to the next node): look
-            # for the snapped state by Newton from the profile shifted inward by 1..3 nodes,
+            # for the snapped state by Newton from the profile shifted inward by 1..6 nodes,
             # else by pseudo-transient relaxation from the last state
             stats[STAT_JUMPS] += 1
-            ok = snap(h, hp, g, A, ceff, H, h0, c, tol * h0, max_iter, r, hm, factor, e_base, W,
+            ok = snap(h, hp, g, A, ceff, H, h0, c, tol_gap, max_iter, r, hm, factor, e_base, W,
                       slot_of, node_of, state, params, stats)
             if not ok:
-                for i in range(N):
-                    hp[i] = h[i]
-                ok = relax(hp, g, A, ceff, H, h0, c, tol * h0, RELAX_MAX_ITER, stats)
+                hp[:] = h
+                ok = relax(hp, g, A, ceff, H, h0, c, tol_gap, RELAX_MAX_ITER, stats)
             if not ok:
-                h_out[:] = h
-                step_io[0] = dd / h0
-                return STATUS_NEWTON_FAILED, n
+                status = STATUS_NEWTON_FAILED
+                break
+            quadratic = False
+        # -- control the step: the crack tip may move by da_max at most
         a_new = crossing_radius(hp, r, hm)
-        if ok and abs(a_new - a_cur) > da_max and dd > dd_min * 1.0001:
+        da = abs(a_new - a_cur)
+        if da > da_max and dd > dd_min * 1.0001:
             stats[STAT_REJECTED] += 1
             easy = 0
-            # halve until the change, assumed proportional to the step, fits
-            da_est = abs(a_new - a_cur)
-            while da_est > 0.8 * da_max and dd > dd_min:
+            da_est = da
+            while da_est > REJECT_TARGET * da_max and dd > dd_min:
                 dd = max(0.5 * dd, dd_min)
                 da_est *= 0.5
             continue
-        # accept the step
         lj_traction(hp, h0, c, sig_new)
+        P = load(sig_new, wP)
+        if quadratic:
+            lj_traction(h_pred, h0, c, sigma_pred)
+            err = abs(load(sigma_pred, wP) - P) / max(abs(P), 1.0)
+        else:
+            err = np.inf
+        # -- accept
         update_modes(e, b, q, sig_new, sigma)
-        for i in range(N):
-            h_prev2[i] = h_prev[i]
-            h_prev[i] = h[i]
-            h[i] = hp[i]
-            sigma[i] = sig_new[i]
+        h_prev2[:] = h_prev
+        h_prev[:] = h
+        h[:] = hp
+        sigma[:] = sig_new
         dt_prev2 = dt_prev
         dt_prev = dt
         t += dt
         delta -= dd
-        P = load(sigma, wP)
         t_out[n] = t
         d_out[n] = delta
         P_out[n] = P
         a_out[n] = a_new
         ai_out[n] = crossing_radius(h, r, h0)
-        if P < P_min:
-            P_min = P
+        if P < P_out[i_min]:
             i_min = n
         n += 1
-        if a_new >= r[N - 1]:
-            h_out[:] = h
-            step_io[0] = dd / h0
-            return STATUS_DOMAIN, n
-        if a_new > tip_hi or a_new < tip_lo:
-            h_out[:] = h
-            step_io[0] = dd / h0
-            return STATUS_LEFT_BAND, n
-        if stop_reached(P_out, a_out, n, i_min, stop_mode, min_travel):
-            h_out[:] = h
-            step_io[0] = dd / h0
-            return STATUS_DONE, n
-        da = abs(a_new - a_cur)
         a_cur = a_new
-        # steps change by factors of 2 only, and grow after 8 easy steps in a row: C_eff
-        # (hence the factorized Jacobian) changes only when the step does
-        if da < 0.3 * da_max:
-            easy += 1
-            if easy >= 8 and dd < step_max * h0:
-                dd = min(2.0 * dd, step_max * h0)
-                easy = 0
-        else:
-            easy = 0
+        # -- stop
+        if a_new >= r[N - 1]:
+            status = STATUS_DOMAIN
+            break
+        if a_new > tip_hi or a_new < tip_lo:
+            status = STATUS_LEFT_BAND
+            break
+        if stop_reached(P_out, a_out, n, i_min, stop_mode, min_travel):
+            status = STATUS_DONE
+            break
+        dd, easy = next_step(dd, easy, da, da_max, err, dd_max, tol_step)
+    h_out[:] = h
+    step_io[0] = dd / h0
+    return status, n
