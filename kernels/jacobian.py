@@ -61,6 +61,7 @@ STATE_SUBSET = 2
 PARAM_ETA = 0
 
 
+
 def new_jacobian_cache(N, kmax=WOODBURY_MAX, eta=WOODBURY_ETA):
     """Work arrays that carry a factorized Jacobian and its low-rank corrections between steps.
 
@@ -138,30 +139,34 @@ def newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of, state, 
     T holds the nodes whose effective stiffness E = ceff d moved away from the factorized
     one; the correction is exact for them (Woodbury identity), nodes outside T differ by
     less than params[PARAM_ETA]. Returns (dh, ok); ok is False when T outgrew the cache
-    (refactorize). ``stats[stat_columns]`` counts the new columns.
+    (refactorize: measured cheaper than correcting only the largest moves, which needs
+    more iterations with a full-size correction). ``stats[stat_columns]`` counts the new
+    columns.
     """
     N = F.size
     kmax = W.shape[1]
     eta = params[PARAM_ETA]
     m = state[STATE_SUBSET]
+    # the nodes that moved: those already corrected (their column is kept) and new ones
     T = np.empty(N, np.int64)
+    new = np.empty(N, np.int64)
     k = 0
-    for i in range(N):
-        jb = abs(1.0 - A[i, i] * e_base[i])
-        if A[i, i] * abs(ceff * d[i] - e_base[i]) > eta * max(jb, 1.0):
-            T[k] = i
-            k += 1
-    if k > kmax:
-        return np.empty(0), False
-    new = np.empty(k, np.int64)
     n_new = 0
-    for a in range(k):
-        if slot_of[T[a]] < 0:
-            new[n_new] = T[a]
-            n_new += 1
+    for i in range(N):
+        dev = A[i, i] * abs(ceff * d[i] - e_base[i]) / max(abs(1.0 - A[i, i] * e_base[i]), 1.0)
+        if dev > eta:
+            if slot_of[i] >= 0:
+                T[k] = i
+                k += 1
+            else:
+                new[n_new] = i
+                n_new += 1
+    if k + n_new > kmax or state[STATE_SLOTS] + n_new > kmax:
+        return np.empty(0), False
+    for a in range(n_new):
+        T[k] = new[a]
+        k += 1
     if n_new > 0:
-        if state[STATE_SLOTS] + n_new > kmax:
-            return np.empty(0), False
         cols = np.empty((N, n_new))
         for r in range(N):
             for b in range(n_new):
