@@ -28,10 +28,9 @@ from numba import njit
 
 from .history import history_vector, step_coefficients, update_modes
 from .interface import crossing_radius, lj_traction, lj_traction_and_stiffness
-from .jacobian import (CACHE_COLUMNS, CACHE_E_BASE, CACHE_FACTOR, CACHE_NODE_OF,  # noqa: F401
-                       CACHE_PARAMS, CACHE_SLOT_OF, CACHE_STATE, PARAM_ETA, STATE_SLOTS,
-                       STATE_SUBSET, STATE_VALID, apply_base, factorize, invalidate,
-                       new_jacobian_cache, newton_direction)
+# invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
+from .jacobian import (STATE_VALID, factorize, invalidate, new_jacobian_cache,  # noqa: F401
+                       newton_direction)
 
 STATUS_DONE = 0
 STATUS_NEWTON_FAILED = 1

@@ -26,7 +26,8 @@ import time
 import numpy as np
 
 from kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_DOMAIN, STATUS_LEFT_BAND,
-                           STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT, stop_reached, unload)
+                           STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT, invalidate, stop_reached,
+                           unload)
 
 from . import units
 from .exact import unload_exact
@@ -215,6 +216,9 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
     try:
         h_init, delta0 = relaxed_state(el, delta0=scene.delta0, a0=scene.a0,
                                        mesh_key=(mesh.key, mesh.spacing))
+        # the unloading starts unfactorized whether or not the relaxed state was cached,
+        # so a scene's result does not depend on what the process solved before
+        invalidate(el.cache)
     except RuntimeError as exc:
         res.reason = f"initial state: {exc}"
         return
