@@ -7,14 +7,11 @@ Each time step solves, for the nodal gaps h (docs/design.md sections 2 and 4),
 where A is the influence matrix (already scaled by the node spacing), sigma the
 Lennard-Jones law and (C_eff, H) the hereditary-integral coefficients of the step.
 
-Newton's Jacobian is J = I - C_eff A diag(d), d = sigma'(h). Its inverse J_b^-1 is kept
-from step to step; the nodes whose stiffness d moved away from the factorized d_b (the
-crack-tip region) are corrected exactly by the Woodbury identity, with one column
-J_b^-1 A[:, i] per corrected node, so every iteration is a true Newton step at the cost
-of about two matrix-vector products. When the correction set fills up it is merged into
-the inverse (a rank-k update); a fresh inverse is taken when C_eff changes (the step
-size changed), after MAX_MERGES merges, or when a line search fails with a stale one.
-The line search (on |F|_2) keeps every gap positive.
+Newton's Jacobian J = I - C_eff A diag(sigma'(h)) is factorized on the interacting nodes
+only and kept from step to step, corrected by low rank where the stiffness moved
+(:mod:`kernels.jacobian`); it is refactorized when the corrections outgrow their cache,
+when an iteration contracts the residual poorly, or when a line search fails with a
+stale factorization. The line search (on |F|_2) keeps every gap positive.
 
 On a coarse mesh the discrete equilibrium path can fold (the crack tip snaps from node to
 node); the loop then looks for the snapped state (:func:`snap`, :func:`relax`).
@@ -31,6 +28,9 @@ from numba import njit
 
 from .history import history_vector, step_coefficients, update_modes
 from .interface import crossing_radius, lj_traction, lj_traction_and_stiffness
+# invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
+from .jacobian import (STATE_VALID, factorize, invalidate, new_jacobian_cache,  # noqa: F401
+                       newton_direction)
 
 STATUS_DONE = 0
 STATUS_NEWTON_FAILED = 1
@@ -38,21 +38,23 @@ STATUS_STEP_LIMIT = 2
 STATUS_DOMAIN = 3
 STATUS_LEFT_BAND = 4
 
-# stats vector layout
-STAT_ITER = 0
-STAT_FACTOR = 1
-STAT_REJECTED = 2
-STAT_FAILED_SOLVES = 3
-STAT_COLUMNS = 4
-STAT_REFACTOR_OVERFLOW = 5
-STAT_REFACTOR_LINESEARCH = 6
-STAT_JUMPS = 7
-STAT_MERGES = 8
-N_STATS = 9
+# stats vector layout (counters, incremented)
+STAT_ITER = 0                 # Newton iterations
+STAT_FACTOR = 1               # factorizations (restricted base or dense fallback)
+STAT_REJECTED = 2             # steps rejected by the step control
+STAT_FAILED_SOLVES = 3        # Newton solves that did not converge
+STAT_COLUMNS = 4              # low-rank correction columns J_b^-1 A[:, i]
+STAT_REFACTOR_OVERFLOW = 5    # refactorizations: the corrections outgrew the cache
+STAT_REFACTOR_LINESEARCH = 6  # refactorizations: a line search failed with a stale base
+STAT_JUMPS = 7                # folds of the discrete path (snap / relax)
+STAT_SUBSET = 8               # sum of |S| (factorized nodes) over the factorizations
+STAT_RESIDUALS = 9            # residual evaluations (one N x N mat-vec each)
+STAT_REFACTOR_SLOW = 10       # refactorizations: an iteration contracted poorly
+N_STATS = 11
 
-#: rank-k merges of the corrections into the inverse before a fresh factorization
-#: (bounds the round-off that repeated updates accumulate)
-MAX_MERGES = 8
+#: an iteration with a stale factorization that reduces |F|_2 by less than this factor
+#: refactorizes before the next one
+SLOW_CONTRACTION = 0.5
 
 #: the pull-off is past once the load has recovered by this fraction of |P_min| ...
 RECOVERY = 0.05
@@ -94,50 +96,6 @@ SNAP_STEP_FRACTION = 1.0 / 8.0
 #: pseudo-time iterations allowed for one snap of the crack tip at a fold
 RELAX_MAX_ITER = 300
 
-#: a node joins the low-rank correction when its Jacobian diagonal moved by more than this
-#: fraction, C A_ii |d_i - d_base_i| / max(|J_b,ii|, 1); smaller changes are left out, which
-#: makes Newton slightly inexact (linear convergence with about this factor)
-WOODBURY_ETA = 0.02
-#: most corrected nodes before the Jacobian is refactorized
-WOODBURY_MAX = 96
-
-
-#: The Jacobian cache is a tuple of arrays (Numba passes it unpacked); its parts by position:
-CACHE_INVERSE = 0      # Jinv (N, N): inverse of J_b = I - C_b A diag(d_b)
-CACHE_D_BASE = 1       # d_b (N): the stiffness sigma'(h_b) Jinv was built with
-CACHE_COLUMNS = 2      # W (N, kmax): columns J_b^-1 A[:, i] of the corrected nodes
-CACHE_SLOT_OF = 3      # slot_of (N): slot of a corrected node in W, or -1
-CACHE_NODE_OF = 4      # node_of (kmax): node of each slot
-CACHE_STATE = 5        # state (3, int64), indexed by the STATE_* constants
-CACHE_C_BASE = 6       # c_base (2, float), indexed by the CBASE_* constants
-#: state[STATE_VALID]: 1 when Jinv holds a factorization, 0 to refactorize at the next solve
-STATE_VALID = 0
-#: state[STATE_SLOTS]: slots of W in use
-STATE_SLOTS = 1
-#: state[STATE_MERGES]: rank-k merges since the last factorization
-STATE_MERGES = 2
-#: c_base[CBASE_CEFF]: C_eff of the factorization (a step of another size refactorizes)
-CBASE_CEFF = 0
-#: c_base[CBASE_ETA]: relative stiffness change above which a node is corrected
-CBASE_ETA = 1
-
-
-def new_jacobian_cache(N, kmax=WOODBURY_MAX, eta=WOODBURY_ETA):
-    """Work arrays that carry a factorized Jacobian and its low-rank corrections between steps.
-
-    Returns the tuple (Jinv, d_base, W, slot_of, node_of, state, c_base), positions named by
-    the CACHE_* constants, ``state`` indexed by STATE_*, ``c_base`` by CBASE_*.
-    """
-    kmax = min(int(kmax), N)
-    return (np.empty((N, N)), np.zeros(N), np.empty((N, kmax)), np.full(N, -1, np.int64),
-            np.full(kmax, -1, np.int64), np.zeros(3, np.int64), np.array([0.0, eta]))
-
-
-def invalidate(cache):
-    """Mark the factorization in ``cache`` stale: the next solve refactorizes."""
-    cache[CACHE_STATE][STATE_VALID] = 0
-
-
 @njit(cache=True)
 def residual(h, g, A, ceff, H, h0, c, sig, w, F):
     """F = h - g - A (ceff sigma(h) - H); returns max |F|. sig, w are work arrays."""
@@ -174,136 +132,23 @@ def _norm2(F):
 
 
 @njit(cache=True)
-def factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base):
-    """Jinv <- inverse of J = I - ceff A diag(sigma'(h)); clears the low-rank corrections."""
-    N = h.size
-    sig = np.empty(N)
-    lj_traction_and_stiffness(h, h0, c, sig, d_base)
-    J = np.empty((N, N))
-    for i in range(N):
-        for j in range(N):
-            J[i, j] = -ceff * A[i, j] * d_base[j]
-        J[i, i] += 1.0
-    Jinv[:, :] = np.linalg.inv(J)
-    for i in range(N):
-        slot_of[i] = -1
-    state[STATE_VALID] = 1
-    state[STATE_SLOTS] = 0
-    state[STATE_MERGES] = 0
-    c_base[CBASE_CEFF] = ceff
+def _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats, reason):
+    m = factorize(h, A, ceff, h0, c, factor, e_base, slot_of, state)
+    stats[STAT_FACTOR] += 1
+    stats[STAT_SUBSET] += m
+    if reason >= 0:
+        stats[reason] += 1
 
 
 @njit(cache=True)
-def merge_corrections(d, Jinv, d_base, W, slot_of, node_of, state, c_base):
-    """Fold the corrections of every slotted node into Jinv (one rank-k Woodbury update).
-
-    With S the slotted nodes, Delta = d_S - d_b,S and K = I - C W_SS Delta:
-    J^-1 = J_b^-1 + C W Delta K^-1 E_S^T J_b^-1, exact; then d_b,S <- d_S and the slots are
-    freed. Costs a k x k solve with N right-hand sides and one N x k x N product, about a
-    fifth of a new inverse for k ~ 100 at N = 500.
-    """
-    k = state[STATE_SLOTS]
-    N = Jinv.shape[0]
-    ceff = c_base[CBASE_CEFF]
-    nodes = node_of[:k].copy()
-    delta = np.empty(k)
-    for b in range(k):
-        delta[b] = d[nodes[b]] - d_base[nodes[b]]
-    K = np.empty((k, k))
-    for a in range(k):
-        for b in range(k):
-            K[a, b] = -ceff * W[nodes[a], b] * delta[b]
-        K[a, a] += 1.0
-    rows = np.empty((k, N))
-    for a in range(k):
-        rows[a, :] = Jinv[nodes[a], :]
-    M1 = np.linalg.solve(K, rows)
-    Wd = np.empty((N, k))
-    for r in range(N):
-        for b in range(k):
-            Wd[r, b] = ceff * W[r, b] * delta[b]
-    Jinv += Wd @ M1
-    for b in range(k):
-        d_base[nodes[b]] = d[nodes[b]]
-        slot_of[nodes[b]] = -1
-    state[STATE_SLOTS] = 0
-    state[STATE_MERGES] += 1
-
-
-@njit(cache=True)
-def newton_direction(F, d, A, ceff, eta, Jinv, d_base, W, slot_of, node_of, state, stats):
-    """Newton step dh = -J(h)^-1 F with J(h) = J_b - ceff A_S diag(d_S - d_b,S) E_S^T.
-
-    S holds the nodes whose stiffness moved away from the factorized one; the correction
-    is exact for them (Woodbury identity), nodes outside S differ by less than
-    WOODBURY_ETA. Returns (dh, ok); ok is False when S outgrew the cache (refactorize).
-    """
-    N = F.size
-    kmax = W.shape[1]
-    c_base0 = ceff
-    S = np.empty(N, np.int64)
-    k = 0
-    for i in range(N):
-        jb = abs(1.0 - c_base0 * A[i, i] * d_base[i])
-        if ceff * A[i, i] * abs(d[i] - d_base[i]) > eta * max(jb, 1.0):
-            S[k] = i
-            k += 1
-    if k > kmax:
-        return np.empty(0), False
-    # new columns W[:, slot] = J_b^-1 A[:, i], all at once (one matrix-matrix product)
-    new = np.empty(k, np.int64)
-    m = 0
-    for a in range(k):
-        if slot_of[S[a]] < 0:
-            new[m] = S[a]
-            m += 1
-    if m > 0:
-        if state[STATE_SLOTS] + m > kmax:
-            return np.empty(0), False
-        cols = np.empty((N, m))
-        for r in range(N):
-            for b in range(m):
-                cols[r, b] = A[r, new[b]]
-        Wn = Jinv @ cols
-        for b in range(m):
-            slot = state[STATE_SLOTS]
-            state[STATE_SLOTS] += 1
-            for r in range(N):
-                W[r, slot] = Wn[r, b]
-            slot_of[new[b]] = slot
-            node_of[slot] = new[b]
-        stats[STAT_COLUMNS] += m
-    y = Jinv @ F
-    if k == 0:
-        return -y, True
-    K = np.empty((k, k))
-    delta = np.empty(k)
-    rhs = np.empty(k)
-    for b in range(k):
-        delta[b] = d[S[b]] - d_base[S[b]]
-    for a in range(k):
-        rhs[a] = y[S[a]]
-        for b in range(k):
-            K[a, b] = -ceff * W[S[a], slot_of[S[b]]] * delta[b]
-        K[a, a] += 1.0
-    z = np.linalg.solve(K, rhs)
-    dh = -y
-    for b in range(k):
-        coef = ceff * delta[b] * z[b]
-        sl = slot_of[S[b]]
-        for r in range(N):
-            dh[r] -= coef * W[r, sl]
-    return dh, True
-
-
-@njit(cache=True)
-def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, node_of,
-           state, c_base, stats):
+def newton(h, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, node_of,
+           state, params, stats):
     """Solve F(h) = 0 in place, starting from ``h``. Returns True on convergence.
 
-    The Jacobian factorization in (Jinv, d_base, ...) is reused and corrected (see
-    :func:`newton_direction`); it is rebuilt when C_eff changed, when too many nodes need
-    a correction, or when a line search fails with a reused factorization.
+    The Jacobian factorization in the cache (:func:`kernels.jacobian.new_jacobian_cache`)
+    is reused and corrected (:func:`kernels.jacobian.newton_direction`); it is rebuilt when
+    too many nodes need a correction, when a stale one contracts the residual by less than
+    SLOW_CONTRACTION, or when a line search fails with a stale one.
     """
     N = h.size
     sig = np.empty(N)
@@ -313,48 +158,45 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, nod
     Ft = np.empty(N)
     ht = np.empty(N)
     norm = residual(h, g, A, ceff, H, h0, c, sig, w, F)
+    stats[STAT_RESIDUALS] += 1
     if norm <= tol:
         return True
-    if state[STATE_VALID] == 0 or abs(ceff - c_base[CBASE_CEFF]) > 1e-12 * abs(ceff):
-        factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
-        stats[STAT_FACTOR] += 1
-    fresh = True
+    fresh = False
+    if state[STATE_VALID] == 0:
+        _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats, -1)
+        fresh = True
     for it in range(max_iter):
         stats[STAT_ITER] += 1
         lj_traction_and_stiffness(h, h0, c, sig, d)
-        dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of, node_of,
-                                 state, stats)
-        if not ok and state[STATE_MERGES] < MAX_MERGES and state[STATE_SLOTS] > 0:
-            # the correction set is full: fold it into the inverse and try again
-            merge_corrections(d, Jinv, d_base, W, slot_of, node_of, state, c_base)
-            stats[STAT_MERGES] += 1
-            dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of,
-                                      node_of, state, stats)
+        dh, ok = newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of, state,
+                                  params, stats, STAT_COLUMNS)
         if not ok:
-            factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
-            stats[STAT_FACTOR] += 1
-            stats[STAT_REFACTOR_OVERFLOW] += 1
-            dh, ok = newton_direction(F, d, A, ceff, c_base[CBASE_ETA], Jinv, d_base, W, slot_of,
-                                      node_of, state, stats)
+            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
+                         STAT_REFACTOR_OVERFLOW)
+            fresh = True
+            dh, ok = newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of,
+                                      state, params, stats, STAT_COLUMNS)
         lam = positive_step(h, dh)
         # backtracking on the merit |F|_2 (Newton directions descend it); the max norm
         # decides convergence
         accepted = False
         n2 = _norm2(F)
+        nt2 = n2
         for _ls in range(16):
             for i in range(N):
                 ht[i] = h[i] + lam * dh[i]
             nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
-            if _norm2(Ft) < (1.0 - 1e-4 * lam) * n2:
+            stats[STAT_RESIDUALS] += 1
+            nt2 = _norm2(Ft)
+            if nt2 < (1.0 - 1e-4 * lam) * n2:
                 accepted = True
                 break
             lam *= 0.5
         if not accepted:
             if fresh:        # a line search failed on an exact Jacobian: give up
                 return False
-            factorize(h, A, ceff, h0, c, Jinv, d_base, slot_of, state, c_base)
-            stats[STAT_FACTOR] += 1
-            stats[STAT_REFACTOR_LINESEARCH] += 1
+            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
+                         STAT_REFACTOR_LINESEARCH)
             fresh = True
             continue
         for i in range(N):
@@ -363,7 +205,12 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, nod
         norm = nt
         if norm <= tol:
             return True
-        fresh = False
+        if not fresh and nt2 > SLOW_CONTRACTION * n2:
+            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
+                         STAT_REFACTOR_SLOW)
+            fresh = True
+        else:
+            fresh = False
     return False
 
 
@@ -420,8 +267,8 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
 
 
 @njit(cache=True)
-def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, Jinv, d_base, W, slot_of, node_of,
-         state, c_base, stats):
+def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, factor, e_base, W, slot_of,
+         node_of, state, params, stats):
     """Newton from the gap profile outside the crack tip shifted inward by 1 to 6 nodes.
 
     Near a fold of the discrete path the stable state the tip snaps to is, locally, the
@@ -440,8 +287,8 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, Jinv, d_base, W, slo
                 hp[i] = h[i + shift]
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
-        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, Jinv, d_base, W, slot_of, node_of,
-                  state, c_base, stats):
+        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, node_of,
+                  state, params, stats):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -453,10 +300,79 @@ def load(sigma, wP):
     return 2.0 * np.pi * np.dot(wP, sigma)
 
 
+#: steps in a row whose contact-radius change is below EASY_DA_FRACTION * da_max before
+#: the step doubles (steps change by factors of 2 only)
+EASY_STEPS = 8
+EASY_DA_FRACTION = 0.3
+#: a step rejected for its radius change is halved until the change, assumed proportional
+#: to the step, is below this fraction of da_max
+REJECT_TARGET = 0.8
+#: where the load evolves smoothly the step grows beyond step_max, up to this factor, while
+#: the predictor's load error stays below step_tol and the crack tip moves by less than
+#: SMOOTH_DA_FRACTION da_max per step
+SMOOTH_STEP_FACTOR = 8.0
+SMOOTH_DA_FRACTION = 0.6
+#: the predictor never puts a gap below this fraction of the last accepted one
+PREDICT_FLOOR = 0.5
+
+
+@njit(cache=True)
+def predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp):
+    """Starting gap of the next solve: quadratic (Lagrange) extrapolation through the last
+    three accepted states (linear after one, constant at the start), floored at
+    PREDICT_FLOOR of the last gap. Returns True when the extrapolation was quadratic (its
+    distance to the solution is then the step-error estimate)."""
+    N = h.size
+    if dt_prev2 > 0.0:
+        t1 = -dt_prev
+        t2 = -dt_prev - dt_prev2
+        l0 = (dt - t1) * (dt - t2) / (t1 * t2)
+        l1 = dt * (dt - t2) / (t1 * (t1 - t2))
+        l2 = dt * (dt - t1) / (t2 * (t2 - t1))
+        for i in range(N):
+            hp[i] = max(l0 * h[i] + l1 * h_prev[i] + l2 * h_prev2[i], PREDICT_FLOOR * h[i])
+        return True
+    if dt_prev > 0.0:
+        s = dt / dt_prev
+        for i in range(N):
+            hp[i] = max(h[i] + s * (h[i] - h_prev[i]), PREDICT_FLOOR * h[i])
+        return False
+    hp[:] = h
+    return False
+
+
+@njit(cache=True)
+def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
+    """Step control after an accepted step: (next indentation step, easy-step count).
+
+    Up to ``dd_max`` the step doubles after EASY_STEPS steps in a row that moved the crack
+    tip by less than EASY_DA_FRACTION da_max. Beyond it (up to SMOOTH_STEP_FACTOR dd_max)
+    it doubles after EASY_STEPS steps in a row while a doubled step would keep the tip
+    motion below SMOOTH_DA_FRACTION da_max and the predictor's load error ``err``, 8 err
+    for a doubled step (third order), below ``step_tol``; it is halved back as soon as
+    either bound is exceeded.
+    """
+    if dd > dd_max * 1.0001:
+        if da > SMOOTH_DA_FRACTION * da_max or err > step_tol:
+            return max(0.5 * dd, dd_max), 0
+        easy += 1
+    elif da < EASY_DA_FRACTION * da_max:
+        easy += 1
+    else:
+        easy = 0
+    if easy >= EASY_STEPS:
+        if dd < dd_max * 0.9999:
+            return min(2.0 * dd, dd_max), 0
+        if (2.0 * da < SMOOTH_DA_FRACTION * da_max and 8.0 * err < step_tol
+                and dd < SMOOTH_STEP_FACTOR * dd_max * 0.9999):
+            return min(2.0 * dd, SMOOTH_STEP_FACTOR * dd_max), 0
+    return dd, easy
+
+
 @njit(cache=True)
 def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io,
-           step_max, step_min, da_max, tol, max_iter, max_steps, stop_mode, min_travel,
-           tip_lo, tip_hi, Jinv, d_base, W, slot_of, node_of, state, c_base,
+           step_max, step_min, da_max, step_tol, tol, max_iter, max_steps, stop_mode, min_travel,
+           tip_lo, tip_hi, factor, e_base, W, slot_of, node_of, state, params,
            t_out, d_out, P_out, a_out, ai_out, h_out, stats):
     """Unload at constant rate from the state ``h_init`` with the Prony recursion.
 
@@ -483,12 +399,15 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         on return the step the run would take next.
     step_max, step_min : indentation steps in units of h0.
     da_max : largest contact-radius change per step (a_ref units).
+    step_tol : relative load error of the step predictor, |P(predicted) - P| / max(|P|, 1),
+        below which the step may grow beyond ``step_max`` (up to SMOOTH_STEP_FACTOR
+        times) where the load evolves smoothly; 0 keeps every step <= step_max.
     stop_mode : 0 stop after pull-off and load recovery, 1 follow to separation.
     min_travel : crack-tip recession after the minimum required to stop (a_ref), see
         :func:`stop_reached`.
     tip_lo, tip_hi : radii the crack tip must stay within (the well-resolved band of a
         graded mesh); leaving them ends the run with STATUS_LEFT_BAND.
-    Jinv, d_base, W, slot_of, node_of, state, c_base : Jacobian cache arrays
+    factor, e_base, W, slot_of, node_of, state, params : Jacobian cache arrays
         (:func:`new_jacobian_cache`); may carry the factorization of the initial solve.
     t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
     h_out : (N,) receives the gap of the last accepted step.
@@ -512,6 +431,8 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
     h_prev = h_init.copy()
     h_prev2 = h_init.copy()
     hp = np.empty(N)
+    h_pred = np.empty(N)
+    sigma_pred = np.empty(N)
     sigma = np.empty(N)
     sig_new = np.empty(N)
     lj_traction(h, h0, c, sigma)
@@ -532,117 +453,96 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
     for i in range(1, n):
         if P_out[i] < P_out[i_min]:
             i_min = i
-    P_min = P_out[i_min]
-    dd = step_io[0] * h0 if step_io[0] > 0.0 else step_max * h0
+    # units converted once: steps and tolerances in d_ref from here on
+    dd_max = step_max * h0
     dd_min = step_min * h0
+    tol_gap = tol * h0
+    tol_step = step_tol * h0
+    dd = step_io[0] * h0 if step_io[0] > 0.0 else dd_max
     dt_prev = 0.0
     dt_prev2 = 0.0
     easy = 0
-    while True:
-        if n > max_steps:
-            h_out[:] = h
-            step_io[0] = dd / h0
-            return STATUS_STEP_LIMIT, n
+    status = STATUS_STEP_LIMIT
+    while n <= max_steps:
+        # -- predict
         dt = dd / (rate * h0)
         ceff = step_coefficients(weights, times, dt, e, b)
         history_vector(weights, e, b, q, sigma, H)
         for i in range(N):
             g[i] = -(delta - dd) + h0 + r2half[i]
-        if dt_prev2 > 0.0:
-            # quadratic (Lagrange) extrapolation through the last three accepted states
-            t1 = -dt_prev
-            t2 = -dt_prev - dt_prev2
-            l0 = (dt - t1) * (dt - t2) / (t1 * t2)
-            l1 = dt * (dt - t2) / (t1 * (t1 - t2))
-            l2 = dt * (dt - t1) / (t2 * (t2 - t1))
-            for i in range(N):
-                hp[i] = l0 * h[i] + l1 * h_prev[i] + l2 * h_prev2[i]
-                if hp[i] < 0.5 * h[i]:
-                    hp[i] = 0.5 * h[i]
-        elif dt_prev > 0.0:
-            s = dt / dt_prev
-            for i in range(N):
-                hp[i] = h[i] + s * (h[i] - h_prev[i])
-                if hp[i] < 0.5 * h[i]:
-                    hp[i] = 0.5 * h[i]
-        else:
-            for i in range(N):
-                hp[i] = h[i]
-        ok = newton(hp, g, A, ceff, H, h0, c, tol * h0, max_iter, Jinv, d_base, W, slot_of,
-                    node_of, state, c_base, stats)
+        quadratic = predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp)
+        h_pred[:] = hp
+        # -- solve
+        ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, factor, e_base, W, slot_of,
+                    node_of, state, params, stats)
         if not ok:
             stats[STAT_FAILED_SOLVES] += 1
             state[STATE_VALID] = 0
             easy = 0
-            if dd > max(dd_min, SNAP_STEP_FRACTION * step_max * h0) * 1.0001:
+            if dd > max(dd_min, SNAP_STEP_FRACTION * dd_max) * 1.0001:
                 dd = max(0.5 * dd, dd_min)
                 continue
             # the equilibrium path folds here (the crack tip snaps to the next node): look
-            # for the snapped state by Newton from the profile shifted inward by 1..3 nodes,
+            # for the snapped state by Newton from the profile shifted inward by 1..6 nodes,
             # else by pseudo-transient relaxation from the last state
             stats[STAT_JUMPS] += 1
-            ok = snap(h, hp, g, A, ceff, H, h0, c, tol * h0, max_iter, r, hm, Jinv, d_base, W,
-                      slot_of, node_of, state, c_base, stats)
+            ok = snap(h, hp, g, A, ceff, H, h0, c, tol_gap, max_iter, r, hm, factor, e_base, W,
+                      slot_of, node_of, state, params, stats)
             if not ok:
-                for i in range(N):
-                    hp[i] = h[i]
-                ok = relax(hp, g, A, ceff, H, h0, c, tol * h0, RELAX_MAX_ITER, stats)
+                hp[:] = h
+                ok = relax(hp, g, A, ceff, H, h0, c, tol_gap, RELAX_MAX_ITER, stats)
             if not ok:
-                h_out[:] = h
-                step_io[0] = dd / h0
-                return STATUS_NEWTON_FAILED, n
+                status = STATUS_NEWTON_FAILED
+                break
+            quadratic = False
+        # -- control the step: the crack tip may move by da_max at most
         a_new = crossing_radius(hp, r, hm)
-        if ok and abs(a_new - a_cur) > da_max and dd > dd_min * 1.0001:
+        da = abs(a_new - a_cur)
+        if da > da_max and dd > dd_min * 1.0001:
             stats[STAT_REJECTED] += 1
             easy = 0
-            # halve until the change, assumed proportional to the step, fits
-            da_est = abs(a_new - a_cur)
-            while da_est > 0.8 * da_max and dd > dd_min:
+            da_est = da
+            while da_est > REJECT_TARGET * da_max and dd > dd_min:
                 dd = max(0.5 * dd, dd_min)
                 da_est *= 0.5
             continue
-        # accept the step
         lj_traction(hp, h0, c, sig_new)
+        P = load(sig_new, wP)
+        if quadratic:
+            lj_traction(h_pred, h0, c, sigma_pred)
+            err = abs(load(sigma_pred, wP) - P) / max(abs(P), 1.0)
+        else:
+            err = np.inf
+        # -- accept
         update_modes(e, b, q, sig_new, sigma)
-        for i in range(N):
-            h_prev2[i] = h_prev[i]
-            h_prev[i] = h[i]
-            h[i] = hp[i]
-            sigma[i] = sig_new[i]
+        h_prev2[:] = h_prev
+        h_prev[:] = h
+        h[:] = hp
+        sigma[:] = sig_new
         dt_prev2 = dt_prev
         dt_prev = dt
         t += dt
         delta -= dd
-        P = load(sigma, wP)
         t_out[n] = t
         d_out[n] = delta
         P_out[n] = P
         a_out[n] = a_new
         ai_out[n] = crossing_radius(h, r, h0)
-        if P < P_min:
-            P_min = P
+        if P < P_out[i_min]:
             i_min = n
         n += 1
-        if a_new >= r[N - 1]:
-            h_out[:] = h
-            step_io[0] = dd / h0
-            return STATUS_DOMAIN, n
-        if a_new > tip_hi or a_new < tip_lo:
-            h_out[:] = h
-            step_io[0] = dd / h0
-            return STATUS_LEFT_BAND, n
-        if stop_reached(P_out, a_out, n, i_min, stop_mode, min_travel):
-            h_out[:] = h
-            step_io[0] = dd / h0
-            return STATUS_DONE, n
-        da = abs(a_new - a_cur)
         a_cur = a_new
-        # steps change by factors of 2 only, and grow after 8 easy steps in a row: C_eff
-        # (hence the factorized Jacobian) changes only when the step does
-        if da < 0.3 * da_max:
-            easy += 1
-            if easy >= 8 and dd < step_max * h0:
-                dd = min(2.0 * dd, step_max * h0)
-                easy = 0
-        else:
-            easy = 0
+        # -- stop
+        if a_new >= r[N - 1]:
+            status = STATUS_DOMAIN
+            break
+        if a_new > tip_hi or a_new < tip_lo:
+            status = STATUS_LEFT_BAND
+            break
+        if stop_reached(P_out, a_out, n, i_min, stop_mode, min_travel):
+            status = STATUS_DONE
+            break
+        dd, easy = next_step(dd, easy, da, da_max, err, dd_max, tol_step)
+    h_out[:] = h
+    step_io[0] = dd / h0
+    return status, n

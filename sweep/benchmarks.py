@@ -454,8 +454,39 @@ def _nodes_used(res) -> int:
     return int(res.numerics.nodes)
 
 
+def kernel_counters(scene, numerics) -> dict:
+    """Counters of the unloading kernel on one run (``kernels.solve`` STAT_*), per step:
+    residual evaluations (one N x N mat-vec each), Newton iterations, correction columns
+    (one application of the restricted inverse each), factorizations and the mean size of
+    the factorized block |S|/N."""
+    from kernels import solve as ks
+
+    from . import solver
+    captured = {}
+    orig = solver.unload
+
+    def capture(*args):
+        out = orig(*args)
+        captured["stats"] = args[-1].copy()
+        return out
+    solver.unload = capture
+    try:
+        res = solver.simulate(scene, numerics)
+    finally:
+        solver.unload = orig
+    st, steps, N = captured["stats"], max(res.steps, 1), _nodes_used(res)
+    return {"residual_matvecs_per_step": st[ks.STAT_RESIDUALS] / steps,
+            "newton_iterations_per_step": st[ks.STAT_ITER] / steps,
+            "columns_per_step": st[ks.STAT_COLUMNS] / steps,
+            "factorizations": int(st[ks.STAT_FACTOR]),
+            "steps_per_factorization": steps / max(st[ks.STAT_FACTOR], 1),
+            "subset_fraction": st[ks.STAT_SUBSET] / max(st[ks.STAT_FACTOR], 1) / N,
+            "note": "counters include the relaxed start's elastic solves when not cached"}
+
+
 def bench_step_over_matvec(plan: BenchPlan) -> dict:
-    """Time per step over the time of one dense N x N mat-vec at the mesh's N."""
+    """Time per step over the time of one dense N x N mat-vec at the mesh's N, with the
+    kernel's counters (:func:`kernel_counters`)."""
     from .scene import Numerics, Scene
     scene = Scene(**plan.matvec_scene)
     out = {}
@@ -464,6 +495,7 @@ def bench_step_over_matvec(plan: BenchPlan) -> dict:
         row = step_cost(scene, num, plan.repeat)
         row["matvec_s"] = matvec_seconds(row["nodes"])
         row["ratio"] = row["step_s"] / row["matvec_s"]
+        row["counters"] = kernel_counters(scene, num)
         out[str(N)] = row
     return out
 

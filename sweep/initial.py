@@ -9,6 +9,7 @@ in a non-solution minimum of |F| where the contact edge sits between nodes).
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 
 import numpy as np
 
@@ -19,6 +20,10 @@ from .problem import jkr_radius
 
 #: Newton iterations of the elastic solves of the initial state (poorer starting guesses)
 MAX_NEWTON_ITER_INITIAL = 40
+#: relaxed states kept per process: the initial state depends on the mesh, mu and a0 (or
+#: delta0) only, so a sweep over materials and rates solves each one once per worker
+RELAXED_CACHE_SIZE = 64
+_RELAXED: OrderedDict = OrderedDict()
 
 
 def jkr_gap_guess(r: np.ndarray, delta: float, h0: float) -> np.ndarray:
@@ -100,11 +105,32 @@ def _solve_at(el: ElasticSolver, delta: float) -> np.ndarray:
     raise RuntimeError(f"no converged relaxed state at delta0={delta:.6g}")
 
 
-def relaxed_state(el: ElasticSolver, delta0=None, a0=None):
+def relaxed_state(el: ElasticSolver, delta0=None, a0=None, mesh_key=None):
     """Relaxed elastic state at ``delta0`` or at the indentation giving contact radius ``a0``.
 
-    Returns (h, delta0) or raises RuntimeError with a reason.
+    ``mesh_key`` (hashable, determines the mesh and its influence matrix, e.g.
+    ``sweep.mesh.Mesh.key`` with the spacing) keeps the solution in a per-process cache of
+    RELAXED_CACHE_SIZE states, returned (copied) to the next call with the same mesh, LJ
+    law, tolerance and initial state; ``el`` then solves nothing (its Jacobian cache stays
+    unfactorized). Returns (h, delta0) or raises RuntimeError with a reason.
     """
+    key = None
+    if mesh_key is not None:
+        key = (mesh_key, el.h0, el.c, el.tol, delta0, a0)
+        hit = _RELAXED.get(key)
+        if hit is not None:
+            _RELAXED.move_to_end(key)
+            return hit[0].copy(), hit[1]
+    h, d = _solve_relaxed(el, delta0, a0)
+    if key is not None:
+        _RELAXED[key] = (h.copy(), d)
+        if len(_RELAXED) > RELAXED_CACHE_SIZE:
+            _RELAXED.popitem(last=False)
+    return h, d
+
+
+def _solve_relaxed(el: ElasticSolver, delta0=None, a0=None):
+    """The relaxed state of :func:`relaxed_state`, solved."""
     if delta0 is not None:
         return _solve_at(el, float(delta0)), float(delta0)
 

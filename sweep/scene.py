@@ -264,7 +264,9 @@ class Numerics:
     tail_gap : float
         Gap at the mesh edge, in units of h0, used by the automatic domain (>= 10).
     step : float
-        Largest indentation step, in units of h0 (the adaptive step never exceeds it).
+        Largest indentation step, in units of h0, where the crack tip moves or the load
+        evolves fast (the adaptive step exceeds it, up to 8 times, only where the
+        predictor's load error is below 1e-3: sweep.solver.STEP_TOL).
     min_step : float
         Smallest indentation step in units of h0 before a run is declared failed.
     da_max : float

@@ -112,6 +112,10 @@ def test_bench_json_keys_with_a_tiny_plan():
     rep = bench_all(plan, progress=lambda m: None)
     json.dumps(rep, default=str)
     assert set(rep["step_over_matvec"]) == {str(n) for n in plan.matvec_nodes}
+    for row in rep["step_over_matvec_detail"].values():
+        c = row["counters"]
+        assert c["residual_matvecs_per_step"] >= 1.0          # at least one residual a step
+        assert 0.0 < c["subset_fraction"] <= 1.0 and c["factorizations"] >= 1
     assert set(rep["prony_speedup"]) == {str(n) for n in plan.prony_steps}
     assert rep["compile_s"] is None                          # tiny: no fresh processes
     assert rep["scenes_per_minute"] > 0 and rep["parallel_speedup"] > 0

@@ -5,11 +5,11 @@ This is the interface a tip-following mesh and a wall-time budget build on.
 """
 import numpy as np
 
-from kernels.solve import STATUS_DONE, STATUS_STEP_LIMIT, new_jacobian_cache, unload
+from kernels.solve import N_STATS, STATUS_DONE, STATUS_STEP_LIMIT, new_jacobian_cache, unload
 from sweep.initial import ElasticSolver, relaxed_state
 from sweep.problem import prepare
 from sweep.scene import Numerics, Scene
-from sweep.solver import MAX_NEWTON_ITER, STOP_TRAVEL_SPACINGS
+from sweep.solver import MAX_NEWTON_ITER, STEP_TOL, STOP_TRAVEL_SPACINGS
 
 SCENE = Scene(n=0.8, k=0.2, mu=3.24, a0=1.5, rate=10.0)
 NUMERICS = Numerics(mesh="uniform", nodes=120, domain=3.0, step=0.25, da_max=1.0,
@@ -23,7 +23,7 @@ def _run(chunk):
     N, M = pb.mesh.nodes, pb.prony_weights.size
     q, step = np.zeros((M, N)), np.zeros(1)
     out = [np.empty(NUMERICS.max_steps + 1) for _ in range(5)]
-    stats = np.zeros(9, np.int64)
+    stats = np.zeros(N_STATS, np.int64)
     cache = new_jacobian_cache(N)
     n, calls = 0, 0
     while True:
@@ -31,7 +31,7 @@ def _run(chunk):
         limit = NUMERICS.max_steps if chunk is None else min(n + chunk, NUMERICS.max_steps)
         status, n = unload(pb.A, pb.mesh.r, pb.wP, h, delta0, SCENE.rate, pb.h0, pb.c,
                            pb.prony_weights, pb.prony_times, q, n, step, NUMERICS.step,
-                           NUMERICS.min_step, NUMERICS.da_max * pb.mesh.spacing, NUMERICS.tol,
+                           NUMERICS.min_step, NUMERICS.da_max * pb.mesh.spacing, STEP_TOL, NUMERICS.tol,
                            MAX_NEWTON_ITER, limit, pb.stop_mode,
                            STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range, *cache, *out,
                            h_out, stats)
@@ -74,3 +74,40 @@ def test_time_budget_ends_a_run_failed_with_the_reason(monkeypatch):
     assert res.status == "failed"
     assert res.reason.startswith("time budget") and "time_budget_s" in res.reason
     assert res.steps <= 2 * solver.CHUNK_STEPS
+
+
+def test_step_control_grows_beyond_step_max_only_where_smooth():
+    from kernels.solve import EASY_STEPS, SMOOTH_STEP_FACTOR, next_step
+    dd_max, da_max, tol = 1.0, 1.0, 1e-3
+
+    def run(da, err, dd=dd_max, steps=EASY_STEPS):
+        easy = 0
+        for _ in range(steps):
+            dd, easy = next_step(dd, easy, da, da_max, err, dd_max, tol)
+        return dd
+    assert run(0.1, 1e-6) == 2.0                       # smooth and slow tip: doubles
+    assert run(0.1, 1e-6, steps=10 * EASY_STEPS) == SMOOTH_STEP_FACTOR   # capped
+    assert run(0.1, 1e-3) == dd_max                    # predictor error too large
+    assert run(0.4, 1e-6) == dd_max                    # a doubled step would move the tip too far
+    assert run(0.1, np.inf) == dd_max                  # no error estimate (after a fold)
+    # beyond step_max, a fast tip or a large error halves the step back at once
+    assert next_step(4.0, 3, 0.7, da_max, 1e-6, dd_max, tol) == (2.0, 0)
+    assert next_step(4.0, 3, 0.1, da_max, 2e-3, dd_max, tol) == (2.0, 0)
+    # below step_max the step doubles after EASY_STEPS slow steps, never past step_max
+    assert run(0.1, np.inf, dd=0.5) == dd_max
+
+
+def test_grown_steps_keep_the_pull_off(monkeypatch):
+    from sweep import solver
+    # a large contact: the crack tip recedes slowly over hundreds of steps (~1 s per run)
+    scene = Scene(n=0.6, k=0.1, mu=3.24, a0=8.0, rate=10**2.5)
+    num = Numerics.preset("fast", pull_off_rtol=0.0, max_nodes=1000)
+    grown = solver.simulate(scene, num)
+    monkeypatch.setattr(solver, "STEP_TOL", 0.0)
+    capped = solver.simulate(scene, num)
+    assert grown.ok and capped.ok
+    assert grown.steps < 0.9 * capped.steps
+    steps = -np.diff(grown.trajectory["delta"]) / prepare(scene, num).h0
+    assert steps.max() > 1.5 * num.step and np.all(steps <= 8 * num.step * (1 + 1e-9))
+    assert abs(grown.pull_off / capped.pull_off - 1) < 1e-6
+    assert abs(grown.crack_speed / capped.crack_speed - 1) < 1e-4
