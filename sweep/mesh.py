@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kernels.influence import assemble_unit, combine_lattice_hats, load_weights_nodes
+from kernels.influence import (assemble_nodes, assemble_unit, combine_lattice_hats,
+                               load_weights_nodes)
 
 #: the crack band reaches this fraction of a0 inward (pull-off radii measured on the
 #: reference scenes are 0.42-0.53 a0; the elastic limit is 1.145 a_ref) ...
@@ -172,6 +173,11 @@ def crack_band(a0: float, l0: float, pull_off_only: bool = True) -> tuple[float,
 
 #: the cached unit-spacing matrix grows in multiples of this many nodes
 UNIT_BLOCK = 256
+#: a graded mesh whose lattice is wider than this many fine spacings (a fine band at large
+#: mu: 2.4e5 at mu = 100) has its influence matrix assembled on its own nodes
+#: (kernels.influence.assemble_nodes, about 1 s for 700 nodes) rather than combined from
+#: the unit-spacing matrix of the whole lattice (width^2 entries)
+LATTICE_MAX_WIDTH = 6000
 _UNIT = [np.zeros((0, 0))]
 _MESH_CACHE: dict = {}
 _MESH_CACHE_SIZE = 32
@@ -198,6 +204,8 @@ def influence(mesh: Mesh) -> np.ndarray:
         idx = mesh.lattice
         if mesh.kind == "uniform":
             A1 = unit_influence(mesh.nodes)
+        elif 2 * idx[-1] - idx[-2] + 1 > LATTICE_MAX_WIDTH:
+            A1 = assemble_nodes(idx.astype(float))
         else:
             width = int(2 * idx[-1] - idx[-2]) + 1
             A1 = combine_lattice_hats(np.ascontiguousarray(unit_influence(width)[idx, :]),

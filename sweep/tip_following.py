@@ -1,0 +1,288 @@
+"""Viscoelastic unloading on a mesh refined around the crack tip that follows it.
+
+At a large Tabor parameter the process zone l0 = 1.693/mu^2 (a_ref) is tiny (1.9e-3 at mu =
+30, 1.7e-4 at mu = 100) and a fixed graded mesh, fine over the whole band the tip sweeps
+(from a0 down to below the pull-off radius), needs 10^4-10^5 nodes. Here only a *window*
+around the crack tip is fine (spacing l0 / ``band_resolution``, :func:`sweep.mesh.graded_mesh`
+with the window as its band, element lengths growing by ``grading`` outside it), and the
+mesh is rebuilt when the tip leaves the window:
+
+1. the window is placed with the tip ``behind`` process zones from its trailing end (the
+   cohesive zone and the recent wake of the Prony modes stay fine) and ``ahead`` zones of
+   room in the direction the tip moves (inward while the contact shrinks);
+2. the unloading kernel runs until the tip leaves the window less TIP_MARGIN_ZONES l0
+   (``kernels.solve.STATUS_LEFT_BAND``);
+3. a new mesh is built with the window moved to the tip, the gap ``h`` and the Prony modal
+   state ``q`` are carried over (every mesh lies on the lattice of the fine spacing, so
+   nodes common to both meshes keep their values exactly; the others are interpolated by a
+   cubic spline, exact for the r^2/2 of the rigid profile), the records continue, and the
+   kernel resumes (:func:`sweep.solver.unload_chunk`).
+
+The cost is set by the window (a few hundred nodes, whatever a0) and by the number of time
+steps (the tip moves at most ``da_max`` spacings per step); each new mesh costs one
+influence-matrix assembly (about 1 s at 700 nodes).
+
+Units and conventions of docs/design.md section 2.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP_LIMIT,
+                           new_jacobian_cache)
+
+from . import units
+from .initial import ElasticSolver, relaxed_state
+from .problem import Refused, initial_estimates, prepare
+from .scene import Numerics, Result, Scene
+
+#: room for the tip in its direction of motion, in process zones l0 (the tip moves this far,
+#: less TIP_MARGIN_ZONES, between two meshes)
+WINDOW_AHEAD_ZONES = 16.0
+#: fine region behind the tip (the cohesive zone, a few l0, and the recent wake), l0
+WINDOW_BEHIND_ZONES = 8.0
+#: most meshes of one run (a run that needs more ends failed with the reason)
+MAX_MESHES = 5000
+
+
+def tip_window(tip: float, l0: float, ahead: float = WINDOW_AHEAD_ZONES,
+               behind: float = WINDOW_BEHIND_ZONES, direction: int = -1) -> tuple[float, float]:
+    """The fine window (a_ref radii) for a crack tip at ``tip`` moving inward
+    (``direction`` -1, the contact shrinks) or outward (+1): ``ahead`` process zones l0 of
+    room in the direction of motion, ``behind`` zones on the other side."""
+    if direction < 0:
+        lo, hi = tip - ahead * l0, tip + behind * l0
+    else:
+        lo, hi = tip - behind * l0, tip + ahead * l0
+    return max(lo, 0.0), hi
+
+
+def transfer(run, old_r: np.ndarray, new_r: np.ndarray) -> None:
+    """Carry the state of an unloading run (gap ``h``, Prony modes ``q``) from nodes
+    ``old_r`` to ``new_r`` in place, with a new Jacobian cache; records, step and counters
+    stay. A cubic spline interpolates (it returns the old values at common nodes)."""
+    h = CubicSpline(old_r, run.h)(new_r)
+    run.h = np.maximum(h, 0.5 * float(np.min(run.h)))
+    if run.q.shape[0] > 0:
+        run.q = np.ascontiguousarray(CubicSpline(old_r, run.q, axis=1)(new_r))
+    else:
+        run.q = np.zeros((0, new_r.size))
+    run.cache = new_jacobian_cache(new_r.size)
+
+
+def initial_state(el: ElasticSolver, scene: Scene):
+    """The relaxed state (gap, indentation) of a scene on the window mesh of ``el``.
+
+    From a0: the elastic equilibrium at contact radius a0 on the quasi-static branch
+    (:class:`sweep.quasistatic.ElasticBranch`, which fixes the radius, not the indentation),
+    carried to the mesh and polished by Newton at its indentation, then a secant on the
+    indentation to the radius a0 on this mesh (warm-started solves; the tip stays in the
+    fine window), to a0 or, where the tip is pinned between nodes, within one fine
+    spacing (``Result.a0_result`` says where). A direct Newton solve from the JKR gap, as
+    :func:`sweep.initial.relaxed_state` does, can converge to a state whose tip sits on the
+    coarse mesh outside the window at large mu. From delta0, and where the above fails:
+    :func:`sweep.initial.relaxed_state`.
+    """
+    from .quasistatic import ElasticBranch
+
+    if scene.a0 is not None:
+        a0 = scene.a0
+        br = ElasticBranch(scene.mu, a0, 0.5 * a0)
+        h_b, d_b = br.guess(a0)
+        h_b, d, ok = br.solve(a0, h_b, d_b)
+        if ok:
+            guess = np.maximum(CubicSpline(a0 * br.x, h_b)(el.r), 0.3 * el.h0)
+            ok, h = el.solve(d, guess)
+            f = el.radius(h) - a0 if ok else math.nan
+            best = (abs(f), h, d) if ok else None
+            slope = 2.0 * a0 - 1.0 / math.sqrt(2.0 * a0)     # JKR d delta / d a
+            d_prev, f_prev = d, f
+            for _ in range(20):
+                if not ok or abs(f) <= 1e-10 * a0:
+                    break
+                secant = (d - d_prev) / (f - f_prev) if f != f_prev else 0.0
+                # the secant where a(delta) moves; the JKR slope where the tip is pinned
+                d_new = d - f * (secant if 0.2 * slope < secant < 5.0 * slope else slope)
+                ok, h_new = el.solve(d_new, np.maximum(h - (d_new - d), 0.3 * h))
+                if not ok:
+                    break
+                d_prev, f_prev, d, h = d, f, d_new, h_new
+                f = el.radius(h) - a0
+                if abs(f) < best[0]:
+                    best = (abs(f), h, d)
+                if abs(f - f_prev) < 1e-2 * abs(f):     # pinned: a(delta) does not move
+                    break
+            # a tip pinned between nodes (lattice trapping) cannot reach a0 exactly: within
+            # a spacing
+            spacing = float(np.min(np.diff(el.r)))
+            if best is not None and best[0] <= spacing:
+                return best[1], float(best[2])
+    return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
+
+
+def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
+                           ahead: float = WINDOW_AHEAD_ZONES,
+                           behind: float = WINDOW_BEHIND_ZONES) -> Result:
+    """Simulate one scene with the BEM on a mesh refined around the moving crack tip.
+
+    Parameters
+    ----------
+    scene : Scene
+    numerics : Numerics, optional
+        Default ``Numerics.preset("balanced")``; the fine spacing is l0 / band_resolution
+        (or, with ``nodes`` set, the mesh of that many nodes), the rest as for
+        :func:`sweep.solver.simulate` (steps, tolerances, time budget, error indicator).
+    ahead, behind : float
+        The window, in process zones l0 (see :func:`tip_window`).
+
+    Returns
+    -------
+    Result
+        As :func:`sweep.solver.simulate`; ``nodes_used`` is the largest mesh of the run,
+        ``reason`` of an ok result says how many meshes it took.
+    """
+    from .solver import CHECK_FRACTION, _check_resolution, coarser, resolution_error
+
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    t_start = time.perf_counter()
+    deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
+    res = _attempt(scene, numerics, ahead, behind, deadline)
+    if res.ok and numerics.pull_off_rtol > 0:
+        res.error_estimate = resolution_error(res.spacing, units.l0_hat(scene.mu))
+        if res.error_estimate > CHECK_FRACTION * numerics.pull_off_rtol:
+            _check_resolution(res, _attempt(scene, coarser(numerics), ahead, behind, deadline))
+    res.wall_s = time.perf_counter() - t_start
+    return res
+
+
+def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
+    from .solver import (CHUNK_STEPS, STATUS_TIME_BUDGET, UnloadingState, _finish,
+                         unload_chunk)
+
+    if numerics.mesh != "graded" or numerics.exact:
+        numerics = dataclasses.replace(numerics, mesh="graded", exact=False)
+    res = Result(scene=scene, numerics=numerics)
+    l0 = units.l0_hat(scene.mu)
+    _, a_est, _ = initial_estimates(scene, numerics)
+    try:
+        # the initial state: where the relaxed tip lies outside the first window (delta0
+        # scenes, whose radius is a JKR estimate), once more with the window there
+        for _ in range(2):
+            pb = prepare(scene, numerics, tip_window(a_est, l0, ahead, behind))
+            el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, numerics.tol)
+            h_init, delta0 = initial_state(el, scene)
+            a_init = el.radius(h_init)
+            lo, hi = pb.tip_range
+            if lo <= a_init <= hi or a_init <= 0.0:
+                break
+            a_est = a_init
+    except Refused as exc:
+        res.reason = str(exc)
+        return res
+    except RuntimeError as exc:
+        res.reason = f"initial state: {exc}"
+        return res
+    res.delta0_result, res.a0_result = delta0, a_init
+    res.a0_inner = el.radius(h_init, 1.0)
+    res.spacing, res.domain_used = pb.mesh.spacing, pb.mesh.domain
+    res.prony_terms, res.prony_error = int(pb.prony_weights.size), pb.prony_error
+    if a_init <= 0.0:
+        res.reason = "no contact in the initial state (delta0 below the jump-in)"
+        return res
+    if a_init >= pb.mesh.r[-2]:
+        res.reason = f"initial contact radius {a_init:.4g} reaches the mesh edge"
+        return res
+
+    run = UnloadingState.start(pb, h_init, delta0, el.cache, el.stats.copy())
+    meshes, nodes = 1, pb.mesh.nodes
+    while True:
+        status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
+        if status == STATUS_LEFT_BAND and meshes < MAX_MESHES:
+            a = run.records[3]
+            direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1
+            try:
+                new = prepare(scene, numerics,
+                              tip_window(a[run.n - 1], l0, ahead, behind, direction))
+            except Refused as exc:
+                res.reason = f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"
+                return res
+            transfer(run, pb.mesh.r, new.mesh.r)
+            pb, meshes, nodes = new, meshes + 1, max(nodes, new.mesh.nodes)
+        elif status == STATUS_STEP_LIMIT and run.n <= numerics.max_steps:
+            pass
+        else:
+            break
+        if time.perf_counter() > deadline:
+            status = STATUS_TIME_BUDGET
+            break
+    n = run.n
+    t, delta, P, a, a_inner = (x[:n].copy() for x in run.records)
+    res.trajectory = {"t": t, "delta": delta, "P": P, "a": a, "a_inner": a_inner}
+    res.steps = n - 1
+    res.newton_iterations = int(run.stats[STAT_ITER])
+    res.factorizations = int(run.stats[STAT_FACTOR])
+    res.nodes_used = nodes
+    if status == STATUS_LEFT_BAND:
+        res.reason = f"more than {MAX_MESHES} meshes (a = {a[-1]:.4g})"
+        return res
+    _finish(res, scene, status, t, delta, P, a, a_inner, pb.mesh.spacing)
+    if res.ok:
+        note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
+        res.reason = f"{res.reason}; {note}" if res.reason else note
+    return res
+
+
+#: the convergence study (``python -m sweep.tip_following``): a viscoelastic scene unloaded
+#: from a0 = 1.2 (n = 0.8, k = 0.5, rate 1), fine spacing l0/band_resolution, window
+#: (ahead, behind) in l0
+STUDY_SCENE = dict(n=0.8, k=0.5, a0=1.2, rate=1.0)
+STUDY_RESOLUTIONS = (8.0, 16.0, 24.0)
+STUDY_WINDOWS = ((16.0, 8.0), (8.0, 4.0), (32.0, 16.0))
+
+
+def convergence_study(mu: float, resolutions=STUDY_RESOLUTIONS, windows=STUDY_WINDOWS,
+                      preset: str = "balanced", **scene) -> list[dict]:
+    """Pull-off of one scene against the fine spacing (at the first window) and the window
+    (at the middle resolution). Rows: band_resolution, ahead, behind, status, pull_off,
+    nodes, meshes (from the reason), steps, seconds."""
+    sc = Scene(mu=mu, **{**STUDY_SCENE, **scene})
+    grid = [(res, *windows[0]) for res in resolutions]
+    mid = resolutions[len(resolutions) // 2]
+    grid += [(mid, *w) for w in windows[1:]]
+    rows = []
+    for res_, ahead, behind in grid:
+        num = Numerics.preset(preset, band_resolution=res_, pull_off_rtol=0.0,
+                              time_budget_s=0.0)
+        r = simulate_tip_following(sc, num, ahead, behind)
+        meshes = int(r.reason.split(" meshes")[0].split()[-1]) if "meshes" in r.reason else 0
+        rows.append(dict(mu=mu, band_resolution=res_, ahead=ahead, behind=behind,
+                         status=r.status, pull_off=r.pull_off, nodes=r.nodes_used,
+                         meshes=meshes, steps=r.steps, seconds=r.wall_s))
+    return rows
+
+
+def _main(argv=None) -> None:
+    import argparse
+
+    p = argparse.ArgumentParser(prog="python -m sweep.tip_following",
+                                description="convergence of the tip-following BEM")
+    p.add_argument("--mu", type=float, nargs="+", default=[30.0, 100.0])
+    p.add_argument("--resolutions", type=float, nargs="+", default=list(STUDY_RESOLUTIONS))
+    args = p.parse_args(argv)
+    print(f"scene {STUDY_SCENE}, preset balanced; windows (ahead, behind) in l0")
+    print(f"{'mu':>5} {'res':>4} {'ahead':>5} {'behind':>6} {'status':>6} {'pull_off':>9} "
+          f"{'nodes':>5} {'meshes':>6} {'steps':>6} {'s':>6}")
+    for mu in args.mu:
+        for r in convergence_study(mu, tuple(args.resolutions)):
+            print(f"{r['mu']:5g} {r['band_resolution']:4g} {r['ahead']:5g} {r['behind']:6g} "
+                  f"{r['status']:>6} {r['pull_off']:9.5f} {r['nodes']:5d} {r['meshes']:6d} "
+                  f"{r['steps']:6d} {r['seconds']:6.1f}", flush=True)
+
+
+if __name__ == "__main__":
+    _main()

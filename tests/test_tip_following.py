@@ -1,0 +1,80 @@
+"""The BEM on a mesh refined around the crack tip that follows it (sweep.tip_following).
+
+Independent checks: the same scene on the fixed-band graded mesh (sweep.solver.simulate),
+where both run; the elastic quasi-static branch (sweep.quasistatic) for k = 1 at high mu;
+the state transfer between meshes against its exact values (common nodes, a cubic).
+"""
+import numpy as np
+import pytest
+
+from sweep import Numerics, Scene, simulate
+from sweep import models
+from sweep import quasistatic as qs
+from sweep import tip_following as tf
+from sweep.solver import UnloadingState
+
+
+def test_window_leaves_room_in_the_direction_of_motion():
+    lo, hi = tf.tip_window(1.0, 0.01, ahead=16, behind=8, direction=-1)
+    assert lo == pytest.approx(0.84) and hi == pytest.approx(1.08)
+    lo, hi = tf.tip_window(1.0, 0.01, ahead=16, behind=8, direction=1)
+    assert lo == pytest.approx(0.92) and hi == pytest.approx(1.16)
+    assert tf.tip_window(0.05, 0.01)[0] == 0.0
+
+
+def test_transfer_keeps_common_nodes_and_interpolates_a_cubic_exactly():
+    from sweep.mesh import graded_mesh
+    old = graded_mesh(3.0, (1.0, 1.1), 1e-3, 1.1)
+    new = graded_mesh(3.0, (0.95, 1.05), 1e-3, 1.1)
+    r = old.r
+    cubic = lambda x: 0.3 + 0.5 * x**2 - 0.1 * x**3            # noqa: E731
+    run = UnloadingState(h=cubic(r) + 0.0, delta0=0.0, q=np.vstack([np.sin(r), cubic(r)]),
+                         records=[], n=0, step=np.zeros(1), cache=None, stats=None)
+    h_old, q_old = run.h.copy(), run.q.copy()
+    tf.transfer(run, old.r, new.r)
+    assert run.h.shape == (new.nodes,) and run.q.shape == (2, new.nodes)
+    assert run.cache[0].shape == (new.nodes, new.nodes)
+    common, i_old, i_new = np.intersect1d(old.lattice, new.lattice, return_indices=True)
+    assert common.size > 50
+    assert np.array_equal(run.h[i_new], h_old[i_old])
+    assert np.array_equal(run.q[:, i_new], q_old[:, i_old])
+    assert np.allclose(run.h, cubic(new.r), atol=1e-12)
+    assert np.allclose(run.q[1], cubic(new.r), atol=1e-12)
+
+
+def test_tip_following_matches_the_fixed_band_where_both_run():
+    """mu = 4, a0 = 2.5: the tip recedes by about 25 process zones, so a window of 6 l0
+    ahead is rebuilt several times; the pull-off equals the fixed band's to 1e-3."""
+    scene = Scene(n=0.8, k=0.2, mu=4.0, a0=2.5, rate=10.0)
+    num = Numerics.preset("fast", pull_off_rtol=0.0)
+    fixed = simulate(scene, num)
+    moving = tf.simulate_tip_following(scene, num, ahead=6.0, behind=4.0)
+    assert fixed.ok and moving.ok, (fixed.reason, moving.reason)
+    meshes = int(moving.reason.split(" meshes")[0].split()[-1])
+    assert meshes >= 3
+    assert moving.nodes_used < fixed.nodes_used
+    assert moving.pull_off == pytest.approx(fixed.pull_off, rel=1e-3)
+    assert moving.a_pulloff == pytest.approx(fixed.a_pulloff, abs=2 * fixed.spacing)
+
+
+def test_large_mu_bem_scenes_route_to_the_tip_following_mesh():
+    num = Numerics.preset("balanced")
+    assert models.wants_tip_following(Scene(n=0.8, k=0.5, mu=30.0, a0=1.5, rate=1.0), num)
+    assert models.wants_tip_following(Scene(n=0.8, k=0.5, mu=100.0, a0=15.0, rate=1.0), num)
+    assert not models.wants_tip_following(Scene(n=0.8, k=0.5, mu=3.24, a0=1.5, rate=1.0), num)
+    # an explicit node count or the uniform mesh asks for the fixed mesh
+    assert not models.wants_tip_following(Scene(n=0.8, k=0.5, mu=30.0, a0=1.5, rate=1.0),
+                                          Numerics.preset("balanced", nodes=800))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("mu", [30.0, 100.0])
+def test_elastic_limit_at_high_mu(mu):
+    """k = 1 through the hereditary kernel on the tip-following mesh: the elastic
+    quasi-static pull-off from the same a0 (an independent solver and mesh) to 1 %."""
+    scene = Scene(n=0.8, k=1.0, mu=mu, a0=1.2, rate=1.0)
+    res = tf.simulate_tip_following(scene, Numerics.preset("balanced", band_resolution=8.0,
+                                                           pull_off_rtol=0.0))
+    ref = qs.elastic_pull_off(mu, a_start=1.2)
+    assert res.ok, res.reason
+    assert res.pull_off == pytest.approx(ref.pull_off, rel=0.01)
