@@ -7,8 +7,9 @@ Two kinds (``Numerics.mesh``), nodes in a_ref units with r_0 = 0:
   crack tip sweeps while unloading (from a little outside the initial contact radius a0
   down to below the pull-off radius), spacings growing geometrically by ``grading`` from
   the band inward to r = 0 (deep inside the compressed contact) and outward to the domain
-  edge (the far Lennard-Jones tail). The fine spacing is the process zone
-  l0 = 1.693/mu^2 divided by ``band_resolution``, or the one that gives exactly ``nodes``
+  edge (the far Lennard-Jones tail). The fine spacing is the tip zone (the process zone
+  l0 = 1.693/mu^2, or sqrt(h0) on the DMT side: :func:`sweep.problem.tip_zone`) divided
+  by ``band_resolution``, or the one that gives exactly ``nodes``
   nodes when a node count is requested.
 
 The influence matrix of a mesh is assembled once per process (:func:`influence`); a

@@ -139,12 +139,12 @@ def bem_nodes_needed(scene, numerics=None) -> int:
     import dataclasses
 
     from .mesh import scene_mesh
-    from .problem import initial_estimates
+    from .problem import initial_estimates, tip_zone
     from .scene import Numerics
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     _, a_est, domain = initial_estimates(scene, numerics)
-    l0 = units.l0_hat(scene.mu)
+    l0 = tip_zone(scene.mu)
     if numerics.mesh == "uniform":
         return int(math.ceil(domain * numerics.zone_nodes / l0)) + 1
     mesh = scene_mesh(dataclasses.replace(numerics, nodes=None), l0, a_est, domain,

@@ -76,7 +76,8 @@ class Scene:
     k : float
         Ratio of relaxed to glassy modulus E0/Einf, in (0, 1]; ``k = 1`` is elastic.
     mu : float
-        Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.5, 20].
+        Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.01, 100] (the BEM above about
+        8 on a mesh that follows the crack tip, :mod:`sweep.tip_following`).
     rate : float
         Dimensionless unloading rate r-hat = r tau0 / h0, in (0, 1e12].
     a0 : float, optional
@@ -101,8 +102,8 @@ class Scene:
                     lo_open=True, label="$n$", order=2, cli_default=0.8)
     k: float = axis(0.1, help="E0/Einf, relaxed over glassy modulus; 1 is elastic",
                     limits=(0.0, 1.0), lo_open=True, label="$k$", order=3)
-    mu: float = axis(3.24, help="Tabor parameter (the hereditary BEM takes 0.5-20; elastic "
-                     "scenes, k = 1, the whole range)", limits=(0.01, 100.0), label=r"$\mu$",
+    mu: float = axis(3.24, help="Tabor parameter (the BEM on a tip-following mesh where "
+                     "its fixed crack band exceeds max_nodes; elastic scenes the quasi-static branch)", limits=(0.01, 100.0), label=r"$\mu$",
                      order=4)
     rate: float = axis(help="unloading rate r-hat = r tau0 / h0", limits=(0.0, 1e12),
                        lo_open=True, label=r"unloading rate $\hat r = r\tau_0/h_0$", order=7,

@@ -38,7 +38,7 @@ from kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP
 
 from . import units
 from .initial import ElasticSolver, relaxed_state
-from .problem import Refused, initial_estimates, prepare
+from .problem import Refused, initial_estimates, prepare, tip_zone
 from .scene import Numerics, Result, Scene
 
 #: room for the tip in its direction of motion, in process zones l0 (the tip moves this far,
@@ -153,7 +153,7 @@ def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
     deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
     res = _attempt(scene, numerics, ahead, behind, deadline)
     if res.ok and numerics.pull_off_rtol > 0:
-        res.error_estimate = resolution_error(res.spacing, units.l0_hat(scene.mu))
+        res.error_estimate = resolution_error(res.spacing, tip_zone(scene.mu))
         if res.error_estimate > CHECK_FRACTION * numerics.pull_off_rtol:
             _check_resolution(res, _attempt(scene, coarser(numerics), ahead, behind, deadline))
     res.wall_s = time.perf_counter() - t_start
@@ -167,7 +167,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     if numerics.mesh != "graded" or numerics.exact:
         numerics = dataclasses.replace(numerics, mesh="graded", exact=False)
     res = Result(scene=scene, numerics=numerics)
-    l0 = units.l0_hat(scene.mu)
+    l0 = tip_zone(scene.mu)
     _, a_est, _ = initial_estimates(scene, numerics)
     try:
         # the initial state: where the relaxed tip lies outside the first window (delta0
