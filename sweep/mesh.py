@@ -177,8 +177,9 @@ UNIT_BLOCK = 256
 #: a graded mesh whose lattice is wider than this many fine spacings (a fine band at large
 #: mu: 2.4e5 at mu = 100) has its influence matrix assembled on its own nodes
 #: (kernels.influence.assemble_nodes, about 1 s for 700 nodes) rather than combined from
-#: the unit-spacing matrix of the whole lattice (width^2 entries)
-LATTICE_MAX_WIDTH = 6000
+#: the unit-spacing matrix of the whole lattice, whose assembly costs about 3.5 us per entry
+#: once per process (15 s at 2048, 2 min at 6000)
+LATTICE_MAX_WIDTH = 2048
 _UNIT = [np.zeros((0, 0))]
 _MESH_CACHE: dict = {}
 _MESH_CACHE_SIZE = 32

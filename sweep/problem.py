@@ -24,6 +24,11 @@ from .theory import jkr_contact_radius
 WINDOW_SAFETY = 10.0
 #: ... widened outward to multiples of this many decades (shared by the scenes of a sweep)
 WINDOW_GRID = 0.5
+#: ... and never beyond this time (tau0): both materials have relaxed by then (MPL: the
+#: retardation times are Gamma(n)-distributed, Chat - 1 ~ exp(-2 sqrt(t)) < 1e-80 for
+#: n <= 5; SLS: exp(-t)), while a fit over more decades costs seconds (13 s for
+#: n = 0.2, k = 1e-4 up to 3e7 at rate 1e-4)
+WINDOW_T_MAX = 1e4
 #: the crack tip stays this many process zones inside the fine band of a graded mesh
 TIP_MARGIN_ZONES = 2.0
 #: max-tension gap over h0: the crack tip (contact radius a) is where the gap is 3^(1/6) h0
@@ -96,7 +101,7 @@ def time_window(scene: Scene, numerics: Numerics, delta0: float) -> tuple[float,
     h0 = units.h0_hat(scene.mu)
     t_min = numerics.min_step / scene.rate        # the smallest step the run may take
     travel = max(delta0, 0.0) + 3.0 + 2.0 * math.sqrt(max(delta0, 1.0))
-    t_max = max(WINDOW_SAFETY * travel / (scene.rate * h0), 10 * t_min)
+    t_max = max(min(WINDOW_SAFETY * travel / (scene.rate * h0), WINDOW_T_MAX), 10 * t_min)
     lo = math.floor(math.log10(t_min) / WINDOW_GRID) * WINDOW_GRID
     hi = math.ceil(math.log10(t_max) / WINDOW_GRID) * WINDOW_GRID
     return 10.0 ** lo, 10.0 ** hi

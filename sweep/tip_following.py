@@ -50,6 +50,14 @@ WINDOW_BEHIND_ZONES = 8.0
 MAX_MESHES = 5000
 
 
+def steps_needed(a0: float, spacing: float, da_max: float) -> int:
+    """Fewest time steps a run from the contact radius ``a0`` can take (the tip moves at
+    most ``da_max`` fine spacings per step): the tip recedes at least to max(0.6 a0, 1.2)
+    (pull-off radii: 0.42-0.53 a0 on the reference scenes, 1.04 in the elastic JKR limit)."""
+    travel = max(a0 - max(0.6 * a0, 1.2), 0.0)
+    return int(math.ceil(travel / (da_max * spacing)))
+
+
 def tip_window(tip: float, l0: float, ahead: float = WINDOW_AHEAD_ZONES,
                behind: float = WINDOW_BEHIND_ZONES, direction: int = -1) -> tuple[float, float]:
     """The fine window (a_ref radii) for a crack tip at ``tip`` moving inward
@@ -75,53 +83,76 @@ def transfer(run, old_r: np.ndarray, new_r: np.ndarray) -> None:
     run.cache = new_jacobian_cache(new_r.size)
 
 
-def initial_state(el: ElasticSolver, scene: Scene):
-    """The relaxed state (gap, indentation) of a scene on the window mesh of ``el``.
+def branch_state(scene: Scene):
+    """The relaxed elastic equilibrium at contact radius ``scene.a0`` on the quasi-static
+    branch (:class:`sweep.quasistatic.ElasticBranch`, which fixes the radius, not the
+    indentation): (nodes r, gap h, indentation delta), or None if it was not found.
 
-    From a0: the elastic equilibrium at contact radius a0 on the quasi-static branch
-    (:class:`sweep.quasistatic.ElasticBranch`, which fixes the radius, not the indentation),
-    carried to the mesh and polished by Newton at its indentation, then a secant on the
-    indentation to the radius a0 on this mesh (warm-started solves; the tip stays in the
-    fine window), to a0 or, where the tip is pinned between nodes, within one fine
-    spacing (``Result.a0_result`` says where). A direct Newton solve from the JKR gap, as
-    :func:`sweep.initial.relaxed_state` does, can converge to a state whose tip sits on the
-    coarse mesh outside the window at large mu. From delta0, and where the above fails:
-    :func:`sweep.initial.relaxed_state`.
+    Raises :class:`sweep.problem.Refused` where a0 lies below the displacement-controlled
+    fold of the branch (JKR: a = 0.5): the state exists but is unstable (the indentation
+    decreases as the radius grows), so no relaxed state can be held there.
     """
     from .quasistatic import ElasticBranch
 
-    if scene.a0 is not None:
+    a0 = scene.a0
+    br = ElasticBranch(scene.mu, a0, 0.5 * a0)
+    h_b, d_b = br.guess(a0)
+    h_b, d, ok = br.solve(a0, h_b, d_b)
+    if not ok:      # small a0: along the branch from a radius where the guess is good
+        h_b, d = br.guess(max(1.2, 2.0 * a0))
+        for a in np.geomspace(max(1.2, 2.0 * a0), a0, 16):
+            h_b, d, ok = br.solve(a, h_b, d)
+            if not ok:
+                return None
+    _, d_up, ok_up = br.solve(1.001 * a0, h_b, d)
+    if ok_up and d_up < d:
+        raise Refused(f"a0 = {a0:g} lies below the fold of the relaxed elastic branch at mu = "
+                      f"{scene.mu:g} (the indentation decreases as the radius grows): no "
+                      f"stable relaxed state there; give a larger a0 (JKR: a0 > 0.5) or delta0")
+    return a0 * br.x, h_b, d
+
+
+def initial_state(el: ElasticSolver, scene: Scene, branch=None):
+    """The relaxed state (gap, indentation) of a scene on the window mesh of ``el``.
+
+    From a0: the equilibrium at contact radius a0 on the quasi-static branch (``branch``,
+    :func:`branch_state`), carried to the mesh and polished by Newton at its indentation,
+    then a secant on the indentation to the radius a0 on this mesh (warm-started solves;
+    the tip stays in the fine window), to a0 or, where the tip is pinned between nodes,
+    within one fine spacing (``Result.a0_result`` says where). A direct Newton solve from
+    the JKR gap, as :func:`sweep.initial.relaxed_state` does, can converge to a state whose
+    tip sits on the coarse mesh outside the window at large mu. From delta0, and where the
+    above fails: :func:`sweep.initial.relaxed_state`.
+    """
+    if branch is not None:
         a0 = scene.a0
-        br = ElasticBranch(scene.mu, a0, 0.5 * a0)
-        h_b, d_b = br.guess(a0)
-        h_b, d, ok = br.solve(a0, h_b, d_b)
-        if ok:
-            guess = np.maximum(CubicSpline(a0 * br.x, h_b)(el.r), 0.3 * el.h0)
-            ok, h = el.solve(d, guess)
-            f = el.radius(h) - a0 if ok else math.nan
-            best = (abs(f), h, d) if ok else None
-            slope = 2.0 * a0 - 1.0 / math.sqrt(2.0 * a0)     # JKR d delta / d a
-            d_prev, f_prev = d, f
-            for _ in range(20):
-                if not ok or abs(f) <= 1e-10 * a0:
-                    break
-                secant = (d - d_prev) / (f - f_prev) if f != f_prev else 0.0
-                # the secant where a(delta) moves; the JKR slope where the tip is pinned
-                d_new = d - f * (secant if 0.2 * slope < secant < 5.0 * slope else slope)
-                ok, h_new = el.solve(d_new, np.maximum(h - (d_new - d), 0.3 * h))
-                if not ok:
-                    break
-                d_prev, f_prev, d, h = d, f, d_new, h_new
-                f = el.radius(h) - a0
-                if abs(f) < best[0]:
-                    best = (abs(f), h, d)
-                if abs(f - f_prev) < 1e-2 * abs(f):     # pinned: a(delta) does not move
-                    break
-            # a tip pinned between nodes (lattice trapping) cannot reach a0 exactly: within
-            # a spacing
-            spacing = float(np.min(np.diff(el.r)))
-            if best is not None and best[0] <= spacing:
-                return best[1], float(best[2])
+        r_b, h_b, d = branch
+        guess = np.maximum(CubicSpline(r_b, h_b)(el.r), 0.3 * el.h0)
+        ok, h = el.solve(d, guess)
+        f = el.radius(h) - a0 if ok else math.nan
+        best = (abs(f), h, d) if ok else None
+        slope = 2.0 * a0 - 1.0 / math.sqrt(2.0 * a0)     # JKR d delta / d a
+        d_prev, f_prev = d, f
+        for _ in range(20):
+            if not ok or abs(f) <= 1e-10 * a0:
+                break
+            secant = (d - d_prev) / (f - f_prev) if f != f_prev else 0.0
+            # the secant where a(delta) moves; the JKR slope where the tip is pinned
+            d_new = d - f * (secant if 0.2 * slope < secant < 5.0 * slope else slope)
+            ok, h_new = el.solve(d_new, np.maximum(h - (d_new - d), 0.3 * h))
+            if not ok:
+                break
+            d_prev, f_prev, d, h = d, f, d_new, h_new
+            f = el.radius(h) - a0
+            if abs(f) < best[0]:
+                best = (abs(f), h, d)
+            if abs(f - f_prev) < 1e-2 * abs(f):     # pinned: a(delta) does not move
+                break
+        # a tip pinned between nodes (lattice trapping) cannot reach a0 exactly: within
+        # a spacing
+        spacing = float(np.min(np.diff(el.r)))
+        if best is not None and best[0] <= spacing:
+            return best[1], float(best[2])
     return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
 
 
@@ -169,13 +200,22 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     res = Result(scene=scene, numerics=numerics)
     l0 = tip_zone(scene.mu)
     _, a_est, _ = initial_estimates(scene, numerics)
+    spacing = l0 / numerics.band_resolution
+    need = steps_needed(a_est, spacing, numerics.da_max)
+    if need > numerics.max_steps:
+        res.reason = (f"too many steps: the crack tip recedes at least {a_est - max(0.6 * a_est, 1.2):.3g}"
+                      f" a_ref at most da_max = {numerics.da_max:g} fine spacings ({spacing:.2g}) "
+                      f"per step, > {need} steps (max_steps = {numerics.max_steps}); raise "
+                      f"max_steps, or lower band_resolution, or use the crack-front model")
+        return res
     try:
+        branch = branch_state(scene) if scene.a0 is not None else None
         # the initial state: where the relaxed tip lies outside the first window (delta0
         # scenes, whose radius is a JKR estimate), once more with the window there
         for _ in range(2):
             pb = prepare(scene, numerics, tip_window(a_est, l0, ahead, behind))
             el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, numerics.tol)
-            h_init, delta0 = initial_state(el, scene)
+            h_init, delta0 = initial_state(el, scene, branch)
             a_init = el.radius(h_init)
             lo, hi = pb.tip_range
             if lo <= a_init <= hi or a_init <= 0.0:
@@ -257,7 +297,7 @@ def convergence_study(mu: float, resolutions=STUDY_RESOLUTIONS, windows=STUDY_WI
     rows = []
     for res_, ahead, behind in grid:
         num = Numerics.preset(preset, band_resolution=res_, pull_off_rtol=0.0,
-                              time_budget_s=0.0)
+                              time_budget_s=1800.0)
         r = simulate_tip_following(sc, num, ahead, behind)
         meshes = int(r.reason.split(" meshes")[0].split()[-1]) if "meshes" in r.reason else 0
         rows.append(dict(mu=mu, band_resolution=res_, ahead=ahead, behind=behind,
