@@ -83,10 +83,12 @@ def transfer(run, old_r: np.ndarray, new_r: np.ndarray) -> None:
     run.cache = new_jacobian_cache(new_r.size)
 
 
-def branch_state(scene: Scene):
+def branch_state(scene: Scene, band_resolution: float = 16.0):
     """The relaxed elastic equilibrium at contact radius ``scene.a0`` on the quasi-static
     branch (:class:`sweep.quasistatic.ElasticBranch`, which fixes the radius, not the
-    indentation): (nodes r, gap h, indentation delta), or None if it was not found.
+    indentation), on a mesh as fine as the window's (``band_resolution`` spacings per
+    process zone, 8 zones each side): (nodes r, gap h, indentation delta), or None if it
+    was not found.
 
     Raises :class:`sweep.problem.Refused` where a0 lies below the displacement-controlled
     fold of the branch (JKR: a = 0.5): the state exists but is unstable (the indentation
@@ -95,7 +97,7 @@ def branch_state(scene: Scene):
     from .quasistatic import ElasticBranch
 
     a0 = scene.a0
-    br = ElasticBranch(scene.mu, a0, 0.5 * a0)
+    br = ElasticBranch(scene.mu, a0, 0.5 * a0, zone_resolution=band_resolution, zone=8.0)
     h_b, d_b = br.guess(a0)
     h_b, d, ok = br.solve(a0, h_b, d_b)
     if not ok:      # small a0: along the branch from a radius where the guess is good
@@ -117,42 +119,72 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
 
     From a0: the equilibrium at contact radius a0 on the quasi-static branch (``branch``,
     :func:`branch_state`), carried to the mesh and polished by Newton at its indentation,
-    then a secant on the indentation to the radius a0 on this mesh (warm-started solves;
-    the tip stays in the fine window), to a0 or, where the tip is pinned between nodes,
-    within one fine spacing (``Result.a0_result`` says where). A direct Newton solve from
-    the JKR gap, as :func:`sweep.initial.relaxed_state` does, can converge to a state whose
-    tip sits on the coarse mesh outside the window at large mu. From delta0, and where the
-    above fails: :func:`sweep.initial.relaxed_state`.
+    then bracketed and bisected on the indentation to the radius a0 on this mesh
+    (warm-started solves; the tip stays in the fine window): to a0 or, where the tip is
+    pinned between nodes (a(delta) a staircase), within two fine spacings
+    (``Result.a0_result`` says where), else RuntimeError with the reason. A direct Newton
+    solve from the JKR gap, as :func:`sweep.initial.relaxed_state` does, can converge to a
+    state whose tip sits on the coarse mesh outside the window at large mu, and its
+    continuation costs a dense factorization per solve. From delta0:
+    :func:`sweep.initial.relaxed_state`.
     """
     if branch is not None:
         a0 = scene.a0
         r_b, h_b, d = branch
-        guess = np.maximum(CubicSpline(r_b, h_b)(el.r), 0.3 * el.h0)
-        ok, h = el.solve(d, guess)
-        f = el.radius(h) - a0 if ok else math.nan
-        best = (abs(f), h, d) if ok else None
-        slope = 2.0 * a0 - 1.0 / math.sqrt(2.0 * a0)     # JKR d delta / d a
-        d_prev, f_prev = d, f
-        for _ in range(20):
-            if not ok or abs(f) <= 1e-10 * a0:
-                break
-            secant = (d - d_prev) / (f - f_prev) if f != f_prev else 0.0
-            # the secant where a(delta) moves; the JKR slope where the tip is pinned
-            d_new = d - f * (secant if 0.2 * slope < secant < 5.0 * slope else slope)
-            ok, h_new = el.solve(d_new, np.maximum(h - (d_new - d), 0.3 * h))
-            if not ok:
-                break
-            d_prev, f_prev, d, h = d, f, d_new, h_new
-            f = el.radius(h) - a0
-            if abs(f) < best[0]:
-                best = (abs(f), h, d)
-            if abs(f - f_prev) < 1e-2 * abs(f):     # pinned: a(delta) does not move
-                break
-        # a tip pinned between nodes (lattice trapping) cannot reach a0 exactly: within
-        # a spacing
+        ok, h = el.solve(d, np.maximum(CubicSpline(r_b, h_b)(el.r), 0.3 * el.h0))
+        if not ok:
+            raise RuntimeError(f"no equilibrium on the window mesh at the branch state of "
+                               f"a0 = {a0:g}")
         spacing = float(np.min(np.diff(el.r)))
-        if best is not None and best[0] <= spacing:
+        best = [abs(el.radius(h) - a0), h, d]
+
+        def radius_at(d_new, h_from, d_from):
+            ok, h_new = el.solve(d_new, np.maximum(h_from - (d_new - d_from), 0.3 * h_from))
+            if not ok:
+                return None, None
+            f_new = el.radius(h_new) - a0
+            if abs(f_new) < best[0]:
+                best[:] = [abs(f_new), h_new, d_new]
+            return f_new, h_new
+
+        # bracket a0 in delta (the radius grows with the indentation on the stable branch),
+        # then bisect: the tip may be pinned between nodes (lattice trapping), so a(delta)
+        # is a staircase and a0 is reached to within the step it jumps over
+        f = el.radius(h) - a0
+        slope = 2.0 * a0 - 1.0 / math.sqrt(2.0 * a0)     # JKR d delta / d a
+        step = -math.copysign(min(max(2.0 * abs(f) * slope, 1e-3 * el.h0), 0.2 * el.h0), f)
+        lo = hi = None
+        d_far, h_far = d, h
+        for _ in range(60):
+            if f == 0.0:
+                return h, float(d)
+            d_new = d_far + step
+            f_new, h_new = radius_at(d_new, h_far, d_far)
+            if f_new is None:           # Newton failed: a smaller step
+                step *= 0.5
+                continue
+            if (f_new > 0) != (f > 0):
+                lo, hi = sorted([(d_far, h_far), (d_new, h_new)], key=lambda x: x[0])
+                break
+            d_far, h_far, f = d_new, h_new, f_new
+            step = math.copysign(min(2.0 * abs(step), 0.2 * el.h0), step)
+        if lo is None:
+            raise RuntimeError(f"could not bracket the indentation of a0 = {a0:g}")
+        for _ in range(60):
+            if best[0] <= 1e-10 * a0 or hi[0] - lo[0] <= 1e-14 * max(1.0, abs(d)):
+                break
+            d_mid = 0.5 * (lo[0] + hi[0])
+            f_mid, h_mid = radius_at(d_mid, lo[1], lo[0])
+            if f_mid is None:
+                break
+            if f_mid > 0:
+                hi = (d_mid, h_mid)
+            else:
+                lo = (d_mid, h_mid)
+        if best[0] <= 2.0 * spacing:
             return best[1], float(best[2])
+        raise RuntimeError(f"the tip jumps over a0 = {a0:g} by more than two fine spacings "
+                           f"(closest {best[0]:.3g} a_ref away): refine the mesh")
     return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
 
 
@@ -209,7 +241,8 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                       f"max_steps, or lower band_resolution, or use the crack-front model")
         return res
     try:
-        branch = branch_state(scene) if scene.a0 is not None else None
+        branch = (branch_state(scene, numerics.band_resolution) if scene.a0 is not None
+                  else None)
         # the initial state: where the relaxed tip lies outside the first window (delta0
         # scenes, whose radius is a JKR estimate), once more with the window there
         for _ in range(2):
@@ -286,10 +319,10 @@ STUDY_WINDOWS = ((16.0, 8.0), (8.0, 4.0), (32.0, 16.0))
 
 
 def convergence_study(mu: float, resolutions=STUDY_RESOLUTIONS, windows=STUDY_WINDOWS,
-                      preset: str = "balanced", **scene) -> list[dict]:
+                      preset: str = "balanced", on_row=None, **scene) -> list[dict]:
     """Pull-off of one scene against the fine spacing (at the first window) and the window
     (at the middle resolution). Rows: band_resolution, ahead, behind, status, pull_off,
-    nodes, meshes (from the reason), steps, seconds."""
+    nodes, meshes (from the reason), steps, seconds; ``on_row(row)`` as each is done."""
     sc = Scene(mu=mu, **{**STUDY_SCENE, **scene})
     grid = [(res, *windows[0]) for res in resolutions]
     mid = resolutions[len(resolutions) // 2]
@@ -303,6 +336,8 @@ def convergence_study(mu: float, resolutions=STUDY_RESOLUTIONS, windows=STUDY_WI
         rows.append(dict(mu=mu, band_resolution=res_, ahead=ahead, behind=behind,
                          status=r.status, pull_off=r.pull_off, nodes=r.nodes_used,
                          meshes=meshes, steps=r.steps, seconds=r.wall_s))
+        if on_row is not None:
+            on_row(rows[-1])
     return rows
 
 
@@ -317,11 +352,14 @@ def _main(argv=None) -> None:
     print(f"scene {STUDY_SCENE}, preset balanced; windows (ahead, behind) in l0")
     print(f"{'mu':>5} {'res':>4} {'ahead':>5} {'behind':>6} {'status':>6} {'pull_off':>9} "
           f"{'nodes':>5} {'meshes':>6} {'steps':>6} {'s':>6}")
+
+    def show(r):
+        print(f"{r['mu']:5g} {r['band_resolution']:4g} {r['ahead']:5g} {r['behind']:6g} "
+              f"{r['status']:>6} {r['pull_off']:9.5f} {r['nodes']:5d} {r['meshes']:6d} "
+              f"{r['steps']:6d} {r['seconds']:6.1f}", flush=True)
+
     for mu in args.mu:
-        for r in convergence_study(mu, tuple(args.resolutions)):
-            print(f"{r['mu']:5g} {r['band_resolution']:4g} {r['ahead']:5g} {r['behind']:6g} "
-                  f"{r['status']:>6} {r['pull_off']:9.5f} {r['nodes']:5d} {r['meshes']:6d} "
-                  f"{r['steps']:6d} {r['seconds']:6.1f}", flush=True)
+        convergence_study(mu, tuple(args.resolutions), on_row=show)
 
 
 if __name__ == "__main__":
