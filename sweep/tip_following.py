@@ -46,6 +46,8 @@ from .scene import Numerics, Result, Scene
 WINDOW_AHEAD_ZONES = 16.0
 #: fine region behind the tip (the cohesive zone, a few l0, and the recent wake), l0
 WINDOW_BEHIND_ZONES = 8.0
+#: Newton tolerance (units of h0) of a first relaxed solve where the numerics' one stalls
+LOOSE_TOL = 1e-4
 #: most meshes of one run (a run that needs more ends failed with the reason)
 MAX_MESHES = 5000
 
@@ -83,12 +85,13 @@ def transfer(run, old_r: np.ndarray, new_r: np.ndarray) -> None:
     run.cache = new_jacobian_cache(new_r.size)
 
 
-def branch_state(scene: Scene, band_resolution: float = 16.0):
+def branch_state(scene: Scene, band_resolution: float = 16.0, domain: float | None = None):
     """The relaxed elastic equilibrium at contact radius ``scene.a0`` on the quasi-static
     branch (:class:`sweep.quasistatic.ElasticBranch`, which fixes the radius, not the
     indentation), on a mesh as fine as the window's (``band_resolution`` spacings per
-    process zone, 8 zones each side): (nodes r, gap h, indentation delta), or None if it
-    was not found.
+    process zone, 8 zones each side) out to ``domain`` (the window mesh's, so that the gap
+    is interpolated, never extrapolated): (nodes r, gap h, indentation delta), or None if
+    it was not found.
 
     Raises :class:`sweep.problem.Refused` where a0 lies below the displacement-controlled
     fold of the branch (JKR: a = 0.5): the state exists but is unstable (the indentation
@@ -97,7 +100,8 @@ def branch_state(scene: Scene, band_resolution: float = 16.0):
     from .quasistatic import ElasticBranch
 
     a0 = scene.a0
-    br = ElasticBranch(scene.mu, a0, 0.5 * a0, zone_resolution=band_resolution, zone=8.0)
+    br = ElasticBranch(scene.mu, a0, 0.5 * a0, zone_resolution=band_resolution, zone=8.0,
+                       domain=domain)
     h_b, d_b = br.guess(a0)
     h_b, d, ok = br.solve(a0, h_b, d_b)
     if not ok:      # small a0: along the branch from a radius where the guess is good
@@ -128,10 +132,23 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
     continuation costs a dense factorization per solve. From delta0:
     :func:`sweep.initial.relaxed_state`.
     """
+    def solve(d_new, guess):
+        # Newton to the numerics' tolerance; where it stalls (large mu: the LJ stiffness
+        # c/h0 makes the Jacobian ill-conditioned), first to 1e-4 h0, then on from there
+        ok, h_new = el.solve(d_new, guess)
+        if not ok:
+            tol, el.tol = el.tol, max(el.tol, LOOSE_TOL)
+            ok, h_new = el.solve(d_new, guess)
+            el.tol = tol
+            if ok:
+                ok_fine, h_fine = el.solve(d_new, h_new)
+                h_new = h_fine if ok_fine else h_new
+        return ok, h_new
+
     if branch is not None:
         a0 = scene.a0
         r_b, h_b, d = branch
-        ok, h = el.solve(d, np.maximum(CubicSpline(r_b, h_b)(el.r), 0.3 * el.h0))
+        ok, h = solve(d, np.maximum(CubicSpline(r_b, h_b)(el.r), 0.3 * el.h0))
         if not ok:
             raise RuntimeError(f"no equilibrium on the window mesh at the branch state of "
                                f"a0 = {a0:g}")
@@ -139,7 +156,7 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
         best = [abs(el.radius(h) - a0), h, d]
 
         def radius_at(d_new, h_from, d_from):
-            ok, h_new = el.solve(d_new, np.maximum(h_from - (d_new - d_from), 0.3 * h_from))
+            ok, h_new = solve(d_new, np.maximum(h_from - (d_new - d_from), 0.3 * h_from))
             if not ok:
                 return None, None
             f_new = el.radius(h_new) - a0
@@ -231,7 +248,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         numerics = dataclasses.replace(numerics, mesh="graded", exact=False)
     res = Result(scene=scene, numerics=numerics)
     l0 = tip_zone(scene.mu)
-    _, a_est, _ = initial_estimates(scene, numerics)
+    _, a_est, domain = initial_estimates(scene, numerics)
     spacing = l0 / numerics.band_resolution
     need = steps_needed(a_est, spacing, numerics.da_max)
     if need > numerics.max_steps:
@@ -241,7 +258,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                       f"max_steps, or lower band_resolution, or use the crack-front model")
         return res
     try:
-        branch = (branch_state(scene, numerics.band_resolution) if scene.a0 is not None
+        branch = (branch_state(scene, numerics.band_resolution, domain) if scene.a0 is not None
                   else None)
         # the initial state: where the relaxed tip lies outside the first window (delta0
         # scenes, whose radius is a JKR estimate), once more with the window there
