@@ -252,8 +252,9 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     spacing = l0 / numerics.band_resolution
     need = steps_needed(a_est, spacing, numerics.da_max)
     if need > numerics.max_steps:
-        res.reason = (f"too many steps: the crack tip recedes at least {a_est - max(0.6 * a_est, 1.2):.3g}"
-                      f" a_ref at most da_max = {numerics.da_max:g} fine spacings ({spacing:.2g}) "
+        travel = a_est - max(0.6 * a_est, 1.2)
+        res.reason = (f"too many steps: the crack tip recedes at least {travel:.3g} a_ref at most"
+                      f" da_max = {numerics.da_max:g} fine spacings ({spacing:.2g}) "
                       f"per step, > {need} steps (max_steps = {numerics.max_steps}); raise "
                       f"max_steps, or lower band_resolution, or use the crack-front model")
         return res
