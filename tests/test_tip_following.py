@@ -1,15 +1,17 @@
 """The BEM on a mesh refined around the crack tip that follows it (sweep.tip_following).
 
 Independent checks: the same scene on the fixed-band graded mesh (sweep.solver.simulate),
-where both run; the elastic quasi-static branch (sweep.quasistatic) for k = 1 at high mu;
-the state transfer between meshes against its exact values (common nodes, a cubic).
+where both run; the state transfer between meshes against its exact values (common nodes,
+a cubic). Not here: the elastic limit (k = 1 or a very slow rate) through the hereditary
+kernel at mu = 30 -- the tip snaps node to node about every other step (measured: 1939
+snaps in 3597 steps, 10 s per 500 steps at l0/8), which is why elastic scenes run on the
+quasi-static branch (tests/test_quasistatic.py).
 """
 import numpy as np
 import pytest
 
 from sweep import Numerics, Scene, simulate
 from sweep import models
-from sweep import quasistatic as qs
 from sweep import tip_following as tf
 from sweep.solver import UnloadingState
 
@@ -65,16 +67,3 @@ def test_large_mu_bem_scenes_route_to_the_tip_following_mesh():
     # an explicit node count or the uniform mesh asks for the fixed mesh
     assert not models.wants_tip_following(Scene(n=0.8, k=0.5, mu=30.0, a0=1.5, rate=1.0),
                                           Numerics.preset("balanced", nodes=800))
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("mu", [30.0, 100.0])
-def test_elastic_limit_at_high_mu(mu):
-    """k = 1 through the hereditary kernel on the tip-following mesh: the elastic
-    quasi-static pull-off from the same a0 (an independent solver and mesh) to 1 %."""
-    scene = Scene(n=0.8, k=1.0, mu=mu, a0=1.2, rate=1.0)
-    res = tf.simulate_tip_following(scene, Numerics.preset("balanced", band_resolution=8.0,
-                                                           pull_off_rtol=0.0))
-    ref = qs.elastic_pull_off(mu, a_start=1.2)
-    assert res.ok, res.reason
-    assert res.pull_off == pytest.approx(ref.pull_off, rel=0.01)
