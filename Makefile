@@ -11,7 +11,7 @@ export NUMBA_NUM_THREADS ?= 1
 
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
         tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms \
-        agreement agreement-high-mu
+        agreement agreement-high-mu extremes tip-convergence elastic-table
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
@@ -24,6 +24,9 @@ help:
 	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/)"
 	@echo "make agreement - BEM vs crack-front model vs PB estimate (results/agreement/)"
 	@echo "make agreement-high-mu - its mu = 15 point (about 35 min), merged by make agreement"
+	@echo "make extremes [QUICK=1] - stability at the extremes of (n, k, rate, a0, mu)"
+	@echo "make tip-convergence - tip-following BEM: pull-off vs spacing and window, mu = 30, 100"
+	@echo "make elastic-table - elastic pull-off vs mu (0.01 ... 100), quasi-static branch"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -70,6 +73,18 @@ bench-detail: $(STAMP)
 	$(BIN)/python -m sweep.benchmarks presets --out results/bench/presets.json
 	$(BIN)/python -m sweep.benchmarks scheduler --out results/bench/scheduler.json
 	$(BIN)/python -m sweep.benchmarks store --out results/bench/store.json
+
+# issue 10: the whole Tabor range. Stability at the extremes of (n, k, rate, a0, mu) (144
+# scenes; QUICK=1 the covering subset), the tip-following mesh's convergence at mu = 30 and
+# 100, the elastic pull-off against mu (quasi-static branch)
+extremes: $(STAMP)
+	$(BIN)/python -m sweep.extremes $(if $(filter 1,$(QUICK)),--quick)
+
+tip-convergence: $(STAMP)
+	$(BIN)/python -m sweep.tip_following --mu 30 100
+
+elastic-table: $(STAMP)
+	$(BIN)/python -m sweep.quasistatic
 
 bench-convergence: $(STAMP)
 	$(BIN)/python -m sweep.benchmarks convergence --mu 6 --out results/bench/convergence_mu6.json

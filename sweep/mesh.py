@@ -7,8 +7,9 @@ Two kinds (``Numerics.mesh``), nodes in a_ref units with r_0 = 0:
   crack tip sweeps while unloading (from a little outside the initial contact radius a0
   down to below the pull-off radius), spacings growing geometrically by ``grading`` from
   the band inward to r = 0 (deep inside the compressed contact) and outward to the domain
-  edge (the far Lennard-Jones tail). The fine spacing is the process zone
-  l0 = 1.693/mu^2 divided by ``band_resolution``, or the one that gives exactly ``nodes``
+  edge (the far Lennard-Jones tail). The fine spacing is the tip zone (the process zone
+  l0 = 1.693/mu^2, or sqrt(h0) on the DMT side: :func:`sweep.problem.tip_zone`) divided
+  by ``band_resolution``, or the one that gives exactly ``nodes``
   nodes when a node count is requested.
 
 The influence matrix of a mesh is assembled once per process (:func:`influence`); a
@@ -21,7 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kernels.influence import assemble_unit, combine_lattice_hats, load_weights_nodes
+from kernels.influence import (assemble_nodes, assemble_unit, combine_lattice_hats,
+                               load_weights_nodes)
 
 #: the crack band reaches this fraction of a0 inward (pull-off radii measured on the
 #: reference scenes are 0.42-0.53 a0; the elastic limit is 1.145 a_ref) ...
@@ -172,6 +174,12 @@ def crack_band(a0: float, l0: float, pull_off_only: bool = True) -> tuple[float,
 
 #: the cached unit-spacing matrix grows in multiples of this many nodes
 UNIT_BLOCK = 256
+#: a graded mesh whose lattice is wider than this many fine spacings (a fine band at large
+#: mu: 2.4e5 at mu = 100) has its influence matrix assembled on its own nodes
+#: (kernels.influence.assemble_nodes, about 1 s for 700 nodes) rather than combined from
+#: the unit-spacing matrix of the whole lattice, whose assembly costs about 3.5 us per entry
+#: once per process (15 s at 2048, 2 min at 6000)
+LATTICE_MAX_WIDTH = 2048
 _UNIT = [np.zeros((0, 0))]
 _MESH_CACHE: dict = {}
 _MESH_CACHE_SIZE = 32
@@ -198,6 +206,8 @@ def influence(mesh: Mesh) -> np.ndarray:
         idx = mesh.lattice
         if mesh.kind == "uniform":
             A1 = unit_influence(mesh.nodes)
+        elif 2 * idx[-1] - idx[-2] + 1 > LATTICE_MAX_WIDTH:
+            A1 = assemble_nodes(idx.astype(float))
         else:
             width = int(2 * idx[-1] - idx[-2]) + 1
             A1 = combine_lattice_hats(np.ascontiguousarray(unit_influence(width)[idx, :]),

@@ -4,8 +4,10 @@ r"""Models of one scene and the registry that maps a model name to its simulate 
 name     model
 =======  ======================================================================================
 bem      the boundary-element model (:func:`sweep.solver.simulate`): LJ interface, hereditary
-         integral; the reference, affordable while the process zone l0 = 1.693/mu^2 spans a
-         few nodes
+         integral; the reference. On a graded mesh whose fixed crack band would need more
+         than ``max_nodes`` nodes (mu above about 8, or large a0) it runs on a mesh refined
+         around the crack tip that follows it (:mod:`sweep.tip_following`,
+         :func:`wants_tip_following`)
 crack    the crack-front model (:func:`sweep.crack_front.simulate_crack`): JKR contact whose
          edge opens with the Persson-Brener Gamma(v) of the scene's spectrum
 pb       the paper's closed-form estimate (:func:`pb_estimate`): the crack speed at pull-off
@@ -31,7 +33,8 @@ from .errors import check_choice, check_positive
 from .theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 
 __all__ = ["MODELS", "pb_estimate", "simulate_pb", "simulate_model", "simulate_scene",
-           "choose_model", "bem_nodes_needed", "bem_node_budget", "wants_quasistatic"]
+           "choose_model", "bem_nodes_needed", "bem_node_budget", "wants_quasistatic",
+           "wants_tip_following"]
 
 
 def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171) -> dict:
@@ -95,9 +98,22 @@ def simulate_pb(scene, numerics=None):
 
 
 def _bem(scene, numerics=None):
+    from .scene import Numerics
     from .solver import simulate
+    from .tip_following import simulate_tip_following
 
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if wants_tip_following(scene, numerics):
+        return simulate_tip_following(scene, numerics)
     return simulate(scene, numerics)
+
+
+def wants_tip_following(scene, numerics) -> bool:
+    """Whether a BEM scene runs on the tip-following mesh (:mod:`sweep.tip_following`):
+    a graded mesh sized from the band resolution (``nodes`` unset, not ``exact``) whose
+    fixed crack band would need more than ``numerics.max_nodes`` nodes (large mu or a0)."""
+    return (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact
+            and bem_nodes_needed(scene, numerics) > numerics.max_nodes)
 
 
 def _elastic(scene, numerics=None):
@@ -123,12 +139,12 @@ def bem_nodes_needed(scene, numerics=None) -> int:
     import dataclasses
 
     from .mesh import scene_mesh
-    from .problem import initial_estimates
+    from .problem import initial_estimates, tip_zone
     from .scene import Numerics
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     _, a_est, domain = initial_estimates(scene, numerics)
-    l0 = units.l0_hat(scene.mu)
+    l0 = tip_zone(scene.mu)
     if numerics.mesh == "uniform":
         return int(math.ceil(domain * numerics.zone_nodes / l0)) + 1
     mesh = scene_mesh(dataclasses.replace(numerics, nodes=None), l0, a_est, domain,

@@ -312,7 +312,7 @@ def compute(case=PDMS_CASE, fits=None) -> dict:
             "pull_off_over_jkr_at_slowest": {
                 m: out_models[m]["pull_off_mN"][0] / p_jkr for m in MODELS},
             "slowest_speed_um_s": float(speeds_um[0])},
-        "bem": "not run: mu = 103 is outside the BEM's reach (Scene mu <= 20; l0 = 1.6e-4 a_ref)",
+        "bem": "not run: mu = 103 is outside the BEM's range (mu <= 100, sweep.problem.BEM_MU_RANGE; l0 = 1.6e-4 a_ref)",
         "gs_over_linear": {
             "crack_speed_um_s": list(v_um), "gamma_lin": list(g_lin), "gamma_gs": list(g_gs),
             "ratio": list(ratio), "paper_fit": list(paper_ratio),

@@ -6,8 +6,20 @@ import math
 import numpy as np
 
 
+#: a parabola refinement lowering the sampled minimum by more than this fraction must
+#: also predict the neighbouring samples (see :func:`refine_minimum`)
+VERTEX_RTOL = 1e-3
+
+
 def refine_minimum(t, P):
-    """(t*, P*) of the minimum of P(t) refined by a parabola through the 3 samples around it."""
+    """(t*, P*) of the minimum of P(t) refined by a parabola through the 3 samples around it.
+
+    The parabola is rejected, and the sampled minimum returned, where it is no local model
+    of P (a kink or a jump of the load): where it lowers the minimum by more than
+    max(P[i-1], P[i+1]) - P[i] (impossible for a parabola through equally spaced samples),
+    or by more than VERTEX_RTOL |P[i]| while missing the samples i - 2, i + 2 by more than
+    it lowers the minimum.
+    """
     i = int(np.argmin(P))
     if 0 < i < len(P) - 1:
         x = t[i - 1:i + 2]
@@ -19,8 +31,16 @@ def refine_minimum(t, P):
             C = y[1] - A * x[1] ** 2 - B * x[1]
             if A > 0:
                 ts = -B / (2 * A)
-                if x[0] <= ts <= x[2]:
-                    return i, ts, min(A * ts * ts + B * ts + C, y[1])
+                vertex = A * ts * ts + B * ts + C
+                miss = 0.0
+                for j in (i - 2, i + 2):
+                    if 0 <= j < len(P):
+                        miss = max(miss, abs(A * t[j] ** 2 + B * t[j] + C - P[j]))
+                drop = y[1] - vertex
+                smooth = (drop <= max(y[0], y[2]) - y[1]
+                          and (drop <= VERTEX_RTOL * abs(y[1]) or miss <= drop))
+                if x[0] <= ts <= x[2] and smooth:
+                    return i, ts, min(vertex, y[1])
     return i, t[i], P[i]
 
 

@@ -24,19 +24,40 @@ from .theory import jkr_contact_radius
 WINDOW_SAFETY = 10.0
 #: ... widened outward to multiples of this many decades (shared by the scenes of a sweep)
 WINDOW_GRID = 0.5
+#: ... and never beyond this time (tau0): both materials have relaxed by then (MPL: the
+#: retardation times are Gamma(n)-distributed, Chat - 1 ~ exp(-2 sqrt(t)) < 1e-80 for
+#: n <= 5; SLS: exp(-t)), while a fit over more decades costs seconds (13 s for
+#: n = 0.2, k = 1e-4 up to 3e7 at rate 1e-4)
+WINDOW_T_MAX = 1e4
 #: the crack tip stays this many process zones inside the fine band of a graded mesh
 TIP_MARGIN_ZONES = 2.0
 #: max-tension gap over h0: the crack tip (contact radius a) is where the gap is 3^(1/6) h0
 TIP_GAP = 3.0 ** (1.0 / 6.0)
 
 
-#: Tabor parameters the hereditary BEM is validated for (its mesh sizing and folds); the
-#: quasi-static elastic solver (:mod:`sweep.quasistatic`) covers 0.01-100
-BEM_MU_RANGE = (0.5, 20.0)
+#: Tabor parameters of the hereditary BEM: the whole range of Scene. Validated: above about 8
+#: the fixed crack band exceeds max_nodes and the tip-following mesh
+#: (:mod:`sweep.tip_following`) takes over (pull-off converged to 1 % at mu = 30 and 100);
+#: below 1.83 the mesh is sized from sqrt(h0) (:func:`tip_zone`) and the domain from the LJ
+#: tail (elastic pull-off equal to the quasi-static branch's to 1e-3 down to mu = 0.01)
+BEM_MU_RANGE = (0.01, 100.0)
 
 
 class Refused(Exception):
     """The numerics cannot represent the scene (the message says what to change)."""
+
+
+def tip_zone(mu: float) -> float:
+    """Length (a_ref) over which the interface traction varies at the crack tip: the unit
+    of the fine spacing (l0/band_resolution) and of the band margins of a graded mesh.
+
+    The process zone l0 = 1.693/mu^2 on the JKR side. On the DMT side l0 outgrows the
+    contact itself (l0 = 17000 at mu = 0.01) and the sphere hardly deforms: the gap near
+    the contact edge, whose radius is about sqrt(2 (3^(1/6) - 1) h0) at pull-off, grows
+    like the rigid profile r^2/2, by h0 over about sqrt(h0) (h0 = 1/(pi^(2/3) mu)). The
+    zone is the smaller of the two: sqrt(h0) below mu = 1.83, where they cross.
+    """
+    return min(units.l0_hat(mu), math.sqrt(units.h0_hat(mu)))
 
 
 def lj_constants(mu: float) -> tuple[float, float]:
@@ -80,7 +101,7 @@ def time_window(scene: Scene, numerics: Numerics, delta0: float) -> tuple[float,
     h0 = units.h0_hat(scene.mu)
     t_min = numerics.min_step / scene.rate        # the smallest step the run may take
     travel = max(delta0, 0.0) + 3.0 + 2.0 * math.sqrt(max(delta0, 1.0))
-    t_max = max(WINDOW_SAFETY * travel / (scene.rate * h0), 10 * t_min)
+    t_max = max(min(WINDOW_SAFETY * travel / (scene.rate * h0), WINDOW_T_MAX), 10 * t_min)
     lo = math.floor(math.log10(t_min) / WINDOW_GRID) * WINDOW_GRID
     hi = math.ceil(math.log10(t_max) / WINDOW_GRID) * WINDOW_GRID
     return 10.0 ** lo, 10.0 ** hi
@@ -105,7 +126,8 @@ class Problem:
     ----------
     scene, numerics : the inputs.
     h0, c : LJ range (d_ref) and prefactor; ``hm = 3^(1/6) h0`` the max-tension gap.
-    l0 : process zone 1.693/mu^2 (a_ref).
+    l0 : the tip zone (a_ref, :func:`tip_zone`): the process zone 1.693/mu^2, or sqrt(h0)
+        on the DMT side (mu < 1.83).
     delta0_estimate, a0_estimate : the initial state before it is solved (delta0 given, or
         JKR from a0), which sizes the domain, the crack band and the time window.
     mesh : the mesh (``mesh.r`` node radii, ``mesh.spacing`` the fine spacing).
@@ -168,7 +190,7 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
                       f"elastic or auto, large contacts the crack-front model (model crack)")
     h0, c = lj_constants(scene.mu)
-    l0 = units.l0_hat(scene.mu)
+    l0 = tip_zone(scene.mu)
     d_est, a_est, domain = initial_estimates(scene, numerics)
     mesh = scene_mesh(numerics, l0, a_est, domain, pull_off_only=scene.stop == "pulloff",
                       band=band)
@@ -179,12 +201,13 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
             advice = f"use nodes >= {need} for domain {domain:.3g}"
         else:
             advice = "use more nodes (or leave nodes unset to size the mesh from band_resolution)"
-        raise Refused(f"mesh too coarse: the process zone l0 = {l0:.3g} a_ref spans {zone:.2g} "
+        raise Refused(f"mesh too coarse: the tip zone l0 = {l0:.3g} a_ref spans {zone:.2g} "
                       f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
     if mesh.nodes > numerics.max_nodes:
         raise Refused(f"mesh too large: the crack band needs {mesh.nodes} nodes at "
                       f"band_resolution {numerics.band_resolution:g} (> max_nodes = "
-                      f"{numerics.max_nodes}); raise max_nodes or lower band_resolution")
+                      f"{numerics.max_nodes}); raise max_nodes or lower band_resolution, or run it "
+                      f"on the tip-following mesh (sweep.tip_following; model bem does so)")
     weights = times = np.zeros(0)
     error = 0.0
     if scene.k < 1.0 and not numerics.exact:

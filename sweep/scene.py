@@ -77,9 +77,10 @@ class Scene:
         Ratio of relaxed to glassy modulus E0/Einf, in (0, 1]; ``k = 1`` is elastic.
     mu : float
         Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.01, 1000]: the hereditary BEM
-        refuses mu outside [0.5, 20] (sweep.problem.BEM_MU_RANGE), the elastic branch is
-        validated up to 100, the crack-front and pb models (large contacts against l0, e.g.
-        the paper's PDMS at mu = 103) take the whole range.
+        takes [0.01, 100] (sweep.problem.BEM_MU_RANGE; above about 8 on a mesh that follows
+        the crack tip, :mod:`sweep.tip_following`), the elastic branch is validated up to
+        100, the crack-front and pb models (large contacts against l0, e.g. the paper's
+        PDMS at mu = 103) take the whole range.
     rate : float
         Dimensionless unloading rate r-hat = r tau0 / h0, in (0, 1e12].
     a0 : float, optional
@@ -104,9 +105,10 @@ class Scene:
                     lo_open=True, label="$n$", order=2, cli_default=0.8)
     k: float = axis(0.1, help="E0/Einf, relaxed over glassy modulus; 1 is elastic",
                     limits=(0.0, 1.0), lo_open=True, label="$k$", order=3)
-    mu: float = axis(3.24, help="Tabor parameter (the hereditary BEM takes 0.5-20, elastic "
-                     "scenes (k = 1) up to 100, the crack-front and pb models the whole range)",
-                     limits=(0.01, 1000.0), label=r"$\mu$", order=4)
+    mu: float = axis(3.24, help="Tabor parameter (the hereditary BEM 0.01-100, on a "
+                     "tip-following mesh where its fixed crack band exceeds max_nodes; "
+                     "elastic scenes (k = 1) up to 100; the crack-front and pb models "
+                     "the whole range)", limits=(0.01, 1000.0), label=r"$\mu$", order=4)
     rate: float = axis(help="unloading rate r-hat = r tau0 / h0", limits=(0.0, 1e12),
                        lo_open=True, label=r"unloading rate $\hat r = r\tau_0/h_0$", order=7,
                        plot_group=False)

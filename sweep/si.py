@@ -198,7 +198,7 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
     ----------
     si : SIScene
     model : {"bem", "crack", "pb", "auto"}
-        "bem" needs a :class:`sweep.Scene` (its ranges, e.g. mu <= 20); "crack" and "pb" run
+        "bem" needs a :class:`sweep.Scene` (its ranges, e.g. mu <= 100); "crack" and "pb" run
         at any Tabor parameter; "auto" is :func:`sweep.models.choose_model` within the Scene's
         ranges and "crack" beyond them (``model`` in the output says which ran).
     numerics : sweep.Numerics, optional

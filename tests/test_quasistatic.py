@@ -154,6 +154,9 @@ def test_elastic_scenes_of_a_sweep_take_the_quasistatic_branch():
                                  Numerics.preset("balanced", domain=5.0))
 
 
-def test_viscoelastic_scenes_outside_the_bem_range_fail_with_the_reason():
+def test_viscoelastic_scenes_beyond_the_fixed_band_fail_with_the_reason():
+    """The fixed-band solver refuses a band of more than max_nodes at once, naming the
+    tip-following mesh (which the model registry routes such scenes to)."""
     res = simulate(Scene(n=0.5, k=0.1, mu=50.0, a0=2.5, rate=1.0))
-    assert res.status == "failed" and "outside the hereditary BEM's range" in res.reason
+    assert res.status == "failed" and "max_nodes" in res.reason
+    assert "tip-following" in res.reason and res.wall_s < 5.0

@@ -1,0 +1,432 @@
+"""Viscoelastic unloading on a mesh refined around the crack tip that follows it.
+
+At a large Tabor parameter the process zone l0 = 1.693/mu^2 (a_ref) is tiny (1.9e-3 at mu =
+30, 1.7e-4 at mu = 100) and a fixed graded mesh, fine over the whole band the tip sweeps
+(from a0 down to below the pull-off radius), needs 10^4-10^5 nodes. Here only a *window*
+around the crack tip is fine (spacing l0 / ``band_resolution``, :func:`sweep.mesh.graded_mesh`
+with the window as its band, element lengths growing by ``grading`` outside it), and the
+mesh is rebuilt when the tip leaves the window:
+
+1. the window is placed with the tip ``behind`` process zones from its trailing end (the
+   cohesive zone and the recent wake of the Prony modes stay fine) and ``ahead`` zones of
+   room in the direction the tip moves (inward while the contact shrinks);
+2. the unloading kernel runs until the tip leaves the window less TIP_MARGIN_ZONES l0
+   (``kernels.solve.STATUS_LEFT_BAND``);
+3. a new mesh is built with the window moved to the tip, the gap ``h`` and the Prony modal
+   state ``q`` are carried over (every mesh lies on the lattice of the fine spacing, so
+   nodes common to both meshes keep their values exactly; the others are interpolated by a
+   cubic spline, exact for the r^2/2 of the rigid profile), the records continue, and the
+   kernel resumes (:func:`sweep.solver.unload_chunk`).
+
+The cost is set by the window (a few hundred nodes, whatever a0) and by the number of time
+steps (the tip moves at most ``da_max`` spacings per step); each new mesh costs one
+influence-matrix assembly (about 1 s at 700 nodes).
+
+Units and conventions of docs/design.md section 2.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP_LIMIT,
+                           new_jacobian_cache)
+
+from .initial import ElasticSolver, relaxed_state
+from .problem import Refused, initial_estimates, prepare, tip_zone
+from .scene import Numerics, Result, Scene
+
+#: room for the tip in its direction of motion, in process zones l0 (the tip moves this far,
+#: less TIP_MARGIN_ZONES, between two meshes)
+WINDOW_AHEAD_ZONES = 16.0
+#: fine region behind the tip (the cohesive zone, a few l0, and the recent wake), l0
+WINDOW_BEHIND_ZONES = 8.0
+#: Newton tolerance (units of h0) of a first relaxed solve where the numerics' one stalls
+LOOSE_TOL = 1e-4
+#: most meshes of one run (a run that needs more ends failed with the reason)
+MAX_MESHES = 5000
+#: a re-meshing up to the pull-off must leave the load continuous: the load change over the
+#: first step on a new mesh may exceed REMESH_JUMP_STEPS times the change over the
+#: neighbouring steps by at most ``rtol`` |P| (rtol: a quarter of the preset's pull-off
+#: tolerance, at least REMESH_JUMP_RTOL); else the run ends failed with the reason. (The
+#: load on two meshes differs by their discretization error; where the mesh outside the
+#: fine window is too coarse for the carried state, much more.)
+REMESH_JUMP_STEPS = 5.0
+REMESH_JUMP_RTOL = 1e-3
+
+
+def remesh_jump(P: np.ndarray, m: int, rtol: float = REMESH_JUMP_RTOL) -> float | None:
+    """The load jump at record ``m`` (the first on a new mesh) when it is not continuous
+    with its neighbours (see REMESH_JUMP_STEPS), else None."""
+    if m < 2 or m + 1 >= P.size:
+        return None
+    jump = abs(P[m] - P[m - 1])
+    typical = max(abs(P[m - 1] - P[m - 2]), abs(P[m + 1] - P[m]))
+    if jump > REMESH_JUMP_STEPS * typical + rtol * abs(P[m - 1]):
+        return float(jump)
+    return None
+
+
+def _continuity(run, remeshed_at: list, rtol: float) -> str:
+    """Check (and drop from ``remeshed_at``) the re-meshings whose neighbouring records now
+    exist; the reason of a failure when one up to the load minimum so far made the load
+    jump (:func:`remesh_jump`), else ""."""
+    P, a = run.records[2][:run.n], run.records[3][:run.n]
+    i_min = int(np.argmin(P))
+    while remeshed_at and remeshed_at[0] + 1 < run.n:
+        m = remeshed_at.pop(0)
+        if m > i_min + 1:       # after the load minimum: the pull-off is already behind
+            continue
+        jump = remesh_jump(P, m, rtol)
+        if jump is not None:
+            return (f"re-meshing at a = {a[m - 1]:.4g} made the load jump by {jump:.3g} (from "
+                    f"{P[m - 1]:.4g}; tolerance {rtol:g} |P|): the mesh outside the fine window "
+                    f"cannot carry the state; use the fixed crack band (raise max_nodes) or "
+                    f"model crack")
+    return ""
+
+
+def steps_needed(a0: float, spacing: float, da_max: float) -> int:
+    """Fewest time steps a run from the contact radius ``a0`` can take (the tip moves at
+    most ``da_max`` fine spacings per step): the tip recedes at least to max(0.6 a0, 1.2)
+    (pull-off radii: 0.42-0.53 a0 on the reference scenes, 1.04 in the elastic JKR limit)."""
+    travel = max(a0 - max(0.6 * a0, 1.2), 0.0)
+    return int(math.ceil(travel / (da_max * spacing)))
+
+
+def tip_window(tip: float, l0: float, ahead: float = WINDOW_AHEAD_ZONES,
+               behind: float = WINDOW_BEHIND_ZONES, direction: int = -1) -> tuple[float, float]:
+    """The fine window (a_ref radii) for a crack tip at ``tip`` moving inward
+    (``direction`` -1, the contact shrinks) or outward (+1): ``ahead`` process zones l0 of
+    room in the direction of motion, ``behind`` zones on the other side."""
+    if direction < 0:
+        lo, hi = tip - ahead * l0, tip + behind * l0
+    else:
+        lo, hi = tip - behind * l0, tip + ahead * l0
+    return max(lo, 0.0), hi
+
+
+def transfer(run, old_r: np.ndarray, new_r: np.ndarray) -> None:
+    """Carry the state of an unloading run (gap ``h``, Prony modes ``q``) from nodes
+    ``old_r`` to ``new_r`` in place, with a new Jacobian cache; records, step and counters
+    stay. A cubic spline interpolates (it returns the old values at common nodes)."""
+    h = CubicSpline(old_r, run.h)(new_r)
+    run.h = np.maximum(h, 0.5 * float(np.min(run.h)))
+    if run.q.shape[0] > 0:
+        run.q = np.ascontiguousarray(CubicSpline(old_r, run.q, axis=1)(new_r))
+    else:
+        run.q = np.zeros((0, new_r.size))
+    run.cache = new_jacobian_cache(new_r.size)
+
+
+def branch_state(scene: Scene, band_resolution: float = 16.0, domain: float | None = None):
+    """The relaxed elastic equilibrium at contact radius ``scene.a0`` on the quasi-static
+    branch (:class:`sweep.quasistatic.ElasticBranch`, which fixes the radius, not the
+    indentation), on a mesh as fine as the window's (``band_resolution`` spacings per
+    process zone, 8 zones each side) out to ``domain`` (the window mesh's, so that the gap
+    is interpolated, never extrapolated): (nodes r, gap h, indentation delta), or None if
+    it was not found.
+
+    Raises :class:`sweep.problem.Refused` where a0 lies below the displacement-controlled
+    fold of the branch (JKR: a = 0.5): the state exists but is unstable (the indentation
+    decreases as the radius grows), so no relaxed state can be held there.
+    """
+    from .quasistatic import ElasticBranch
+
+    a0 = scene.a0
+    br = ElasticBranch(scene.mu, a0, 0.5 * a0, zone_resolution=band_resolution, zone=8.0,
+                       domain=domain)
+    h_b, d_b = br.guess(a0)
+    h_b, d, ok = br.solve(a0, h_b, d_b)
+    if not ok:      # small a0: along the branch from a radius where the guess is good
+        h_b, d = br.guess(max(1.2, 2.0 * a0))
+        for a in np.geomspace(max(1.2, 2.0 * a0), a0, 16):
+            h_b, d, ok = br.solve(a, h_b, d)
+            if not ok:
+                return None
+    _, d_up, ok_up = br.solve(1.001 * a0, h_b, d)
+    if ok_up and d_up < d:
+        raise Refused(f"a0 = {a0:g} lies below the fold of the relaxed elastic branch at mu = "
+                      f"{scene.mu:g} (the indentation decreases as the radius grows): no "
+                      f"stable relaxed state there; give a larger a0 (JKR: a0 > 0.5) or delta0")
+    return a0 * br.x, h_b, d
+
+
+def initial_state(el: ElasticSolver, scene: Scene, branch=None):
+    """The relaxed state (gap, indentation) of a scene on the window mesh of ``el``.
+
+    From a0: the equilibrium at contact radius a0 on the quasi-static branch (``branch``,
+    :func:`branch_state`), carried to the mesh and polished by Newton at its indentation,
+    then bracketed and bisected on the indentation to the radius a0 on this mesh
+    (warm-started solves; the tip stays in the fine window): to a0 or, where the tip is
+    pinned between nodes (a(delta) a staircase), within two fine spacings
+    (``Result.a0_result`` says where), else RuntimeError with the reason. A direct Newton
+    solve from the JKR gap, as :func:`sweep.initial.relaxed_state` does, can converge to a
+    state whose tip sits on the coarse mesh outside the window at large mu, and its
+    continuation costs a dense factorization per solve. From delta0:
+    :func:`sweep.initial.relaxed_state`.
+    """
+    def solve(d_new, guess):
+        # Newton to the numerics' tolerance; where it stalls (large mu: the LJ stiffness
+        # c/h0 makes the Jacobian ill-conditioned), first to 1e-4 h0, then on from there
+        ok, h_new = el.solve(d_new, guess)
+        if not ok:
+            tol, el.tol = el.tol, max(el.tol, LOOSE_TOL)
+            ok, h_new = el.solve(d_new, guess)
+            el.tol = tol
+            if ok:
+                ok_fine, h_fine = el.solve(d_new, h_new)
+                h_new = h_fine if ok_fine else h_new
+        return ok, h_new
+
+    if branch is not None:
+        a0 = scene.a0
+        r_b, h_b, d = branch
+        ok, h = solve(d, np.maximum(CubicSpline(r_b, h_b)(el.r), 0.3 * el.h0))
+        if not ok:
+            raise RuntimeError(f"no equilibrium on the window mesh at the branch state of "
+                               f"a0 = {a0:g}")
+        spacing = float(np.min(np.diff(el.r)))
+        best = [abs(el.radius(h) - a0), h, d]
+
+        def radius_at(d_new, h_from, d_from):
+            ok, h_new = solve(d_new, np.maximum(h_from - (d_new - d_from), 0.3 * h_from))
+            if not ok:
+                return None, None
+            f_new = el.radius(h_new) - a0
+            if abs(f_new) < best[0]:
+                best[:] = [abs(f_new), h_new, d_new]
+            return f_new, h_new
+
+        # bracket a0 in delta (the radius grows with the indentation on the stable branch),
+        # then bisect: the tip may be pinned between nodes (lattice trapping), so a(delta)
+        # is a staircase and a0 is reached to within the step it jumps over
+        f = el.radius(h) - a0
+        slope = 2.0 * a0 - 1.0 / math.sqrt(2.0 * a0)     # JKR d delta / d a
+        step = -math.copysign(min(max(2.0 * abs(f) * slope, 1e-3 * el.h0), 0.2 * el.h0), f)
+        lo = hi = None
+        d_far, h_far = d, h
+        for _ in range(60):
+            if f == 0.0:
+                return h, float(d)
+            d_new = d_far + step
+            f_new, h_new = radius_at(d_new, h_far, d_far)
+            if f_new is None:           # Newton failed: a smaller step
+                step *= 0.5
+                continue
+            if (f_new > 0) != (f > 0):
+                lo, hi = sorted([(d_far, h_far), (d_new, h_new)], key=lambda x: x[0])
+                break
+            d_far, h_far, f = d_new, h_new, f_new
+            step = math.copysign(min(2.0 * abs(step), 0.2 * el.h0), step)
+        if lo is None:
+            raise RuntimeError(f"could not bracket the indentation of a0 = {a0:g}")
+        for _ in range(60):
+            if best[0] <= 1e-10 * a0 or hi[0] - lo[0] <= 1e-14 * max(1.0, abs(d)):
+                break
+            d_mid = 0.5 * (lo[0] + hi[0])
+            f_mid, h_mid = radius_at(d_mid, lo[1], lo[0])
+            if f_mid is None:
+                break
+            if f_mid > 0:
+                hi = (d_mid, h_mid)
+            else:
+                lo = (d_mid, h_mid)
+        if best[0] <= 2.0 * spacing:
+            return best[1], float(best[2])
+        raise RuntimeError(f"the tip jumps over a0 = {a0:g} by more than two fine spacings "
+                           f"(closest {best[0]:.3g} a_ref away): refine the mesh")
+    return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
+
+
+def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
+                           ahead: float = WINDOW_AHEAD_ZONES,
+                           behind: float = WINDOW_BEHIND_ZONES) -> Result:
+    """Simulate one scene with the BEM on a mesh refined around the moving crack tip.
+
+    Parameters
+    ----------
+    scene : Scene
+    numerics : Numerics, optional
+        Default ``Numerics.preset("balanced")``; the fine spacing is l0 / band_resolution
+        (or, with ``nodes`` set, the mesh of that many nodes), the rest as for
+        :func:`sweep.solver.simulate` (steps, tolerances, time budget, error indicator).
+    ahead, behind : float
+        The window, in process zones l0 (see :func:`tip_window`).
+
+    Returns
+    -------
+    Result
+        As :func:`sweep.solver.simulate`; ``nodes_used`` is the largest mesh of the run,
+        ``reason`` of an ok result says how many meshes it took.
+    """
+    from .solver import CHECK_FRACTION, _check_resolution, coarser, resolution_error
+
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    t_start = time.perf_counter()
+    deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
+    res = _attempt(scene, numerics, ahead, behind, deadline)
+    if res.ok and numerics.pull_off_rtol > 0:
+        res.error_estimate = resolution_error(res.spacing, tip_zone(scene.mu))
+        if res.error_estimate > CHECK_FRACTION * numerics.pull_off_rtol:
+            _check_resolution(res, _attempt(scene, coarser(numerics), ahead, behind, deadline))
+    res.wall_s = time.perf_counter() - t_start
+    return res
+
+
+def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
+    from .solver import (CHUNK_STEPS, STATUS_TIME_BUDGET, UnloadingState, _finish,
+                         unload_chunk)
+
+    if numerics.mesh != "graded" or numerics.exact:
+        numerics = dataclasses.replace(numerics, mesh="graded", exact=False)
+    res = Result(scene=scene, numerics=numerics)
+    l0 = tip_zone(scene.mu)
+    _, a_est, domain = initial_estimates(scene, numerics)
+    spacing = l0 / numerics.band_resolution
+    need = steps_needed(a_est, spacing, numerics.da_max)
+    if need > numerics.max_steps:
+        travel = a_est - max(0.6 * a_est, 1.2)
+        res.reason = (f"too many steps: the crack tip recedes at least {travel:.3g} a_ref at most"
+                      f" da_max = {numerics.da_max:g} fine spacings ({spacing:.2g}) "
+                      f"per step, > {need} steps (max_steps = {numerics.max_steps}); raise "
+                      f"max_steps, or lower band_resolution, or use the crack-front model")
+        return res
+    try:
+        branch = (branch_state(scene, numerics.band_resolution, domain) if scene.a0 is not None
+                  else None)
+        # the initial state: where the relaxed tip lies outside the first window (delta0
+        # scenes, whose radius is a JKR estimate), once more with the window there
+        for _ in range(2):
+            pb = prepare(scene, numerics, tip_window(a_est, l0, ahead, behind))
+            el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, numerics.tol)
+            h_init, delta0 = initial_state(el, scene, branch)
+            a_init = el.radius(h_init)
+            lo, hi = pb.tip_range
+            if lo <= a_init <= hi or a_init <= 0.0:
+                break
+            a_est = a_init
+    except Refused as exc:
+        res.reason = str(exc)
+        return res
+    except RuntimeError as exc:
+        res.reason = f"initial state: {exc}"
+        return res
+    res.delta0_result, res.a0_result = delta0, a_init
+    res.a0_inner = el.radius(h_init, 1.0)
+    res.spacing, res.domain_used = pb.mesh.spacing, pb.mesh.domain
+    res.prony_terms, res.prony_error = int(pb.prony_weights.size), pb.prony_error
+    if a_init <= 0.0:
+        res.reason = "no contact in the initial state (delta0 below the jump-in)"
+        return res
+    if a_init >= pb.mesh.r[-2]:
+        res.reason = f"initial contact radius {a_init:.4g} reaches the mesh edge"
+        return res
+
+    run = UnloadingState.start(pb, h_init, delta0, el.cache, el.stats.copy())
+    meshes, nodes = 1, pb.mesh.nodes
+    remeshed_at = []
+    rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
+    broken = ""
+    while True:
+        status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
+        broken = _continuity(run, remeshed_at, rtol)
+        if broken:
+            break
+        if status == STATUS_LEFT_BAND and meshes < MAX_MESHES:
+            a = run.records[3]
+            direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1
+            try:
+                new = prepare(scene, numerics,
+                              tip_window(a[run.n - 1], l0, ahead, behind, direction))
+            except Refused as exc:
+                res.reason = f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"
+                return res
+            transfer(run, pb.mesh.r, new.mesh.r)
+            remeshed_at.append(run.n)
+            pb, meshes, nodes = new, meshes + 1, max(nodes, new.mesh.nodes)
+        elif status == STATUS_STEP_LIMIT and run.n <= numerics.max_steps:
+            pass
+        else:
+            break
+        if time.perf_counter() > deadline:
+            status = STATUS_TIME_BUDGET
+            break
+    n = run.n
+    t, delta, P, a, a_inner = (x[:n].copy() for x in run.records)
+    res.trajectory = {"t": t, "delta": delta, "P": P, "a": a, "a_inner": a_inner}
+    res.steps = n - 1
+    res.newton_iterations = int(run.stats[STAT_ITER])
+    res.factorizations = int(run.stats[STAT_FACTOR])
+    res.nodes_used = nodes
+    if broken:
+        res.reason = broken
+        return res
+    if status == STATUS_LEFT_BAND:
+        res.reason = f"more than {MAX_MESHES} meshes (a = {a[-1]:.4g})"
+        return res
+    _finish(res, scene, status, t, delta, P, a, a_inner, pb.mesh.spacing)
+    if res.ok:
+        note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
+        res.reason = f"{res.reason}; {note}" if res.reason else note
+    return res
+
+
+#: the convergence study (``python -m sweep.tip_following``): a viscoelastic scene unloaded
+#: from a0 = 1.2 (n = 0.8, k = 0.5, rate 1), fine spacing l0/band_resolution, window
+#: (ahead, behind) in l0
+STUDY_SCENE = dict(n=0.8, k=0.5, a0=1.2, rate=1.0)
+STUDY_RESOLUTIONS = (8.0, 16.0, 24.0)
+STUDY_WINDOWS = ((16.0, 8.0), (8.0, 4.0), (32.0, 16.0))
+
+
+def convergence_study(mu: float, resolutions=STUDY_RESOLUTIONS, windows=STUDY_WINDOWS,
+                      preset: str = "balanced", on_row=None, **scene) -> list[dict]:
+    """Pull-off of one scene against the fine spacing (at the first window) and the window
+    (at the middle resolution). Rows: band_resolution, ahead, behind, status, pull_off,
+    nodes, meshes (from the reason), steps, seconds; ``on_row(row)`` as each is done."""
+    sc = Scene(mu=mu, **{**STUDY_SCENE, **scene})
+    grid = [(res, *windows[0]) for res in resolutions]
+    mid = resolutions[len(resolutions) // 2]
+    grid += [(mid, *w) for w in windows[1:]]
+    rows = []
+    for res_, ahead, behind in grid:
+        num = Numerics.preset(preset, band_resolution=res_, pull_off_rtol=0.0,
+                              time_budget_s=1800.0)
+        r = simulate_tip_following(sc, num, ahead, behind)
+        meshes = int(r.reason.split(" meshes")[0].split()[-1]) if "meshes" in r.reason else 0
+        rows.append(dict(mu=mu, band_resolution=res_, ahead=ahead, behind=behind,
+                         status=r.status, pull_off=r.pull_off, nodes=r.nodes_used,
+                         meshes=meshes, steps=r.steps, seconds=r.wall_s))
+        if on_row is not None:
+            on_row(rows[-1])
+    return rows
+
+
+def _main(argv=None) -> None:
+    import argparse
+
+    p = argparse.ArgumentParser(prog="python -m sweep.tip_following",
+                                description="convergence of the tip-following BEM")
+    p.add_argument("--mu", type=float, nargs="+", default=[30.0, 100.0])
+    p.add_argument("--resolutions", type=float, nargs="+", default=list(STUDY_RESOLUTIONS))
+    args = p.parse_args(argv)
+    print(f"scene {STUDY_SCENE}, preset balanced; windows (ahead, behind) in l0")
+    print(f"{'mu':>5} {'res':>4} {'ahead':>5} {'behind':>6} {'status':>6} {'pull_off':>9} "
+          f"{'nodes':>5} {'meshes':>6} {'steps':>6} {'s':>6}")
+
+    def show(r):
+        print(f"{r['mu']:5g} {r['band_resolution']:4g} {r['ahead']:5g} {r['behind']:6g} "
+              f"{r['status']:>6} {r['pull_off']:9.5f} {r['nodes']:5d} {r['meshes']:6d} "
+              f"{r['steps']:6d} {r['seconds']:6.1f}", flush=True)
+
+    for mu in args.mu:
+        convergence_study(mu, tuple(args.resolutions), on_row=show)
+
+
+if __name__ == "__main__":
+    _main()
