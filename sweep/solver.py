@@ -233,10 +233,10 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
         res.reason = "no contact in the initial state (delta0 below the jump-in)"
         return
 
-    out = [np.empty(numerics.max_steps + 1) for _ in range(5)]
     stats = el.stats.copy()
     min_travel = STOP_TRAVEL_SPACINGS * dr
     if numerics.exact:
+        out = [np.empty(numerics.max_steps + 1) for _ in range(5)]
         status, n = unload_exact(pb.A, r, pb.wP, h_init, delta0, scene, numerics, pb.h0, pb.c,
                                  material_of(scene) if scene.k < 1.0 else None, pb.stop_mode,
                                  min_travel, out, stats)

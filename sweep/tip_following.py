@@ -331,7 +331,6 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     meshes, nodes = 1, pb.mesh.nodes
     remeshed_at = []
     rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
-    broken = ""
     while True:
         status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
         broken = _continuity(run, remeshed_at, rtol)
