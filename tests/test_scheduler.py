@@ -294,3 +294,26 @@ def test_grid_is_expanded_and_hashed_once_per_run(tmp_path, monkeypatch):
     c = cfg()
     rep = run_sweep(c, jobs=1, out=tmp_path / "r.h5", simulate=fake_simulate, progress="none")
     assert rep.total == len(calls) == 4
+
+
+def test_dispatch_order_runs_the_largest_scenes_first():
+    """Longest-processing-time first: a permutation of the grid, ordered by the cost
+    estimate (larger initial contact, then slower rate, first); the estimate follows the
+    campaign's measured costs (a0 = 8 about 16x a0 = 2, rate 1 about 3x rate 1e6)."""
+    num = Numerics.preset("fast")
+    todo = [(f"s{i}", Scene(n=0.8, k=0.1, mu=3.24, a0=a0, rate=rate))
+            for i, (a0, rate) in enumerate([(1.0, 1e6), (8.0, 1e6), (2.0, 1.0), (8.0, 1.0),
+                                            (4.0, 10.0), (1.0, 1.0)])]
+    ordered = scheduler.dispatch_order(todo, num)
+    assert sorted(sid for sid, _ in ordered) == sorted(sid for sid, _ in todo)
+    assert [sid for sid, _ in ordered][:2] == ["s3", "s1"]
+    assert ordered[-1][0] == "s0"
+    costs = [scheduler.estimated_cost(s, num) for _, s in ordered]
+    assert costs == sorted(costs, reverse=True)
+    big = scheduler.estimated_cost(Scene(n=0.8, k=0.1, mu=3.24, a0=8.0, rate=1e6), num)
+    small = scheduler.estimated_cost(Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1e6), num)
+    assert 5.0 < big / small < 50.0
+    # a scene given by its indentation is sized from the JKR estimate of its contact radius
+    deep = scheduler.estimated_cost(Scene(n=0.8, k=0.1, mu=3.24, delta0=11.0, rate=1.0), num)
+    shallow = scheduler.estimated_cost(Scene(n=0.8, k=0.1, mu=3.24, delta0=1.0, rate=1.0), num)
+    assert deep > shallow > 0.0
