@@ -392,6 +392,9 @@ class BenchPlan:
     campaign: str = "configs/threshold.yaml"
     campaign_stride: int = 20
     jobs: int = 2
+    scale_config: str = "configs/scale.yaml"
+    scale_sample: int = 100
+    scale_seed: int = 0
     vs_numpy_scenes: dict = field(default_factory=lambda: dict(VS_NUMPY_SCENES))
     engine_numerics: dict = field(default_factory=lambda: {
         "fast": {"preset": "fast"}, "balanced": {"preset": "balanced"}})
@@ -412,7 +415,8 @@ class BenchPlan:
                    prony_numerics=dict(nodes=60, domain=2.5, da_max=1e6, tol=1e-8,
                                        prony_rtol=1e-2),
                    compile=False, campaign="configs/smoke.yaml",
-                   campaign_stride=4, jobs=1,
+                   campaign_stride=4, jobs=1, scale_config="configs/smoke.yaml",
+                   scale_sample=3,
                    vs_numpy_scenes={"tiny": small},
                    engine_numerics={"fast": existing(dict(nodes=60, domain=2.5, step=0.5,
                                                           prony_rtol=1e-2, **once))},
@@ -529,15 +533,71 @@ def bench_prony_speedup(plan: BenchPlan) -> dict:
     return out
 
 
+def _listed(config, scenes, name: str):
+    """A config with the numerics of ``config`` whose grid lists ``scenes`` one by one."""
+    from .config import AXES, config_from_dict
+
+    grid = [{k: v for k, v in s.to_dict().items() if k in AXES and v is not None}
+            for s in scenes]
+    return config_from_dict({**config.to_dict(), "grid": grid, "name": name})
+
+
 def campaign_subset(config, stride: int):
     """Every ``stride``-th scene of a sweep config (its task order), as a config whose grid
     lists them one by one: a sample with the campaign's own mix of n, a0 and rate."""
-    from .config import AXES, config_from_dict
+    picked = [scene for _, scene in config.tasks()[::max(int(stride), 1)]]
+    return _listed(config, picked, f"{config.name}_every{stride}")
 
-    data = config.to_dict()
-    picked = [scene.to_dict() for _, scene in config.tasks()[::max(int(stride), 1)]]
-    grid = [{k: v for k, v in d.items() if k in AXES and v is not None} for d in picked]
-    return config_from_dict({**data, "grid": grid, "name": f"{config.name}_every{stride}"})
+
+def campaign_sample(config, size: int, seed: int = 0):
+    """A seeded random sample of ``size`` scenes of a sweep config (without replacement),
+    as a config listing them: unlike a stride, it cannot alias with the grid's axes."""
+    tasks = config.tasks()
+    rng = np.random.default_rng(seed)
+    pick = np.sort(rng.choice(len(tasks), size=min(int(size), len(tasks)), replace=False))
+    return _listed(config, [tasks[i][1] for i in pick], f"{config.name}_sample{len(pick)}")
+
+
+def bench_scale(plan: "BenchPlan") -> dict:
+    """The issue's scale: minutes for the whole of ``plan.scale_config`` (10,640 scenes over
+    the paper's ranges) at -j{jobs}, estimated from a seeded random sample of
+    ``plan.scale_sample`` scenes run with the config's own numerics (warm workers). The
+    sample's statuses are reported with it: a failed scene costs its time too."""
+    import pandas as pd
+
+    from .scheduler import run_sweep
+    from .store import load
+
+    cfg = load_config_path(plan.scale_config)
+    sample = campaign_sample(cfg, plan.scale_sample, plan.scale_seed)
+    tmp = Path(tempfile.mkdtemp(prefix="bench-scale-"))
+    t = time.perf_counter()
+    rep = run_sweep(sample, jobs=plan.jobs, out=tmp / "sample.h5", progress="none",
+                    resume=False)
+    wall = time.perf_counter() - t
+    df = load(tmp / "sample.h5")
+    n = len(sample.tasks())
+    total = len(cfg.tasks())
+    slow = df.sort_values("wall_s", ascending=False).head(5)
+    return {"config": plan.scale_config, "scenes": total, "sample": n, "seed": plan.scale_seed,
+            "jobs": plan.jobs, "ran": rep.ran, "wall_s": wall,
+            "status_counts": {str(k): int(v) for k, v in df.status.value_counts().items()},
+            "scene_wall_s": {"mean": float(df.wall_s.mean()), "median": float(df.wall_s.median()),
+                             "max": float(df.wall_s.max())},
+            "slowest": [{key: (None if pd.isna(r[key]) else
+                               (str(r[key]) if key == "status" else float(r[key])))
+                         for key in ("n", "k", "rate", "a0", "delta0", "wall_s", "status")}
+                        for r in slow.to_dict("records")],
+            "minutes_estimate": total * wall / max(n, 1) / 60.0,
+            "loadavg": os.getloadavg()}
+
+
+def load_config_path(path: str):
+    """A sweep config by path relative to the repository root (or absolute)."""
+    from .config import load_config
+
+    p = Path(path)
+    return load_config(p if p.is_absolute() else ROOT / p)
 
 
 def bench_campaign(plan: BenchPlan) -> dict:
@@ -680,6 +740,11 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     report["campaign_detail"] = camp
     progress(f"scenes_per_minute: {report['scenes_per_minute']:.1f}, "
              f"parallel_speedup {report['parallel_speedup']:.2f}")
+    scale = bench_scale(plan)
+    report["scale_minutes"] = scale["minutes_estimate"]
+    report["scale_detail"] = scale
+    progress(f"scale: {scale['scenes']} scenes in about {scale['minutes_estimate']:.1f} min "
+             f"(sample of {scale['sample']}: {scale['status_counts']})")
     vs = bench_vs_numpy(plan, progress)
     report["vs_numpy"] = {name: {label: {"engine_s": e["wall_s"], "engine_err": e["err_pull_off"],
                                          "numpy_s": (e["plain_equal_or_worse"] or {}).get("wall_s"),
@@ -702,6 +767,9 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
                              "scene of its grid, run_sweep with jobs workers (warm), scenes "
                              "per wall minute",
         "parallel_speedup": "run_sweep wall at -j1 / at -j{jobs} (warm workers), same subset",
+        "scale_minutes": "estimated wall minutes of the whole scale_config grid at -j{jobs}: "
+                         "the wall of a seeded random sample of scale_sample scenes (its own "
+                         "numerics, dispatch overhead included), times scenes / sample",
         "vs_numpy": "per scene and engine configuration: engine wall (best of repeat, caches "
                     "warm) and relative pull-off error vs the scene's converged reference; "
                     "the plain numpy solver's most accurate ladder run whose error is still "
@@ -781,6 +849,20 @@ def all_cmd(tiny, out):
     report = bench_all(BenchPlan.tiny() if tiny else BenchPlan(),
                        progress=lambda m: click.echo(m, err=True))
     _write(report, out)
+
+
+@bench.command("scale")
+@click.option("--sample", type=int, default=100, show_default=True,
+              help="Scenes in the random sample.")
+@click.option("-j", "--jobs", type=int, default=2, show_default=True)
+@click.option("--config", "config", default="configs/scale.yaml", show_default=True)
+@click.option("--out", default=None, help="JSON report path.")
+def scale_cmd(sample, jobs, config, out):
+    """Estimated minutes for the 10,640-scene grid over the paper's ranges (a random sample)."""
+    from .solver import warm_up
+
+    warm_up()
+    _write(bench_scale(BenchPlan(scale_config=config, scale_sample=sample, jobs=jobs)), out)
 
 
 @bench.command("reference")

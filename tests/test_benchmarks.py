@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from sweep import Numerics, Scene, simulate
-from sweep.benchmarks import BenchPlan, _bracket, bench_all
+from sweep.benchmarks import ROOT, BenchPlan, _bracket, bench_all, campaign_sample
+from sweep.config import load_config
 from sweep.plain_solver import plain_unload
 from sweep.tradeoff import (PRESETS, grid, numerics_fields, pareto_front, plot_pareto,
                             relative_error, suggest_presets, to_numerics, write_table)
@@ -107,6 +108,19 @@ def test_plain_solver_needs_delta0():
         plain_unload(Scene(n=0.8, rate=1.0, a0=2.0), 60, 2.5, 0.5)
 
 
+def test_random_sample_is_seeded_distinct_and_spans_the_grid():
+    cfg = load_config(ROOT / "configs" / "scale.yaml")
+    assert len(cfg.tasks()) == 10640
+    a = campaign_sample(cfg, 200, seed=0)
+    b = campaign_sample(cfg, 200, seed=0)
+    scenes = [s for _, s in a.tasks()]
+    assert scenes == [s for _, s in b.tasks()] and len(set(scenes)) == 200
+    assert a.numerics == cfg.numerics
+    for axis in ("n", "k", "rate", "delta0"):         # every value of every axis: no aliasing
+        assert ({getattr(s, axis) for s in scenes}
+                == {getattr(s, axis) for _, s in cfg.tasks()})
+
+
 def test_bench_json_keys_with_a_tiny_plan():
     plan = BenchPlan.tiny()
     rep = bench_all(plan, progress=lambda m: None)
@@ -119,6 +133,9 @@ def test_bench_json_keys_with_a_tiny_plan():
     assert set(rep["prony_speedup"]) == {str(n) for n in plan.prony_steps}
     assert rep["compile_s"] is None                          # tiny: no fresh processes
     assert rep["scenes_per_minute"] > 0 and rep["parallel_speedup"] > 0
+    sc = rep["scale_detail"]
+    assert sc["sample"] == plan.scale_sample == sc["ran"] == sum(sc["status_counts"].values())
+    assert rep["scale_minutes"] == pytest.approx(sc["scenes"] * sc["wall_s"] / sc["sample"] / 60)
     assert set(rep["vs_numpy"]) == set(plan.vs_numpy_scenes)
     for by_cfg in rep["vs_numpy"].values():
         assert set(by_cfg) == set(plan.engine_numerics)
