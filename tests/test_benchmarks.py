@@ -135,7 +135,10 @@ def test_bench_json_keys_with_a_tiny_plan():
     assert rep["scenes_per_minute"] > 0 and rep["parallel_speedup"] > 0
     sc = rep["scale_detail"]
     assert sc["sample"] == plan.scale_sample == sc["ran"] == sum(sc["status_counts"].values())
-    assert rep["scale_minutes"] == pytest.approx(sc["scenes"] * sc["wall_s"] / sc["sample"] / 60)
+    assert sc["minutes_sample_rate"] == pytest.approx(sc["scenes"] * sc["wall_s"] / sc["sample"] / 60)
+    assert set(sc["sequential_s"]) == {"cold", "warm"}
+    assert 1 <= sc["start_groups"]["sample"] <= sc["start_groups"]["grid"]
+    assert rep["scale_minutes"] == sc["minutes_estimate"] > 0
     assert set(rep["vs_numpy"]) == set(plan.vs_numpy_scenes)
     for by_cfg in rep["vs_numpy"].values():
         assert set(by_cfg) == set(plan.engine_numerics)
