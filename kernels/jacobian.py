@@ -15,7 +15,8 @@ triangular, so
     J_b^-1 v:  x_S = K^-1 v_S,  x_F = v_F + A_FS (E_b,S x_S),   K = I - A_SS diag(E_b,S),
 
 and only the m x m block K is factorized (LU with partial pivoting, LAPACK's dgetrf through
-:mod:`kernels.blas`; an explicit inverse cost 3.6x more at m = 380): the cost of a
+:mod:`kernels.blas`; an explicit inverse cost 3.6x more at m = 380; it is kept only where S
+is the whole mesh, when the cache has no room for the pivots): the cost of a
 factorization falls by (m/N)^3, that of an application (two triangular solves) to (m/N)^2.
 
 Low-rank corrections. Between factorizations the stiffness moves (the crack tip recedes
@@ -61,8 +62,8 @@ UPDATE_FRACTION = 0.1
 #: complement) is below this in magnitude is taken as singular: refactorize
 CAPACITANCE_PIVOT = 1e-8
 
-CACHE_FACTOR = 0       # flat buffer (N*N + N/2 + 1): LU of K (m*m), a copy of A_FS
-#                        ((N-m)*m), at N*N the int32 pivots
+CACHE_FACTOR = 0       # flat buffer (N*N): LU of K (m*m), a copy of A_FS ((N-m)*m), then
+#                        the m int32 pivots; K^-1 when m = N (no room for pivots)
 CACHE_E_BASE = 1       # E_b (N): effective stiffness of the factorization (0 outside S)
 CACHE_COLUMNS = 2      # W (N, kmax): columns J_b^-1 A[:, i] of the corrected nodes
 CACHE_SLOT_OF = 3      # slot_of (N): slot of a corrected node in W, or -1
@@ -90,7 +91,7 @@ def new_jacobian_cache(N, kmax=WOODBURY_MAX, eta=WOODBURY_ETA):
     PARAM_*.
     """
     kmax = min(int(kmax), N)
-    return (np.empty(N * N + N // 2 + 1), np.zeros(N), np.empty((N, kmax)), np.full(N, -1, np.int64),
+    return (np.empty(N * N), np.zeros(N), np.empty((N, kmax)), np.full(N, -1, np.int64),
             np.full(kmax, -1, np.int64), np.zeros(3, np.int64), np.array([eta]),
             np.empty((kmax, kmax)), np.zeros(kmax))
 
@@ -102,8 +103,8 @@ def invalidate(cache):
 
 @njit(cache=True)
 def _pivots(factor, N, m):
-    """The LU pivots (int32, m), stored after the N*N floats of the factor buffer."""
-    return factor[N * N:].view(np.int32)[:m]
+    """The LU pivots (int32, m), stored in the factor buffer after LU and A_FS (N*m floats)."""
+    return factor[N * m:].view(np.int32)[:m]
 
 
 @njit(cache=True)
@@ -126,7 +127,9 @@ def factorize(h, A, ceff, h0, c, factor, e_base, slot_of, state):
             for j in range(m):
                 K[i, j] = -A[i, j] * e_base[j]
             K[i, i] += 1.0
-        if lu_factor(K, _pivots(factor, N, m)) != 0:
+        if m == N:       # no room for pivots: the explicit inverse (contact at the mesh edge)
+            factor[:] = np.linalg.inv(K.copy()).ravel()
+        elif lu_factor(K, _pivots(factor, N, m)) != 0:
             raise np.linalg.LinAlgError("the restricted Jacobian is singular")
         low = factor[m * m:m * m + (N - m) * m].reshape((N - m, m))
         for i in range(N - m):
@@ -146,6 +149,8 @@ def apply_base(X, factor, e_base, m):
     N, p = X.shape
     if m == 0:
         return X.copy()
+    if m == N:
+        return factor.reshape((N, N)) @ np.ascontiguousarray(X)
     B = np.ascontiguousarray(X[:m].T)
     lu_solve(factor[:m * m].reshape((m, m)), _pivots(factor, N, m), B)
     YS = B.T
