@@ -142,7 +142,7 @@ def _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats, reaso
 
 @njit(cache=True)
 def newton(h, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, node_of,
-           state, params, stats):
+           state, params, capacitance, e_corr, stats):
     """Solve F(h) = 0 in place, starting from ``h``. Returns True on convergence.
 
     The Jacobian factorization in the cache (:func:`kernels.jacobian.new_jacobian_cache`)
@@ -169,13 +169,15 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, n
         stats[STAT_ITER] += 1
         lj_traction_and_stiffness(h, h0, c, sig, d)
         dh, ok = newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of, state,
-                                  params, stats, STAT_COLUMNS)
+                                  params, capacitance, e_corr, stats, STAT_COLUMNS)
         if not ok:
             _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
                          STAT_REFACTOR_OVERFLOW)
             fresh = True
             dh, ok = newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of,
-                                      state, params, stats, STAT_COLUMNS)
+                                      state, params, capacitance, e_corr, stats, STAT_COLUMNS)
+            if not ok:       # singular even on a fresh factorization: give up
+                return False
         lam = positive_step(h, dh)
         # backtracking on the merit |F|_2 (Newton directions descend it); the max norm
         # decides convergence
@@ -268,7 +270,7 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
 
 @njit(cache=True)
 def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, factor, e_base, W, slot_of,
-         node_of, state, params, stats):
+         node_of, state, params, capacitance, e_corr, stats):
     """Newton from the gap profile outside the crack tip shifted inward by 1 to 6 nodes.
 
     Near a fold of the discrete path the stable state the tip snaps to is, locally, the
@@ -288,7 +290,7 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, factor, e_base, W, s
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
         if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, node_of,
-                  state, params, stats):
+                  state, params, capacitance, e_corr, stats):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -373,6 +375,7 @@ def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
 def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io,
            step_max, step_min, da_max, step_tol, tol, max_iter, max_steps, stop_mode, min_travel,
            tip_lo, tip_hi, factor, e_base, W, slot_of, node_of, state, params,
+           capacitance, e_corr,
            t_out, d_out, P_out, a_out, ai_out, h_out, stats):
     """Unload at constant rate from the state ``h_init`` with the Prony recursion.
 
@@ -407,8 +410,8 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         :func:`stop_reached`.
     tip_lo, tip_hi : radii the crack tip must stay within (the well-resolved band of a
         graded mesh); leaving them ends the run with STATUS_LEFT_BAND.
-    factor, e_base, W, slot_of, node_of, state, params : Jacobian cache arrays
-        (:func:`new_jacobian_cache`); may carry the factorization of the initial solve.
+    factor, e_base, W, slot_of, node_of, state, params, capacitance, e_corr : Jacobian
+        cache arrays        (:func:`new_jacobian_cache`); may carry the factorization of the initial solve.
     t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
     h_out : (N,) receives the gap of the last accepted step.
     stats : int64 array of length N_STATS (incremented).
@@ -474,7 +477,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         h_pred[:] = hp
         # -- solve
         ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, factor, e_base, W, slot_of,
-                    node_of, state, params, stats)
+                    node_of, state, params, capacitance, e_corr, stats)
         if not ok:
             stats[STAT_FAILED_SOLVES] += 1
             state[STATE_VALID] = 0
@@ -487,7 +490,8 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
             # else by pseudo-transient relaxation from the last state
             stats[STAT_JUMPS] += 1
             ok = snap(h, hp, g, A, ceff, H, h0, c, tol_gap, max_iter, r, hm, factor, e_base, W,
-                      slot_of, node_of, state, params, stats)
+                      slot_of, node_of, state, params, capacitance, e_corr,
+                      stats)
             if not ok:
                 hp[:] = h
                 ok = relax(hp, g, A, ceff, H, h0, c, tol_gap, RELAX_MAX_ITER, stats)

@@ -116,3 +116,26 @@ def test_relaxed_state_is_cached_per_mesh_and_reused_unchanged():
     h4, _ = relaxed_state(el2, a0=1.4, mesh_key=key)
     assert el2.stats[ks.STAT_ITER] > 0
     assert abs(el2.radius(h4) - 1.4) < r[1]
+
+
+def test_capacitance_updates_keep_the_newton_step_exact():
+    # corrected nodes move again (rank-1 updates of the capacitance inverse) and new nodes
+    # join (bordering), over several calls: with eta = 0 every step must stay the exact
+    # dense solve of the current Jacobian
+    A, h, h0, c, rng = _problem(N=70, seed=4)
+    ceff = 0.6
+    cache = jac.new_jacobian_cache(h.size, kmax=50, eta=0.0)
+    _factorize(h, A, ceff, h0, c, cache)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    h2 = h.copy()
+    moved = set()
+    for call in range(4):
+        idx = rng.choice(h.size, 6, replace=False)
+        moved.update(int(i) for i in idx)
+        h2[idx] *= 1.0 + 0.3 * rng.random(6)
+        J, d = _dense_jacobian(A, h2, h0, c, ceff)
+        F = rng.standard_normal(h.size)
+        dh, ok = jac.newton_direction(F, d, A, ceff, *cache, stats, ks.STAT_COLUMNS)
+        assert ok
+        assert stats[ks.STAT_COLUMNS] == len(moved)    # a column per node, kept across calls
+        np.testing.assert_allclose(dh, -np.linalg.solve(J, F), rtol=1e-8, atol=1e-11)

@@ -1,0 +1,106 @@
+"""BLAS and LAPACK from compiled kernels: the routines scipy ships, called on row-major blocks
+(Numba kernels).
+
+Numba's ``np.dot``/``np.linalg`` need contiguous arrays and offer no LU solve; the kernels of
+:mod:`kernels.jacobian` work on the leading k x k block of a preallocated (kmax, kmax) array
+and on the first k columns of an (N, kmax) one. The routines of ``scipy.linalg.cython_blas``
+and ``cython_lapack`` take such blocks through their leading dimension. Their addresses are
+registered with LLVM under a symbol name at import, so the compiled kernels refer to them by
+name (and stay cacheable, as Numba's own LAPACK bindings do).
+
+A row-major (rows, ld) array is, to Fortran, its transpose: an (ld, rows) column-major
+matrix with leading dimension ld; each wrapper below states what it computes in row-major
+terms.
+"""
+from __future__ import annotations
+
+import llvmlite.binding as ll
+import numpy as np
+from numba import njit, types
+from numba.extending import get_cython_function_address
+
+
+def _bind(module: str, name: str, nargs: int):
+    symbol = f"visco_sweep_{name}"
+    ll.add_symbol(symbol, get_cython_function_address(f"scipy.linalg.cython_{module}", name))
+    return types.ExternalFunction(symbol, types.void(*([types.voidptr] * nargs)))
+
+
+_dgemv = _bind("blas", "dgemv", 11)
+_dger = _bind("blas", "dger", 9)
+_dgetrf = _bind("lapack", "dgetrf", 6)
+_dgetrs = _bind("lapack", "dgetrs", 9)
+
+_N = ord("N")
+_T = ord("T")
+
+
+@njit(cache=True)
+def _ints(*values):
+    out = np.empty(len(values), np.int32)
+    for i, v in enumerate(values):
+        out[i] = v
+    return out
+
+
+@njit(cache=True)
+def _gemv(trans, M, rows, cols, x, y, alpha, beta):
+    """dgemv on the Fortran view of M[:rows, :cols] (cols x rows): ``trans`` T gives
+    M @ x into y[:rows], N gives M^T @ x into y[:cols]."""
+    n_out = rows if trans == _T else cols
+    if n_out == 0:
+        return
+    if rows == 0 or cols == 0:
+        for i in range(n_out):
+            y[i] *= beta
+        return
+    code = np.array([trans], np.uint8)
+    dims = _ints(cols, rows, M.shape[1], 1)
+    ab = np.array([alpha, beta])
+    _dgemv(code.ctypes, dims[0:].ctypes, dims[1:].ctypes, ab[0:].ctypes, M.ctypes,
+           dims[2:].ctypes, x.ctypes, dims[3:].ctypes, ab[1:].ctypes, y.ctypes, dims[3:].ctypes)
+
+
+@njit(cache=True)
+def gemv_rows(M, rows, cols, x, y, alpha, beta):
+    """y[:rows] = alpha M[:rows, :cols] @ x[:cols] + beta y[:rows] (M row-major, C order)."""
+    _gemv(_T, M, rows, cols, x, y, alpha, beta)
+
+
+@njit(cache=True)
+def gemv_cols(M, rows, cols, x, y, alpha, beta):
+    """y[:cols] = alpha M[:rows, :cols]^T @ x[:rows] + beta y[:cols] (M row-major)."""
+    _gemv(_N, M, rows, cols, x, y, alpha, beta)
+
+
+@njit(cache=True)
+def ger_rows(M, rows, cols, alpha, x, y):
+    """M[:rows, :cols] += alpha x[:rows] y[:cols]^T (M row-major)."""
+    if rows == 0 or cols == 0:
+        return
+    dims = _ints(cols, rows, M.shape[1], 1)
+    a = np.array([alpha])
+    _dger(dims[0:].ctypes, dims[1:].ctypes, a.ctypes, y.ctypes, dims[3:].ctypes, x.ctypes,
+          dims[3:].ctypes, M.ctypes, dims[2:].ctypes)
+
+
+@njit(cache=True)
+def lu_factor(K, piv):
+    """LU factorization (partial pivoting) of the square C-order ``K`` in place, pivots in
+    ``piv`` (int32). The factors are those of K^T to LAPACK; :func:`lu_solve` accounts for
+    it. Returns LAPACK's info (0: success, > 0: exactly singular)."""
+    dims = _ints(K.shape[0], 0)
+    _dgetrf(dims.ctypes, dims.ctypes, K.ctypes, dims.ctypes, piv.ctypes, dims[1:].ctypes)
+    return dims[1]
+
+
+@njit(cache=True)
+def lu_solve(K, piv, B):
+    """Solve K X = B^T in place of B for the factors of :func:`lu_factor`: ``B`` (p, n)
+    C order holds the p right-hand sides as rows (and receives the solutions)."""
+    if B.shape[0] == 0:
+        return
+    trans = np.array([_T], np.uint8)
+    dims = _ints(K.shape[0], B.shape[0], 0)
+    _dgetrs(trans.ctypes, dims[0:].ctypes, dims[1:].ctypes, K.ctypes, dims[0:].ctypes,
+            piv.ctypes, B.ctypes, dims[0:].ctypes, dims[2:].ctypes)
