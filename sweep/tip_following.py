@@ -36,13 +36,16 @@ import time
 import numpy as np
 import scipy.linalg
 from scipy.interpolate import CubicSpline
+from scipy.optimize import brentq
 
-from kernels.solve import (N_STATS, STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND,
-                           STATUS_STEP_LIMIT, new_jacobian_cache, newton)
+from kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
+                           STATUS_LEFT_BAND, STATUS_STEP_LIMIT, new_jacobian_cache, newton)
 from kernels.interface import lj_traction
 
 from .initial import ElasticSolver, relaxed_state
-from .problem import Refused, initial_estimates, prepare, tip_zone
+from . import units
+from .problem import (Refused, initial_estimates, jkr_radius, material_of, prepare,
+                      tip_zone)
 from .scene import Numerics, Result, Scene
 
 #: room for the tip in its direction of motion, in process zones l0 (the tip moves this far,
@@ -52,6 +55,8 @@ WINDOW_AHEAD_ZONES = 16.0
 WINDOW_BEHIND_ZONES = 8.0
 #: Newton tolerance (units of h0) of a first relaxed solve where the numerics' one stalls
 LOOSE_TOL = 1e-4
+#: time steps of the probe after which a run estimates what it still needs (:func:`_probe`)
+PROBE_STEPS = 200
 #: most meshes of one run (a run that needs more ends failed with the reason)
 MAX_MESHES = 5000
 #: a re-meshing up to the pull-off must leave the load continuous: the load change over the
@@ -97,12 +102,64 @@ def _continuity(run, remeshed_at: list, rtol: float) -> str:
     return ""
 
 
-def steps_needed(a0: float, spacing: float, da_max: float) -> int:
-    """Fewest time steps a run from the contact radius ``a0`` can take (the tip moves at
-    most ``da_max`` fine spacings per step): the tip recedes at least to max(0.6 a0, 1.2)
-    (pull-off radii: 0.42-0.53 a0 on the reference scenes, 1.04 in the elastic JKR limit)."""
-    travel = max(a0 - max(0.6 * a0, 1.2), 0.0)
-    return int(math.ceil(travel / (da_max * spacing)))
+def indentation_travel(scene: Scene, delta0: float) -> float:
+    """Least indentation travel (d_ref) of an unloading from ``delta0`` to the pull-off:
+    D = Cbar(D / (rate h0)) max(delta0, 0), with Cbar(t) = (1/t) int_0^t Chat the mean
+    compliance of a ramp of duration t (tau0).
+
+    Relaxed (slow) the indentation falls from delta0 to the relaxed pull-off, below 0 (JKR:
+    -0.51 at mu = 10); faster, the substrate answers a load change with less compliance, at
+    least Chat(0) = k, so the indentation travels less for the same loss of load (a frozen
+    contact, k = 1e-4 at rate 1e9: 0.028 of 220). Measured D / this estimate on eight
+    scenes at mu = 10-30 (k 1e-4 to 0.5, rates 1e-4 to 1e9): 1.005-1.61, never below 1.
+    """
+    full = max(delta0, 0.0)
+    if full == 0.0 or scene.k >= 1.0:
+        return full
+    h0 = units.h0_hat(scene.mu)
+    mat = material_of(scene)
+
+    def excess(D):
+        t = D / (scene.rate * h0)
+        return D - float(mat.integrated_compliance(t)) / t * full
+
+    return full if excess(full) <= 0.0 else float(brentq(excess, 1e-12 * full, full))
+
+
+@dataclasses.dataclass
+class StepEstimate:
+    """How many time steps a run needs at least, and why (see :func:`estimate_steps`)."""
+
+    steps: int
+    tip_travel: float         # a_ref, the crack tip's least recession
+    tip_steps: int            # at da_max fine spacings per step
+    travel: float             # d_ref, the indentation's least travel
+    step: float               # d_ref, the indentation step assumed
+    travel_steps: int
+
+    def describe(self) -> str:
+        return (f"the crack tip recedes at least {self.tip_travel:.3g} a_ref at most "
+                f"{self.tip_steps and self.tip_travel / self.tip_steps:.2g} per step "
+                f"({self.tip_steps} steps), the indentation falls at least {self.travel:.4g} "
+                f"d_ref by at most {self.step:.3g} per step ({self.travel_steps} steps)")
+
+
+def estimate_steps(scene: Scene, numerics: Numerics, delta: float, a: float,
+                   delta_start: float, a_start: float, step: float) -> StepEstimate:
+    """Least number of further time steps of a run now at indentation ``delta`` and
+    contact radius ``a`` that started at (``delta_start``, ``a_start``), with indentation
+    steps of at most ``step`` (d_ref): the indentation must fall to delta_start -
+    :func:`indentation_travel`, and the crack tip at least to the relaxed JKR radius there
+    (a frozen contact keeps its radius, a relaxed one follows JKR), at most ``da_max``
+    fine spacings per step."""
+    D = indentation_travel(scene, delta_start)
+    a_end = min(jkr_radius(delta_start - D), a_start)
+    tip = max(a - a_end, 0.0)
+    da = numerics.da_max * tip_zone(scene.mu) / numerics.band_resolution
+    rest = max(delta - (delta_start - D), 0.0)
+    tip_steps, travel_steps = int(math.ceil(tip / da)), int(math.ceil(rest / step))
+    return StepEstimate(steps=max(tip_steps, travel_steps), tip_travel=tip, tip_steps=tip_steps,
+                        travel=rest, step=step, travel_steps=travel_steps)
 
 
 def tip_window(tip: float, l0: float, ahead: float = WINDOW_AHEAD_ZONES,
@@ -325,6 +382,33 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
     return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
 
 
+def _probe(scene, numerics, run, delta0, a0, seconds, deadline) -> str:
+    """After the first PROBE_STEPS steps (``seconds`` of wall time): the reason to end the
+    run now when the least number of steps it still needs (:func:`estimate_steps`, with
+    indentation steps no larger than the probe's largest) exceeds max_steps or, at the
+    probe's cost per step, the time left before ``deadline``; else ""."""
+    n = run.n
+    delta, a = run.records[1][:n], run.records[3][:n]
+    if n < 3:
+        return ""
+    step = float(np.max(-np.diff(delta)))
+    need = estimate_steps(scene, numerics, delta[-1], a[-1], delta0, a0, step)
+    per_step = seconds / (n - 1)
+    total = n - 1 + need.steps
+    if total > numerics.max_steps:
+        return (f"too many steps: {need.describe()}, as the first {n - 1} steps took: about "
+                f"{total} steps > max_steps = {numerics.max_steps}; raise max_steps, or lower "
+                f"band_resolution, or use the crack-front model (model crack)")
+    left = deadline - time.perf_counter()
+    if need.steps * per_step > left:
+        return (f"time budget: needs at least {total} steps ({need.describe()}, as the first "
+                f"{n - 1} steps took) at {1e3 * per_step:.2g} ms per step on {run.h.size} "
+                f"nodes: about {need.steps * per_step:.0f} s more, > the {left:.0f} s left of "
+                f"time_budget_s = {numerics.time_budget_s:g}; raise time_budget_s, or lower "
+                f"band_resolution, or use the crack-front model (model crack)")
+    return ""
+
+
 def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
                            ahead: float = WINDOW_AHEAD_ZONES,
                            behind: float = WINDOW_BEHIND_ZONES) -> Result:
@@ -368,15 +452,15 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         numerics = dataclasses.replace(numerics, mesh="graded", exact=False)
     res = Result(scene=scene, numerics=numerics)
     l0 = tip_zone(scene.mu)
-    _, a_est, domain = initial_estimates(scene, numerics)
-    spacing = l0 / numerics.band_resolution
-    need = steps_needed(a_est, spacing, numerics.da_max)
-    if need > numerics.max_steps:
-        travel = a_est - max(0.6 * a_est, 1.2)
-        res.reason = (f"too many steps: the crack tip recedes at least {travel:.3g} a_ref at most"
-                      f" da_max = {numerics.da_max:g} fine spacings ({spacing:.2g}) "
-                      f"per step, > {need} steps (max_steps = {numerics.max_steps}); raise "
-                      f"max_steps, or lower band_resolution, or use the crack-front model")
+    d_est, a_est, domain = initial_estimates(scene, numerics)
+    # up front: the least steps of the run, with every step as large as the kernel's step
+    # control ever lets it grow
+    need = estimate_steps(scene, numerics, d_est, a_est, d_est, a_est,
+                          SMOOTH_STEP_FACTOR * numerics.step * units.h0_hat(scene.mu))
+    if need.steps > numerics.max_steps:
+        res.reason = (f"too many steps: {need.describe()}: > {need.steps} steps (max_steps = "
+                      f"{numerics.max_steps}); raise max_steps, or lower band_resolution, or use "
+                      f"the crack-front model (model crack)")
         return res
     try:
         branch = (branch_state(scene, numerics.band_resolution, domain) if scene.a0 is not None
@@ -413,11 +497,21 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     meshes, nodes = 1, pb.mesh.nodes
     remeshed_at = []
     rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
+    probing = True
     while True:
-        status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
+        t_chunk = time.perf_counter()
+        status = unload_chunk(pb, run, pb.tip_range, PROBE_STEPS if probing else CHUNK_STEPS)
         broken = _continuity(run, remeshed_at, rtol)
         if broken:
             break
+        if probing and status in (STATUS_LEFT_BAND, STATUS_STEP_LIMIT):
+            probing = False
+            refusal = _probe(scene, numerics, run, delta0, a_init,
+                             time.perf_counter() - t_chunk, deadline)
+            if refusal:
+                res.reason = refusal
+                res.steps, res.nodes_used = run.n - 1, nodes
+                return res
         if status == STATUS_LEFT_BAND and meshes < MAX_MESHES:
             a = run.records[3]
             direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1

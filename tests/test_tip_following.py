@@ -150,3 +150,59 @@ def test_a_strongly_viscoelastic_scene_remeshes_continuously_and_matches_the_fix
         tf.transfer = transfer
     assert broken.status == "failed"
     assert "re-meshing" in broken.reason and "jump" in broken.reason
+
+
+def test_indentation_travel_between_its_glassy_and_relaxed_limits():
+    """Relaxed (slow): the whole indentation; glassy (fast): Chat(0) = k of it; a frozen
+    start (delta0 <= 0) none."""
+    slow = Scene(n=0.8, k=0.1, mu=10.0, a0=15.0, rate=1e-6)
+    fast = Scene(n=0.8, k=0.1, mu=10.0, a0=15.0, rate=1e10)
+    assert tf.indentation_travel(slow, 200.0) == pytest.approx(200.0, rel=1e-3)
+    assert tf.indentation_travel(fast, 200.0) == pytest.approx(0.1 * 200.0, rel=1e-3)
+    mid = tf.indentation_travel(Scene(n=0.8, k=0.1, mu=10.0, a0=15.0, rate=1e5), 200.0)
+    assert 20.0 < mid < 200.0
+    assert tf.indentation_travel(slow, -0.3) == 0.0
+
+
+def test_the_step_estimate_is_below_the_steps_a_run_takes():
+    """The probe's estimate of the steps still needed, plus the probe, against the steps
+    the run then took (measured: 2408 vs 4855 at mu = 10, a0 = 2.5; 2274 vs 8606 at mu =
+    15, k = 0.1, a0 = 3, rate 10^2.5; here mu = 6, k = 0.1, a0 = 3)."""
+    scene = Scene(n=0.8, k=0.1, mu=6.0, a0=3.0, rate=10**2.5)
+    num = Numerics.preset("fast", pull_off_rtol=0.0)
+    estimate, seen = tf.estimate_steps, []
+
+    def recording(*args, **kw):
+        seen.append(estimate(*args, **kw))
+        return seen[-1]
+
+    try:
+        tf.estimate_steps = recording
+        res = tf.simulate_tip_following(scene, num, ahead=6.0, behind=4.0)
+    finally:
+        tf.estimate_steps = estimate
+    assert res.ok, res.reason
+    up_front, probe = seen
+    assert 0 < up_front.steps <= probe.steps + tf.PROBE_STEPS <= res.steps
+    assert probe.travel_steps > 0 and probe.tip_steps > 0
+
+
+def test_a_scene_beyond_its_budget_is_refused_after_the_probe_with_what_it_needs():
+    """mu = 10, a0 = 15, rate 1e-4: the indentation falls by about 220 d_ref in steps of
+    0.1 h0 (about 47000 steps, 100-150 s); with a 60 s budget it used to run 60 s and end
+    on the budget. Now it ends after the probe, saying what it needs."""
+    res = tf.simulate_tip_following(Scene(n=0.2, k=0.5, mu=10.0, a0=15.0, rate=1e-4),
+                                    Numerics.preset("balanced", time_budget_s=60.0))
+    assert res.status == "failed"
+    assert res.reason.startswith("time budget: needs at least"), res.reason
+    assert "time_budget_s" in res.reason and "steps" in res.reason
+    assert res.steps <= tf.PROBE_STEPS
+    need = int(res.reason.split("needs at least ")[1].split()[0])
+    assert need > 40000
+
+
+def test_a_scene_beyond_max_steps_is_refused_before_it_starts():
+    res = tf.simulate_tip_following(Scene(n=0.2, k=0.5, mu=100.0, a0=15.0, rate=1e9),
+                                    Numerics.preset("balanced"))
+    assert res.status == "failed" and res.reason.startswith("too many steps")
+    assert res.steps == 0 and "max_steps = 200000" in res.reason
