@@ -582,6 +582,46 @@ def convergence_study(mu: float, resolutions=STUDY_RESOLUTIONS, windows=STUDY_WI
     return rows
 
 
+def interpolate_as_traction(run, old, new) -> None:
+    """The state transfer before the modes were carried as displacements (for comparison
+    only): the gap and each Prony mode interpolated by a cubic spline, no re-equilibration."""
+    run.h = np.maximum(CubicSpline(old.mesh.r, run.h)(new.mesh.r), 0.5 * float(np.min(run.h)))
+    run.q = np.ascontiguousarray(CubicSpline(old.mesh.r, run.q, axis=1)(new.mesh.r))
+    run.cache = new_jacobian_cache(new.mesh.nodes)
+
+
+def remesh_jumps(scene: Scene, numerics: Numerics | None = None, form: str = "auto",
+                 ahead: float = WINDOW_AHEAD_ZONES, behind: float = WINDOW_BEHIND_ZONES):
+    """Run a scene and measure the load at each re-meshing up to the pull-off: (result,
+    rows of (record m, contact radius, P before, |jump|, the larger change over the
+    neighbouring steps)). ``form``: that of :func:`transfer`, or "traction"
+    (:func:`interpolate_as_traction`)."""
+    global transfer
+    marks, carry = [], transfer
+
+    def recording(run, old, new):
+        marks.append(run.n)
+        if form == "traction":
+            interpolate_as_traction(run, old, new)
+        else:
+            carry(run, old, new, form=form)
+
+    transfer = recording
+    try:
+        res = simulate_tip_following(scene, numerics, ahead, behind)
+    finally:
+        transfer = carry
+    rows = []
+    if res.trajectory:
+        P, a = res.trajectory["P"], res.trajectory["a"]
+        i_min = int(np.argmin(P))
+        for m in marks:
+            if 2 <= m < P.size - 1 and m <= i_min + 1:
+                rows.append((m, float(a[m - 1]), float(P[m - 1]), float(abs(P[m] - P[m - 1])),
+                             float(max(abs(P[m - 1] - P[m - 2]), abs(P[m + 1] - P[m])))))
+    return res, rows
+
+
 def _main(argv=None) -> None:
     import argparse
 
@@ -592,8 +632,24 @@ def _main(argv=None) -> None:
     for name in ("n", "k", "a0", "rate"):
         p.add_argument(f"--{name}", type=float, default=STUDY_SCENE[name],
                        help=f"the scene's {name} (default {STUDY_SCENE[name]:g})")
+    p.add_argument("--jumps", choices=("auto", "relaxed", "glassy", "traction"),
+                   help="instead of the study: the load at each re-meshing up to the "
+                        "pull-off with this state transfer (traction: the modes interpolated "
+                        "as tractions, as before the fix)")
     args = p.parse_args(argv)
     scene = {name: getattr(args, name) for name in STUDY_SCENE}
+    if args.jumps:
+        for mu in args.mu:
+            t0 = time.perf_counter()
+            res, rows = remesh_jumps(Scene(mu=mu, **scene), form=args.jumps)
+            print(f"mu {mu:g} {scene} transfer {args.jumps}: {res.status} pull-off "
+                  f"{res.pull_off:.6g}, {res.steps} steps, {res.nodes_used} nodes, "
+                  f"{time.perf_counter() - t0:.0f} s; {res.reason}")
+            for m, a, P, jump, typical in rows:
+                print(f"  re-meshing at a = {a:.4f}: P = {P:.5f}, jump {jump:.3g} = "
+                      f"{jump / abs(P):.2e} |P|, beyond the neighbouring steps' "
+                      f"{max(jump - typical, 0.0) / abs(P):.2e} |P|")
+        return
     print(f"scene {scene}, preset balanced; windows (ahead, behind) in l0")
     print(f"{'mu':>5} {'res':>4} {'ahead':>5} {'behind':>6} {'status':>6} {'pull_off':>9} "
           f"{'nodes':>5} {'meshes':>6} {'steps':>6} {'s':>6}")
