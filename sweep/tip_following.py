@@ -55,8 +55,14 @@ WINDOW_AHEAD_ZONES = 16.0
 WINDOW_BEHIND_ZONES = 8.0
 #: Newton tolerance (units of h0) of a first relaxed solve where the numerics' one stalls
 LOOSE_TOL = 1e-4
-#: time steps of the probe after which a run estimates what it still needs (:func:`_probe`)
+#: time steps of the probe after which a run first estimates what it still needs (then
+#: again after every chunk, :func:`_probe`)
 PROBE_STEPS = 200
+#: after the probe a run ends early on its time budget only when the estimated time it
+#: still needs exceeds the time left by this factor (the probe's cost per step includes the
+#: start's factorizations: 80 ms per step over the first 200 steps of mu = 30, a0 = 10,
+#: rate 1e-4); after later chunks by any factor (their cost per step is the run's)
+TIME_MARGIN = 2.0
 #: most meshes of one run (a run that needs more ends failed with the reason)
 MAX_MESHES = 5000
 #: a re-meshing up to the pull-off must leave the load continuous: the load change over the
@@ -382,30 +388,31 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
     return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
 
 
-def _probe(scene, numerics, run, delta0, a0, seconds, deadline) -> str:
-    """After the first PROBE_STEPS steps (``seconds`` of wall time): the reason to end the
-    run now when the least number of steps it still needs (:func:`estimate_steps`, with
-    indentation steps no larger than the probe's largest) exceeds max_steps or, at the
-    probe's cost per step, the time left before ``deadline``; else ""."""
+def _probe(scene, numerics, run, delta0, a0, per_step, margin, deadline) -> str:
+    """After a chunk of a run (the probe of PROBE_STEPS steps, then each chunk of at least
+    as many; ``per_step`` its wall time per step): the reason to end the run now when the
+    least number of steps it still needs (:func:`estimate_steps`, with indentation steps no
+    larger than the largest so far) exceeds max_steps or, at ``per_step``, takes more than
+    ``margin`` times the time left before ``deadline``; else ""."""
     n = run.n
     delta, a = run.records[1][:n], run.records[3][:n]
     if n < 3:
         return ""
     step = float(np.max(-np.diff(delta)))
     need = estimate_steps(scene, numerics, delta[-1], a[-1], delta0, a0, step)
-    per_step = seconds / (n - 1)
     total = n - 1 + need.steps
     if total > numerics.max_steps:
         return (f"too many steps: {need.describe()}, as the first {n - 1} steps took: about "
                 f"{total} steps > max_steps = {numerics.max_steps}; raise max_steps, or lower "
                 f"band_resolution, or use the crack-front model (model crack)")
     left = deadline - time.perf_counter()
-    if need.steps * per_step > left:
+    if need.steps * per_step > margin * left:
         return (f"time budget: needs at least {total} steps ({need.describe()}, as the first "
                 f"{n - 1} steps took) at {1e3 * per_step:.2g} ms per step on {run.h.size} "
-                f"nodes: about {need.steps * per_step:.0f} s more, > the {left:.0f} s left of "
-                f"time_budget_s = {numerics.time_budget_s:g}; raise time_budget_s, or lower "
-                f"band_resolution, or use the crack-front model (model crack)")
+                f"nodes: about {need.steps * per_step:.0f} s more, > {margin:g} x the "
+                f"{left:.0f} s left of time_budget_s = {numerics.time_budget_s:g}; raise "
+                f"time_budget_s, or lower band_resolution, or use the crack-front model "
+                f"(model crack)")
     return ""
 
 
@@ -497,20 +504,22 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     meshes, nodes = 1, pb.mesh.nodes
     remeshed_at = []
     rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
-    probing = True
     while True:
-        t_chunk = time.perf_counter()
+        probing, n_before, t_chunk = run.n <= 1, run.n, time.perf_counter()
         status = unload_chunk(pb, run, pb.tip_range, PROBE_STEPS if probing else CHUNK_STEPS)
         broken = _continuity(run, remeshed_at, rtol)
         if broken:
             break
-        if probing and status in (STATUS_LEFT_BAND, STATUS_STEP_LIMIT):
-            probing = False
-            refusal = _probe(scene, numerics, run, delta0, a_init,
-                             time.perf_counter() - t_chunk, deadline)
+        if (status in (STATUS_LEFT_BAND, STATUS_STEP_LIMIT)
+                and (probing or run.n - n_before >= PROBE_STEPS)):
+            per_step = (time.perf_counter() - t_chunk) / max(run.n - n_before, 1)
+            refusal = _probe(scene, numerics, run, delta0, a_init, per_step,
+                             TIME_MARGIN if probing else 1.0, deadline)
             if refusal:
                 res.reason = refusal
                 res.steps, res.nodes_used = run.n - 1, nodes
+                res.newton_iterations = int(run.stats[STAT_ITER])
+                res.factorizations = int(run.stats[STAT_FACTOR])
                 return res
         if status == STATUS_LEFT_BAND and meshes < MAX_MESHES:
             a = run.records[3]
