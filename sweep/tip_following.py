@@ -12,11 +12,14 @@ mesh is rebuilt when the tip leaves the window:
    room in the direction the tip moves (inward while the contact shrinks);
 2. the unloading kernel runs until the tip leaves the window less TIP_MARGIN_ZONES l0
    (``kernels.solve.STATUS_LEFT_BAND``);
-3. a new mesh is built with the window moved to the tip, the gap ``h`` and the Prony modal
-   state ``q`` are carried over (every mesh lies on the lattice of the fine spacing, so
-   nodes common to both meshes keep their values exactly; the others are interpolated by a
-   cubic spline, exact for the r^2/2 of the rigid profile), the records continue, and the
-   kernel resumes (:func:`sweep.solver.unload_chunk`).
+3. a new mesh is built with the window moved to the tip and the state is carried over
+   (:func:`transfer`): the gap ``h`` by a cubic spline (every mesh lies on the lattice of
+   the fine spacing, so nodes common to both meshes keep their values exactly), the Prony
+   modal state ``q`` as displacements (A (sigma - q_i), smooth, interpolated and mapped
+   back through the new influence matrix), then the gap is re-equilibrated on the new
+   mesh at frozen time; the records continue and the kernel resumes
+   (:func:`sweep.solver.unload_chunk`). Each re-meshing up to the pull-off must leave the
+   load continuous (:func:`remesh_jump`), else the run ends failed with the reason.
 
 The cost is set by the window (a few hundred nodes, whatever a0) and by the number of time
 steps (the tip moves at most ``da_max`` spacings per step); each new mesh costs one
@@ -31,13 +34,18 @@ import math
 import time
 
 import numpy as np
+import scipy.linalg
 from scipy.interpolate import CubicSpline
+from scipy.optimize import brentq
 
-from kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP_LIMIT,
-                           new_jacobian_cache)
+from kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
+                           STATUS_LEFT_BAND, STATUS_STEP_LIMIT, new_jacobian_cache, newton)
+from kernels.interface import lj_traction
 
 from .initial import ElasticSolver, relaxed_state
-from .problem import Refused, initial_estimates, prepare, tip_zone
+from . import units
+from .problem import (Refused, initial_estimates, jkr_radius, material_of, prepare,
+                      tip_zone)
 from .scene import Numerics, Result, Scene
 
 #: room for the tip in its direction of motion, in process zones l0 (the tip moves this far,
@@ -47,6 +55,14 @@ WINDOW_AHEAD_ZONES = 16.0
 WINDOW_BEHIND_ZONES = 8.0
 #: Newton tolerance (units of h0) of a first relaxed solve where the numerics' one stalls
 LOOSE_TOL = 1e-4
+#: time steps of the probe after which a run first estimates what it still needs (then
+#: again after every chunk, :func:`_probe`)
+PROBE_STEPS = 200
+#: after the probe a run ends early on its time budget only when the estimated time it
+#: still needs exceeds the time left by this factor (the probe's cost per step includes the
+#: start's factorizations: 80 ms per step over the first 200 steps of mu = 30, a0 = 10,
+#: rate 1e-4); after later chunks by any factor (their cost per step is the run's)
+TIME_MARGIN = 2.0
 #: most meshes of one run (a run that needs more ends failed with the reason)
 MAX_MESHES = 5000
 #: a re-meshing up to the pull-off must leave the load continuous: the load change over the
@@ -57,6 +73,8 @@ MAX_MESHES = 5000
 #: fine window is too coarse for the carried state, much more.)
 REMESH_JUMP_STEPS = 5.0
 REMESH_JUMP_RTOL = 1e-3
+#: Newton iterations of the re-equilibration after a state transfer (:func:`transfer`)
+REEQUILIBRATE_ITER = 30
 
 
 def remesh_jump(P: np.ndarray, m: int, rtol: float = REMESH_JUMP_RTOL) -> float | None:
@@ -90,12 +108,64 @@ def _continuity(run, remeshed_at: list, rtol: float) -> str:
     return ""
 
 
-def steps_needed(a0: float, spacing: float, da_max: float) -> int:
-    """Fewest time steps a run from the contact radius ``a0`` can take (the tip moves at
-    most ``da_max`` fine spacings per step): the tip recedes at least to max(0.6 a0, 1.2)
-    (pull-off radii: 0.42-0.53 a0 on the reference scenes, 1.04 in the elastic JKR limit)."""
-    travel = max(a0 - max(0.6 * a0, 1.2), 0.0)
-    return int(math.ceil(travel / (da_max * spacing)))
+def indentation_travel(scene: Scene, delta0: float) -> float:
+    """Least indentation travel (d_ref) of an unloading from ``delta0`` to the pull-off:
+    D = Cbar(D / (rate h0)) max(delta0, 0), with Cbar(t) = (1/t) int_0^t Chat the mean
+    compliance of a ramp of duration t (tau0).
+
+    Relaxed (slow) the indentation falls from delta0 to the relaxed pull-off, below 0 (JKR:
+    -0.51 at mu = 10); faster, the substrate answers a load change with less compliance, at
+    least Chat(0) = k, so the indentation travels less for the same loss of load (a frozen
+    contact, k = 1e-4 at rate 1e9: 0.028 of 220). Measured D / this estimate on eight
+    scenes at mu = 10-30 (k 1e-4 to 0.5, rates 1e-4 to 1e9): 1.005-1.61, never below 1.
+    """
+    full = max(delta0, 0.0)
+    if full == 0.0 or scene.k >= 1.0:
+        return full
+    h0 = units.h0_hat(scene.mu)
+    mat = material_of(scene)
+
+    def excess(D):
+        t = D / (scene.rate * h0)
+        return D - float(mat.integrated_compliance(t)) / t * full
+
+    return full if excess(full) <= 0.0 else float(brentq(excess, 1e-12 * full, full))
+
+
+@dataclasses.dataclass
+class StepEstimate:
+    """How many time steps a run needs at least, and why (see :func:`estimate_steps`)."""
+
+    steps: int
+    tip_travel: float         # a_ref, the crack tip's least recession
+    tip_steps: int            # at da_max fine spacings per step
+    travel: float             # d_ref, the indentation's least travel
+    step: float               # d_ref, the indentation step assumed
+    travel_steps: int
+
+    def describe(self) -> str:
+        return (f"the crack tip recedes at least {self.tip_travel:.3g} a_ref at most "
+                f"{self.tip_steps and self.tip_travel / self.tip_steps:.2g} per step "
+                f"({self.tip_steps} steps), the indentation falls at least {self.travel:.4g} "
+                f"d_ref by at most {self.step:.3g} per step ({self.travel_steps} steps)")
+
+
+def estimate_steps(scene: Scene, numerics: Numerics, delta: float, a: float,
+                   delta_start: float, a_start: float, step: float) -> StepEstimate:
+    """Least number of further time steps of a run now at indentation ``delta`` and
+    contact radius ``a`` that started at (``delta_start``, ``a_start``), with indentation
+    steps of at most ``step`` (d_ref): the indentation must fall to delta_start -
+    :func:`indentation_travel`, and the crack tip at least to the relaxed JKR radius there
+    (a frozen contact keeps its radius, a relaxed one follows JKR), at most ``da_max``
+    fine spacings per step."""
+    D = indentation_travel(scene, delta_start)
+    a_end = min(jkr_radius(delta_start - D), a_start)
+    tip = max(a - a_end, 0.0)
+    da = numerics.da_max * tip_zone(scene.mu) / numerics.band_resolution
+    rest = max(delta - (delta_start - D), 0.0)
+    tip_steps, travel_steps = int(math.ceil(tip / da)), int(math.ceil(rest / step))
+    return StepEstimate(steps=max(tip_steps, travel_steps), tip_travel=tip, tip_steps=tip_steps,
+                        travel=rest, step=step, travel_steps=travel_steps)
 
 
 def tip_window(tip: float, l0: float, ahead: float = WINDOW_AHEAD_ZONES,
@@ -110,17 +180,92 @@ def tip_window(tip: float, l0: float, ahead: float = WINDOW_AHEAD_ZONES,
     return max(lo, 0.0), hi
 
 
-def transfer(run, old_r: np.ndarray, new_r: np.ndarray) -> None:
-    """Carry the state of an unloading run (gap ``h``, Prony modes ``q``) from nodes
-    ``old_r`` to ``new_r`` in place, with a new Jacobian cache; records, step and counters
-    stay. A cubic spline interpolates (it returns the old values at common nodes)."""
+def transfer(run, old, new, form: str = "auto") -> None:
+    """Carry the state of an unloading run from the mesh of the prepared problem ``old`` to
+    that of ``new`` in place, with a new Jacobian cache; records, step and counters stay.
+
+    The displacement of an accepted state is u = A (sigma - sum_i c_i q_i) (docs/design.md
+    section 4; Prony modes q_i, traction sigma = sigma_LJ(h), sum_i c_i = 1 - k with
+    k = Chat(0)).
+
+    1. The gap ``h`` is interpolated by a cubic spline (exact at common nodes).
+    2. The modes are carried as displacements, which are smooth (the influence matrix
+       integrates): interpolated by a cubic spline and mapped back through the new
+       influence matrix. Interpolating q_i itself is wrong: the history keeps the sharp
+       traction of every cohesive zone the tip has passed, which the coarse mesh behind
+       the window samples at its nodes (n = 0.8, k = 0.1, a0 = 3, rate 10^2.5: the load
+       jumped by 29 % at mu = 15 and 124 % at mu = 30 at the first re-meshing).
+    3. The gap is re-equilibrated on the new mesh at frozen time; without it the kernel
+       takes the change from the interpolated to the equilibrium traction for the
+       traction increment of its first step (measured: a load jump of 2.3 %).
+
+    ``form`` says which part of the state is carried and how the traction adjusts:
+
+    * "relaxed": A q_i is carried, the traction adjusts with the relaxed compliance 1;
+    * "glassy": A (sigma - q_i) (the history mode i has forgotten) is carried, the
+      traction adjusts with the glassy compliance k and every mode takes the change (a
+      step of zero length of the kernel);
+    * "auto" (default): relaxed, else glassy where its Newton solve fails (a state beyond
+      the relaxed pull-off at a fold of the discrete path: n = 0.8, k = 0.1, a0 = 3, rate
+      10^2.5, mu = 30 stalled at 1.3e-4 h0 near the load minimum).
+
+    The two forms differ by how the discretization change of the current traction is
+    taken up: on that scene at mu = 6, 8 meshes of a narrow window, the pull-off is the
+    fixed band's to 1.4e-5 (relaxed) and 7.2e-5 (glassy); at mu = 15 and 30 the two agree
+    to 1e-5. Where neither converges the interpolated state is kept (relaxed form) and
+    the caller's load continuity check judges the result.
+    """
+    old_r, new_r = old.mesh.r, new.mesh.r
     h = CubicSpline(old_r, run.h)(new_r)
-    run.h = np.maximum(h, 0.5 * float(np.min(run.h)))
-    if run.q.shape[0] > 0:
-        run.q = np.ascontiguousarray(CubicSpline(old_r, run.q, axis=1)(new_r))
-    else:
-        run.q = np.zeros((0, new_r.size))
+    h = np.maximum(h, 0.5 * float(np.min(run.h)))
     run.cache = new_jacobian_cache(new_r.size)
+    if run.q.shape[0] == 0:
+        run.h, run.q = h, np.zeros((0, new_r.size))
+        return
+    sigma_old, sigma = np.empty(old_r.size), np.empty(new_r.size)
+    lj_traction(run.h, old.h0, old.c, sigma_old)
+    lj_traction(h, new.h0, new.c, sigma)
+    lu = scipy.linalg.lu_factor(new.A)
+
+    def carried(history):       # (M, N_old) tractions -> the same displacements, new mesh
+        U = CubicSpline(old_r, old.A @ history.T, axis=0)(new_r)
+        return scipy.linalg.lu_solve(lu, U).T
+
+    forms = ("relaxed", "glassy") if form == "auto" else (form,)
+    q_first = None
+    for name in forms:
+        if name == "relaxed":
+            q = np.ascontiguousarray(carried(run.q))
+        else:
+            q = np.ascontiguousarray(sigma[None, :] - carried(sigma_old[None, :] - run.q))
+        q_first = q if q_first is None else q_first
+        if run.n == 0:
+            break
+        if name == "relaxed":
+            ceff, H = 1.0, new.prony_weights @ q
+        else:
+            ceff = 1.0 - float(np.sum(new.prony_weights))           # Chat(0)
+            H = new.prony_weights @ q - np.sum(new.prony_weights) * sigma
+        h_eq = _reequilibrate(run, new, h, ceff, np.ascontiguousarray(H))
+        if h_eq is not None:
+            if name == "glassy":            # every mode takes the change of traction
+                sigma_eq = np.empty(new_r.size)
+                lj_traction(h_eq, new.h0, new.c, sigma_eq)
+                q += (sigma_eq - sigma)[None, :]
+            run.h, run.q = h_eq, q
+            return
+    run.h, run.q = h, q_first
+
+
+def _reequilibrate(run, new, h, ceff, H):
+    """The gap on the mesh of ``new`` in equilibrium with u = A (ceff sigma - H) at the
+    indentation of the last record (Newton from ``h``), or None if it does not converge."""
+    g = -float(run.records[1][run.n - 1]) + new.h0 + 0.5 * new.mesh.r**2
+    h_eq = h.copy()
+    stats = run.stats if run.stats is not None else np.zeros(N_STATS, dtype=np.int64)
+    ok = newton(h_eq, g, new.A, ceff, H, new.h0, new.c, new.numerics.tol * new.h0,
+                REEQUILIBRATE_ITER, *new_jacobian_cache(h.size), stats)
+    return h_eq if ok else None
 
 
 def branch_state(scene: Scene, band_resolution: float = 16.0, domain: float | None = None):
@@ -243,6 +388,34 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
     return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
 
 
+def _probe(scene, numerics, run, delta0, a0, per_step, margin, deadline) -> str:
+    """After a chunk of a run (the probe of PROBE_STEPS steps, then each chunk of at least
+    as many; ``per_step`` its wall time per step): the reason to end the run now when the
+    least number of steps it still needs (:func:`estimate_steps`, with indentation steps no
+    larger than the largest so far) exceeds max_steps or, at ``per_step``, takes more than
+    ``margin`` times the time left before ``deadline``; else ""."""
+    n = run.n
+    delta, a = run.records[1][:n], run.records[3][:n]
+    if n < 3:
+        return ""
+    step = float(np.max(-np.diff(delta)))
+    need = estimate_steps(scene, numerics, delta[-1], a[-1], delta0, a0, step)
+    total = n - 1 + need.steps
+    if total > numerics.max_steps:
+        return (f"too many steps: {need.describe()}, as the first {n - 1} steps took: about "
+                f"{total} steps > max_steps = {numerics.max_steps}; raise max_steps, or lower "
+                f"band_resolution, or use the crack-front model (model crack)")
+    left = deadline - time.perf_counter()
+    if need.steps * per_step > margin * left:
+        return (f"time budget: needs at least {total} steps ({need.describe()}, as the first "
+                f"{n - 1} steps took) at {1e3 * per_step:.2g} ms per step on {run.h.size} "
+                f"nodes: about {need.steps * per_step:.0f} s more, > {margin:g} x the "
+                f"{left:.0f} s left of time_budget_s = {numerics.time_budget_s:g}; raise "
+                f"time_budget_s, or lower band_resolution, or use the crack-front model "
+                f"(model crack)")
+    return ""
+
+
 def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
                            ahead: float = WINDOW_AHEAD_ZONES,
                            behind: float = WINDOW_BEHIND_ZONES) -> Result:
@@ -286,15 +459,15 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         numerics = dataclasses.replace(numerics, mesh="graded", exact=False)
     res = Result(scene=scene, numerics=numerics)
     l0 = tip_zone(scene.mu)
-    _, a_est, domain = initial_estimates(scene, numerics)
-    spacing = l0 / numerics.band_resolution
-    need = steps_needed(a_est, spacing, numerics.da_max)
-    if need > numerics.max_steps:
-        travel = a_est - max(0.6 * a_est, 1.2)
-        res.reason = (f"too many steps: the crack tip recedes at least {travel:.3g} a_ref at most"
-                      f" da_max = {numerics.da_max:g} fine spacings ({spacing:.2g}) "
-                      f"per step, > {need} steps (max_steps = {numerics.max_steps}); raise "
-                      f"max_steps, or lower band_resolution, or use the crack-front model")
+    d_est, a_est, domain = initial_estimates(scene, numerics)
+    # up front: the least steps of the run, with every step as large as the kernel's step
+    # control ever lets it grow
+    need = estimate_steps(scene, numerics, d_est, a_est, d_est, a_est,
+                          SMOOTH_STEP_FACTOR * numerics.step * units.h0_hat(scene.mu))
+    if need.steps > numerics.max_steps:
+        res.reason = (f"too many steps: {need.describe()}: > {need.steps} steps (max_steps = "
+                      f"{numerics.max_steps}); raise max_steps, or lower band_resolution, or use "
+                      f"the crack-front model (model crack)")
         return res
     try:
         branch = (branch_state(scene, numerics.band_resolution, domain) if scene.a0 is not None
@@ -332,10 +505,22 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     remeshed_at = []
     rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
     while True:
-        status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
+        probing, n_before, t_chunk = run.n <= 1, run.n, time.perf_counter()
+        status = unload_chunk(pb, run, pb.tip_range, PROBE_STEPS if probing else CHUNK_STEPS)
         broken = _continuity(run, remeshed_at, rtol)
         if broken:
             break
+        if (status in (STATUS_LEFT_BAND, STATUS_STEP_LIMIT)
+                and (probing or run.n - n_before >= PROBE_STEPS)):
+            per_step = (time.perf_counter() - t_chunk) / max(run.n - n_before, 1)
+            refusal = _probe(scene, numerics, run, delta0, a_init, per_step,
+                             TIME_MARGIN if probing else 1.0, deadline)
+            if refusal:
+                res.reason = refusal
+                res.steps, res.nodes_used = run.n - 1, nodes
+                res.newton_iterations = int(run.stats[STAT_ITER])
+                res.factorizations = int(run.stats[STAT_FACTOR])
+                return res
         if status == STATUS_LEFT_BAND and meshes < MAX_MESHES:
             a = run.records[3]
             direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1
@@ -345,7 +530,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
             except Refused as exc:
                 res.reason = f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"
                 return res
-            transfer(run, pb.mesh.r, new.mesh.r)
+            transfer(run, pb, new)
             remeshed_at.append(run.n)
             pb, meshes, nodes = new, meshes + 1, max(nodes, new.mesh.nodes)
         elif status == STATUS_STEP_LIMIT and run.n <= numerics.max_steps:
@@ -406,6 +591,46 @@ def convergence_study(mu: float, resolutions=STUDY_RESOLUTIONS, windows=STUDY_WI
     return rows
 
 
+def interpolate_as_traction(run, old, new) -> None:
+    """The state transfer before the modes were carried as displacements (for comparison
+    only): the gap and each Prony mode interpolated by a cubic spline, no re-equilibration."""
+    run.h = np.maximum(CubicSpline(old.mesh.r, run.h)(new.mesh.r), 0.5 * float(np.min(run.h)))
+    run.q = np.ascontiguousarray(CubicSpline(old.mesh.r, run.q, axis=1)(new.mesh.r))
+    run.cache = new_jacobian_cache(new.mesh.nodes)
+
+
+def remesh_jumps(scene: Scene, numerics: Numerics | None = None, form: str = "auto",
+                 ahead: float = WINDOW_AHEAD_ZONES, behind: float = WINDOW_BEHIND_ZONES):
+    """Run a scene and measure the load at each re-meshing up to the pull-off: (result,
+    rows of (record m, contact radius, P before, |jump|, the larger change over the
+    neighbouring steps)). ``form``: that of :func:`transfer`, or "traction"
+    (:func:`interpolate_as_traction`)."""
+    global transfer
+    marks, carry = [], transfer
+
+    def recording(run, old, new):
+        marks.append(run.n)
+        if form == "traction":
+            interpolate_as_traction(run, old, new)
+        else:
+            carry(run, old, new, form=form)
+
+    transfer = recording
+    try:
+        res = simulate_tip_following(scene, numerics, ahead, behind)
+    finally:
+        transfer = carry
+    rows = []
+    if res.trajectory:
+        P, a = res.trajectory["P"], res.trajectory["a"]
+        i_min = int(np.argmin(P))
+        for m in marks:
+            if 2 <= m < P.size - 1 and m <= i_min + 1:
+                rows.append((m, float(a[m - 1]), float(P[m - 1]), float(abs(P[m] - P[m - 1])),
+                             float(max(abs(P[m - 1] - P[m - 2]), abs(P[m + 1] - P[m])))))
+    return res, rows
+
+
 def _main(argv=None) -> None:
     import argparse
 
@@ -413,8 +638,28 @@ def _main(argv=None) -> None:
                                 description="convergence of the tip-following BEM")
     p.add_argument("--mu", type=float, nargs="+", default=[30.0, 100.0])
     p.add_argument("--resolutions", type=float, nargs="+", default=list(STUDY_RESOLUTIONS))
+    for name in ("n", "k", "a0", "rate"):
+        p.add_argument(f"--{name}", type=float, default=STUDY_SCENE[name],
+                       help=f"the scene's {name} (default {STUDY_SCENE[name]:g})")
+    p.add_argument("--jumps", choices=("auto", "relaxed", "glassy", "traction"),
+                   help="instead of the study: the load at each re-meshing up to the "
+                        "pull-off with this state transfer (traction: the modes interpolated "
+                        "as tractions, as before the fix)")
     args = p.parse_args(argv)
-    print(f"scene {STUDY_SCENE}, preset balanced; windows (ahead, behind) in l0")
+    scene = {name: getattr(args, name) for name in STUDY_SCENE}
+    if args.jumps:
+        for mu in args.mu:
+            t0 = time.perf_counter()
+            res, rows = remesh_jumps(Scene(mu=mu, **scene), form=args.jumps)
+            print(f"mu {mu:g} {scene} transfer {args.jumps}: {res.status} pull-off "
+                  f"{res.pull_off:.6g}, {res.steps} steps, {res.nodes_used} nodes, "
+                  f"{time.perf_counter() - t0:.0f} s; {res.reason}")
+            for m, a, P, jump, typical in rows:
+                print(f"  re-meshing at a = {a:.4f}: P = {P:.5f}, jump {jump:.3g} = "
+                      f"{jump / abs(P):.2e} |P|, beyond the neighbouring steps' "
+                      f"{max(jump - typical, 0.0) / abs(P):.2e} |P|")
+        return
+    print(f"scene {scene}, preset balanced; windows (ahead, behind) in l0")
     print(f"{'mu':>5} {'res':>4} {'ahead':>5} {'behind':>6} {'status':>6} {'pull_off':>9} "
           f"{'nodes':>5} {'meshes':>6} {'steps':>6} {'s':>6}")
 
@@ -424,7 +669,7 @@ def _main(argv=None) -> None:
               f"{r['steps']:6d} {r['seconds']:6.1f}", flush=True)
 
     for mu in args.mu:
-        convergence_study(mu, tuple(args.resolutions), on_row=show)
+        convergence_study(mu, tuple(args.resolutions), on_row=show, **scene)
 
 
 if __name__ == "__main__":
