@@ -25,7 +25,7 @@ help:
 	@echo "make agreement - BEM vs crack-front model vs PB estimate (results/agreement/)"
 	@echo "make agreement-high-mu - its mu = 15 point (about 35 min), merged by make agreement"
 	@echo "make extremes [QUICK=1] - stability at the extremes of (n, k, rate, a0, mu)"
-	@echo "make tip-convergence - tip-following BEM: pull-off vs spacing and window, mu = 30, 100"
+	@echo "make tip-convergence - tip-following BEM: pull-off vs spacing and window, mu = 30, 100 (k = 0.5) and 30 (k = 0.1, rate 10^2.5)"
 	@echo "make elastic-table - elastic pull-off vs mu (0.01 ... 100), quasi-static branch"
 
 $(BIN)/python:
@@ -82,6 +82,7 @@ extremes: $(STAMP)
 
 tip-convergence: $(STAMP)
 	$(BIN)/python -m sweep.tip_following --mu 30 100
+	$(BIN)/python -m sweep.tip_following --mu 30 --k 0.1 --a0 3 --rate 316.227766
 
 elastic-table: $(STAMP)
 	$(BIN)/python -m sweep.quasistatic

@@ -138,14 +138,15 @@ class StepEstimate:
 
     steps: int
     tip_travel: float         # a_ref, the crack tip's least recession
-    tip_steps: int            # at da_max fine spacings per step
+    tip_step: float           # a_ref, the most it moves per step (da_max fine spacings)
+    tip_steps: int
     travel: float             # d_ref, the indentation's least travel
     step: float               # d_ref, the indentation step assumed
     travel_steps: int
 
     def describe(self) -> str:
         return (f"the crack tip recedes at least {self.tip_travel:.3g} a_ref at most "
-                f"{self.tip_steps and self.tip_travel / self.tip_steps:.2g} per step "
+                f"{self.tip_step:.2g} per step "
                 f"({self.tip_steps} steps), the indentation falls at least {self.travel:.4g} "
                 f"d_ref by at most {self.step:.3g} per step ({self.travel_steps} steps)")
 
@@ -164,8 +165,8 @@ def estimate_steps(scene: Scene, numerics: Numerics, delta: float, a: float,
     da = numerics.da_max * tip_zone(scene.mu) / numerics.band_resolution
     rest = max(delta - (delta_start - D), 0.0)
     tip_steps, travel_steps = int(math.ceil(tip / da)), int(math.ceil(rest / step))
-    return StepEstimate(steps=max(tip_steps, travel_steps), tip_travel=tip, tip_steps=tip_steps,
-                        travel=rest, step=step, travel_steps=travel_steps)
+    return StepEstimate(steps=max(tip_steps, travel_steps), tip_travel=tip, tip_step=da,
+                        tip_steps=tip_steps, travel=rest, step=step, travel_steps=travel_steps)
 
 
 def tip_window(tip: float, l0: float, ahead: float = WINDOW_AHEAD_ZONES,
