@@ -646,12 +646,12 @@ def bench_campaign(plan: BenchPlan) -> dict:
     """Scenes per minute of the campaign's numerics on a sample of its grid (every
     ``campaign_stride``-th scene), at -j1 and -j{jobs} with warm workers (a first, untimed
     sweep of the sample's first scenes starts them and loads their caches)."""
-    from .config import config_from_dict, load_config
+    from .config import config_from_dict
     from .scheduler import run_sweep
     from .solver import warm_up
     from .store import load
 
-    cfg = load_config(ROOT / plan.campaign)
+    cfg = load_config_path(plan.campaign)
     sub_cfg = campaign_subset(cfg, plan.campaign_stride)
     tasks = sub_cfg.tasks()
     n = len(tasks)

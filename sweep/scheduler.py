@@ -243,7 +243,7 @@ def estimated_cost(scene, numerics) -> float:
 
         _, a_est, _ = initial_estimates(scene, numerics)
         size = max(a_est, 0.0) / tip_zone(scene.mu)
-        slow = 1.0 + 2.0 / (1.0 + max(math.log10(scene.rate), 0.0)) if scene.rate > 0 else 3.0
+        slow = 1.0 + 2.0 / (1.0 + max(math.log10(scene.rate), 0.0))   # rate > 0 (Scene)
         cost = (1.0 + size) ** 2 * slow
         return cost if math.isfinite(cost) else 1.0
     except Exception:  # ordering is a heuristic: never let it stop a sweep
