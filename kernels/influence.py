@@ -104,6 +104,34 @@ def _piece(r, sa, sb, phi_a, phi_b, singular_at, xs_smooth, ws_smooth, xs_sing, 
 
 
 @njit(cache=True)
+def _entry(ext, i, j, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws_far):
+    """A_ij: the deflection at node i (radius ext[i]) of the hat of node j, whose vertices
+    are ext[j-1], ext[j], ext[j+1] (node 0: the half hat on [ext[0], ext[1]])."""
+    ri = ext[i]
+    val = 0.0
+    if j > 0:
+        sing = 0
+        if i == j:
+            sing = 1
+        elif i == j - 1:
+            sing = -1
+        if i == 0:
+            sing = 0
+        val += _piece(ri, ext[j - 1], ext[j], 0.0, 1.0, sing, xs_smooth, ws_smooth,
+                      xs_sing, ws_sing, xs_far, ws_far)
+    sing = 0
+    if i == j:
+        sing = -1
+    elif i == j + 1:
+        sing = 1
+    if i == 0:
+        sing = 0
+    val += _piece(ri, ext[j], ext[j + 1], 1.0, 0.0, sing, xs_smooth, ws_smooth,
+                  xs_sing, ws_sing, xs_far, ws_far)
+    return val
+
+
+@njit(cache=True)
 def influence_matrix_nodes(r, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws_far):
     """Influence matrix A (N x N) for the hats of arbitrary nodes 0 = r_0 < r_1 < ... .
 
@@ -120,29 +148,37 @@ def influence_matrix_nodes(r, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws
     ext[N] = 2.0 * r[N - 1] - r[N - 2]
     A = np.zeros((N, N))
     for i in range(N):
-        ri = ext[i]
         for j in range(N):
-            val = 0.0
-            if j > 0:
-                sing = 0
-                if i == j:
-                    sing = 1
-                elif i == j - 1:
-                    sing = -1
-                if i == 0:
-                    sing = 0
-                val += _piece(ri, ext[j - 1], ext[j], 0.0, 1.0, sing, xs_smooth, ws_smooth,
-                              xs_sing, ws_sing, xs_far, ws_far)
-            sing = 0
-            if i == j:
-                sing = -1
-            elif i == j + 1:
-                sing = 1
-            if i == 0:
-                sing = 0
-            val += _piece(ri, ext[j], ext[j + 1], 1.0, 0.0, sing, xs_smooth, ws_smooth,
-                          xs_sing, ws_sing, xs_far, ws_far)
-            A[i, j] = val
+            A[i, j] = _entry(ext, i, j, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far,
+                             ws_far)
+    return A
+
+
+@njit(cache=True)
+def unit_block_into(A, i0, i1, j0, j1, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far,
+                    ws_far):
+    """Fill A[i0:i1, j0:j1] with the unit-spacing influence matrix (r_j = j).
+
+    Its entries depend on i and j only (every hat of the lattice is a full unit hat but
+    node 0's), not on the size of the matrix, so a matrix can grow by blocks.
+    """
+    ext = np.arange(max(i1, j1) + 1).astype(np.float64)
+    for i in range(i0, i1):
+        for j in range(j0, j1):
+            A[i, j] = _entry(ext, i, j, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far,
+                             ws_far)
+
+
+def grow_unit(A_old: np.ndarray, N: int) -> np.ndarray:
+    """The unit-spacing matrix of size ``N`` from its leading block ``A_old`` (any size
+    <= N, may be read-only): only the new rows and columns are assembled."""
+    m = A_old.shape[0]
+    A = np.empty((N, N))
+    A[:m, :m] = A_old
+    rules = (GL16_X, GL16_W, GL32_X, GL32_W, GL8_X, GL8_W)
+    if m < N:
+        unit_block_into(A, 0, m, m, N, *rules)
+        unit_block_into(A, m, N, 0, N, *rules)
     return A
 
 

@@ -72,3 +72,48 @@ def test_graded_and_uniform_meshes_agree_at_the_same_spacing():
     u = simulate(scene, Numerics.preset("balanced", mesh="uniform", nodes=nodes, pull_off_rtol=0.0))
     assert g.ok and u.ok and g.nodes_used < 0.7 * u.nodes_used
     assert g.pull_off == pytest.approx(u.pull_off, rel=1e-4)
+
+
+def test_unit_matrix_grows_by_blocks_to_the_fully_assembled_one():
+    from kernels.influence import assemble_unit, grow_unit
+    full = assemble_unit(90)
+    grown = grow_unit(assemble_unit(37), 90)
+    np.testing.assert_array_equal(grown, full)        # the same quadrature, entry by entry
+    np.testing.assert_array_equal(grow_unit(np.zeros((0, 0)), 90), full)
+
+
+def test_unit_matrix_disk_cache_is_written_reused_and_survives_a_bad_file(tmp_path,
+                                                                         monkeypatch):
+    from kernels.influence import assemble_unit
+    from sweep import mesh
+    monkeypatch.setenv(mesh.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(mesh, "UNIT_BLOCK", 32)
+    monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])
+    a = np.array(mesh.unit_influence(40))
+    np.testing.assert_array_equal(a, assemble_unit(64)[:40, :40])
+    files = sorted(tmp_path.glob("unit_influence_*_64.npy"))
+    assert len(files) == 1
+    # a new process (empty memory) reads it back instead of assembling: poison the
+    # assembly to prove it is not called
+    monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])
+    monkeypatch.setattr(mesh, "grow_unit", lambda *a: (_ for _ in ()).throw(AssertionError))
+    np.testing.assert_array_equal(mesh.unit_influence(50), assemble_unit(64)[:50, :50])
+    # growing past the cached size starts from the cached block, replaces the file
+    monkeypatch.undo()
+    monkeypatch.setenv(mesh.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(mesh, "UNIT_BLOCK", 32)
+    monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])
+    np.testing.assert_array_equal(mesh.unit_influence(70), assemble_unit(96)[:70, :70])
+    assert [p.name.rsplit("_", 1)[1] for p in tmp_path.glob("unit_influence_*.npy")] == \
+        ["96.npy"]
+    # a damaged file is ignored (assembled again, and rewritten)
+    bad = next(tmp_path.glob("unit_influence_*.npy"))
+    bad.write_bytes(b"not a matrix")
+    monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])
+    np.testing.assert_array_equal(mesh.unit_influence(20), assemble_unit(32)[:20, :20])
+    # switched off: nothing written
+    off = tmp_path / "off"
+    monkeypatch.setenv(mesh.CACHE_ENV, "off")
+    monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])
+    mesh.unit_influence(20)
+    assert mesh.cache_dir() is None and not off.exists()
