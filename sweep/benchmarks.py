@@ -398,8 +398,11 @@ class BenchPlan:
     vs_numpy_scenes: dict = field(default_factory=lambda: dict(VS_NUMPY_SCENES))
     engine_numerics: dict = field(default_factory=lambda: {
         "fast": {"preset": "fast"}, "balanced": {"preset": "balanced"}})
-    plain_ladder: tuple = ((150, 0.25), (250, 0.25), (250, 0.1), (400, 0.1), (600, 0.1),
-                           (600, 0.05), (900, 0.05))
+    #: the plain solver's (N, step) runs in order of cost; the denser the ladder, the
+    #: tighter the bound ``ratio`` (intermediate rungs added in session 16: 200, 300, 500, 750)
+    plain_ladder: tuple = ((150, 0.25), (200, 0.25), (250, 0.25), (250, 0.1), (300, 0.1),
+                           (400, 0.1), (500, 0.1), (600, 0.1), (500, 0.05), (600, 0.05),
+                           (750, 0.05), (900, 0.05))
     plain_time_limit_s: float = 90.0
     reference_fallback: dict | None = None
     repeat: int = 2
@@ -694,6 +697,28 @@ def _bracket(engine_err: float, plain_rows: list[dict]) -> dict:
             "better": min(better, key=lambda r: r["wall_s"]) if better else None}
 
 
+def plain_time_at(engine_err: float, plain_rows: list[dict]) -> float | None:
+    """The plain solver's time at exactly the engine's error, interpolated (log time linear
+    in log error) between the two neighbouring runs of its time/error frontier (the runs
+    that no cheaper run beats in accuracy); None when no run of the ladder is at least as
+    accurate, or none is as inaccurate (no bracket, nothing to interpolate)."""
+    ok = sorted((r for r in plain_rows if r["status"] == "ok"
+                 and math.isfinite(r["err_pull_off"]) and r["err_pull_off"] > 0.0),
+                key=lambda r: r["wall_s"])
+    frontier = []
+    for r in ok:
+        if not frontier or r["err_pull_off"] < frontier[-1]["err_pull_off"]:
+            frontier.append(r)
+    for lo, hi in zip(frontier, frontier[1:]):        # lo cheaper and less accurate
+        e1, e2 = lo["err_pull_off"], hi["err_pull_off"]
+        if e1 >= engine_err >= e2:
+            if e1 == e2:
+                return lo["wall_s"]
+            f = math.log(e1 / engine_err) / math.log(e1 / e2)
+            return math.exp(math.log(lo["wall_s"]) + f * math.log(hi["wall_s"] / lo["wall_s"]))
+    return None
+
+
 def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
     """Engine vs the plain numpy solver (:mod:`sweep.plain_solver`) on the issue's scenes.
 
@@ -703,7 +728,9 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
     solver climbs its ladder of (N, step) until it is more accurate than every engine
     configuration (or a run exceeds ``plain_time_limit_s``). ``ratio`` = plain time at equal
     or worse error / engine time: a lower bound of the speed-up at equal accuracy;
-    ``ratio_better`` uses the cheapest plain run at least as accurate (an upper estimate).
+    ``ratio_better`` uses the cheapest plain run at least as accurate (an upper estimate);
+    ``ratio_interpolated`` the plain time interpolated to the engine's error on the plain
+    solver's time/error frontier (:func:`plain_time_at`), the estimate at equal accuracy.
     """
     from .plain_solver import plain_unload
     from .scene import Numerics, Scene
@@ -748,6 +775,9 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
             e["plain_better"] = bt
             e["ratio"] = w["wall_s"] / e["wall_s"] if w else None
             e["ratio_better"] = bt["wall_s"] / e["wall_s"] if bt else None
+            t_eq = plain_time_at(e["err_pull_off"], plain)
+            e["plain_s_interpolated"] = t_eq
+            e["ratio_interpolated"] = t_eq / e["wall_s"] if t_eq else None
         out[name] = {"scene": sdict, "reference": {k: ref.get(k) for k in (
                          "pull_off", "source", "uncertainty_pull_off", "domain")},
                      "engine": engine, "plain_ladder": plain}
@@ -792,7 +822,8 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     report["vs_numpy"] = {name: {label: {"engine_s": e["wall_s"], "engine_err": e["err_pull_off"],
                                          "numpy_s": (e["plain_equal_or_worse"] or {}).get("wall_s"),
                                          "numpy_err": (e["plain_equal_or_worse"] or {}).get("err_pull_off"),
-                                         "ratio": e["ratio"]}
+                                         "ratio": e["ratio"],
+                                         "ratio_interpolated": e["ratio_interpolated"]}
                                  for label, e in d["engine"].items()}
                          for name, d in vs.items()}
     report["vs_numpy_detail"] = vs
@@ -819,7 +850,10 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
                     "warm) and relative pull-off error vs the scene's converged reference; "
                     "the plain numpy solver's most accurate ladder run whose error is still "
                     ">= the engine's (numpy_s, numpy_err); ratio = numpy_s / engine_s, a lower "
-                    "bound of the speed-up at equal accuracy (details: vs_numpy_detail)",
+                    "bound of the speed-up at equal accuracy; ratio_interpolated = the plain "
+                    "time interpolated (log-log) to the engine's error on the plain solver's "
+                    "time/error frontier, over engine_s: the estimate at equal accuracy "
+                    "(details: vs_numpy_detail)",
     }
     return report
 

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from sweep import Numerics, Scene, simulate
-from sweep.benchmarks import ROOT, BenchPlan, _bracket, bench_all, campaign_sample
+from sweep.benchmarks import (ROOT, BenchPlan, _bracket, bench_all, campaign_sample,
+                              plain_time_at)
 from sweep.config import load_config
 from sweep.plain_solver import plain_unload
 from sweep.tradeoff import (PRESETS, grid, numerics_fields, pareto_front, plot_pareto,
@@ -45,6 +46,20 @@ def test_bracket_picks_plain_runs_on_either_side_of_the_engine_error():
     assert b["better"]["err_pull_off"] == 2e-4             # cheapest below
     assert _bracket(1e-6, rows)["better"] is None
     assert _bracket(1e-2, rows)["equal_or_worse"] is None
+
+
+def test_plain_time_is_interpolated_on_the_frontier_of_the_plain_runs():
+    rows = [{"status": "ok", "err_pull_off": e, "wall_s": w}
+            for e, w in ((5e-3, 0.1), (1e-3, 0.5), (2e-3, 0.7), (2e-4, 2.0), (5e-5, 9.0))]
+    rows.append({"status": "failed", "err_pull_off": math.inf, "wall_s": 0.01})
+    # on a run: its time; between 1e-3 (0.5 s) and 2e-4 (2 s), a power law: at the
+    # geometric mean of the errors, the geometric mean of the times
+    assert plain_time_at(1e-3, rows) == pytest.approx(0.5)
+    assert plain_time_at(math.sqrt(1e-3 * 2e-4), rows) == pytest.approx(1.0)
+    # the dominated run (2e-3 at 0.7 s, worse and slower than 1e-3 at 0.5 s) is not used:
+    # between 5e-3 and 1e-3 the law through (0.1, 0.5) gives 0.1 * 5**(log(2.5)/log(5))
+    assert plain_time_at(2e-3, rows) == pytest.approx(0.1 * 2.5)
+    assert plain_time_at(1e-5, rows) is None and plain_time_at(1e-2, rows) is None
 
 
 def test_suggested_presets_are_cheapest_under_each_worst_case_target():
