@@ -17,17 +17,17 @@ uniform mesh scales the cached unit-spacing matrix.
 """
 from __future__ import annotations
 
-import hashlib
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+import kernels.influence
 from kernels.influence import (assemble_nodes, combine_lattice_hats, grow_unit,
                                load_weights_nodes)
+
+from . import diskcache
 
 #: the crack band reaches this fraction of a0 inward (pull-off radii measured on the
 #: reference scenes are 0.42-0.53 a0; the elastic limit is 1.145 a_ref) ...
@@ -184,38 +184,17 @@ UNIT_BLOCK = 256
 #: the unit-spacing matrix of the whole lattice, whose assembly costs about 3.5 us per entry
 #: (15 s at 2048, 2 min at 6000); it is assembled once per machine (see unit_influence)
 LATTICE_MAX_WIDTH = 2048
-#: environment variable naming the directory of the on-disk cache of the unit-spacing
-#: matrix; "off" keeps it in memory only. Default: $XDG_CACHE_HOME/viscoadhesion-sweep
-#: (~/.cache/viscoadhesion-sweep)
-CACHE_ENV = "SWEEP_CACHE_DIR"
 _UNIT = [np.zeros((0, 0))]
 _MESH_CACHE: dict = {}
 _MESH_CACHE_SIZE = 32
 
 
-def cache_dir() -> Path | None:
-    """Directory of the on-disk unit-matrix cache, or None when disabled (``SWEEP_CACHE_DIR
-    =off``)."""
-    env = os.environ.get(CACHE_ENV, "").strip()
-    if env.lower() == "off":
-        return None
-    if env:
-        return Path(env)
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "viscoadhesion-sweep"
-
-
-def _quadrature_tag() -> str:
-    """A tag of the assembly code: the cached matrices are those of this exact source of
-    kernels/influence.py (an edit there makes them stale and they are assembled again)."""
-    import kernels.influence as ki
-    return hashlib.sha1(Path(ki.__file__).read_bytes()).hexdigest()[:12]
-
-
-def _cached_unit_files(d: Path) -> list:
-    """[(size, path)] of the cache's unit matrices of this source, largest first."""
+def _unit_files(d: Path) -> list:
+    """[(size, path)] of the cached unit matrices of this kernels/influence.py, largest
+    first."""
+    tag = diskcache.source_tag(kernels.influence.__file__)
     out = []
-    for p in d.glob(f"unit_influence_{_quadrature_tag()}_*.npy"):
+    for p in d.glob(f"unit_influence_{tag}_*.npy"):
         try:
             out.append((int(p.stem.rsplit("_", 1)[1]), p))
         except ValueError:
@@ -223,32 +202,13 @@ def _cached_unit_files(d: Path) -> list:
     return sorted(out, reverse=True)
 
 
-def _load_unit(path: Path, size: int):
-    """The cached matrix at ``path`` (memory-mapped, read-only), or None when unreadable."""
-    try:
-        A = np.load(path, mmap_mode="r")
-    except (OSError, ValueError):
-        return None
-    return A if A.shape == (size, size) and A.dtype == np.float64 else None
-
-
 def _save_unit(d: Path, A: np.ndarray) -> None:
-    """Write ``A`` to the cache atomically (temporary file, then os.replace); never raises:
-    a read-only or full disk only means the next process assembles it again."""
-    try:
-        d.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
-        with os.fdopen(fd, "wb") as fh:
-            np.save(fh, A)
-        os.replace(tmp, d / f"unit_influence_{_quadrature_tag()}_{A.shape[0]}.npy")
-        for size, p in _cached_unit_files(d):     # the smaller ones are its leading blocks
+    """Cache ``A``; the smaller cached matrices, its leading blocks, are removed."""
+    tag = diskcache.source_tag(kernels.influence.__file__)
+    if diskcache.save(d / f"unit_influence_{tag}_{A.shape[0]}.npy", {"a": A}):
+        for size, p in _unit_files(d):
             if size < A.shape[0]:
                 p.unlink(missing_ok=True)
-    except OSError:
-        try:
-            os.unlink(tmp)
-        except (OSError, UnboundLocalError):
-            pass
 
 
 def unit_influence(N: int) -> np.ndarray:
@@ -256,18 +216,18 @@ def unit_influence(N: int) -> np.ndarray:
 
     Its entries do not depend on the matrix size (the last node has a full hat), so one
     matrix, grown in blocks of UNIT_BLOCK nodes (only the new rows and columns are
-    assembled), serves every mesh of the process. It is kept on disk too (:func:`cache_dir`,
+    assembled), serves every mesh of the process. It is kept on disk too (:mod:`sweep.diskcache`,
     memory-mapped, so that the workers of a sweep share one copy and a new process does not
     assemble it again); the file name carries a hash of kernels/influence.py.
     """
     if _UNIT[0].shape[0] < N:
         size = UNIT_BLOCK * int(math.ceil(N / UNIT_BLOCK))
-        d = cache_dir()
+        d = diskcache.cache_dir()
         start = _UNIT[0]
         if d is not None:
-            for cached, path in _cached_unit_files(d):
-                A = _load_unit(path, cached)
-                if A is None:
+            for cached, path in _unit_files(d):
+                A = diskcache.load(path, mmap=True)
+                if A is None or A.shape != (cached, cached) or A.dtype != np.float64:
                     continue
                 if cached >= size:
                     _UNIT[0] = A

@@ -12,10 +12,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
-from . import units
+from . import diskcache, units
+from .materials.prony_series import PronySeries
 from .mesh import Mesh, scene_mesh
 from .scene import Numerics, Scene
 from .theory import jkr_contact_radius
@@ -111,11 +113,46 @@ def time_window(scene: Scene, numerics: Numerics, delta0: float) -> tuple[float,
 def prony_series(kind: str, n: float, k: float, t_min: float, t_max: float, rtol: float):
     """The Prony series of a material's creep compliance on [t_min, t_max] (tau0), cached.
 
-    A fit costs 0.02-0.2 s, more than a fast scene's unloading; the scenes of a sweep
-    repeat the same (material, n, k) and, through the snapped :func:`time_window`, the
-    same window, so each worker fits each series once.
+    A fit costs 0.02-0.2 s (about 60 ms on the threshold campaign), more than a fast
+    scene's unloading; the scenes of a sweep repeat the same (material, n, k) and, through
+    the snapped :func:`time_window`, the same window (156 windows for the 936 scenes of
+    configs/threshold.yaml). Each fit is kept in memory and on disk
+    (:mod:`sweep.diskcache`, keyed by its arguments and a hash of sweep/materials), so a
+    worker or a later sweep reads it instead of fitting it again.
     """
-    return material(kind, n, k).prony(t_min, t_max, rtol)
+    key = (kind, float(n), float(k), float(t_min), float(t_max), float(rtol))
+    d = diskcache.cache_dir()
+    path = None
+    if d is not None:
+        path = d / f"prony_{_materials_tag()}_{diskcache.key_digest(key)}.npz"
+        got = diskcache.load(path)
+        if got is not None and _PRONY_FIELDS <= set(got) and tuple(got["key"]) == key[1:] \
+                and str(got["kind"]) == kind:
+            return PronySeries(weights=got["weights"], times=got["times"],
+                               max_rel_error=float(got["max_rel_error"]),
+                               rtol=float(got["rtol"]), converged=bool(got["converged"]),
+                               k=float(got["k"]), t_min=float(got["t_min"]),
+                               t_max=float(got["t_max"]))
+    series = material(kind, n, k).prony(t_min, t_max, rtol)
+    if path is not None:
+        diskcache.save(path, {"kind": np.array(kind), "key": np.array(key[1:]),
+                              "weights": series.weights, "times": series.times,
+                              **{f: np.array(getattr(series, f)) for f in (
+                                  "max_rel_error", "rtol", "converged", "k", "t_min",
+                                  "t_max")}})
+    return series
+
+
+_PRONY_FIELDS = {"kind", "key", "weights", "times", "max_rel_error", "rtol", "converged", "k",
+                 "t_min", "t_max"}
+
+
+def _materials_tag() -> str:
+    """Hash of the material and fitting code (sweep/materials/*.py): a cached series is
+    used only with the code that fitted it."""
+    from . import materials
+    folder = Path(materials.__file__).parent
+    return diskcache.source_tag(*sorted(str(p) for p in folder.glob("*.py")))
 
 
 @dataclass(frozen=True)

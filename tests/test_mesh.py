@@ -85,8 +85,8 @@ def test_unit_matrix_grows_by_blocks_to_the_fully_assembled_one():
 def test_unit_matrix_disk_cache_is_written_reused_and_survives_a_bad_file(tmp_path,
                                                                          monkeypatch):
     from kernels.influence import assemble_unit
-    from sweep import mesh
-    monkeypatch.setenv(mesh.CACHE_ENV, str(tmp_path))
+    from sweep import diskcache, mesh
+    monkeypatch.setenv(diskcache.CACHE_ENV, str(tmp_path))
     monkeypatch.setattr(mesh, "UNIT_BLOCK", 32)
     monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])
     a = np.array(mesh.unit_influence(40))
@@ -100,7 +100,7 @@ def test_unit_matrix_disk_cache_is_written_reused_and_survives_a_bad_file(tmp_pa
     np.testing.assert_array_equal(mesh.unit_influence(50), assemble_unit(64)[:50, :50])
     # growing past the cached size starts from the cached block, replaces the file
     monkeypatch.undo()
-    monkeypatch.setenv(mesh.CACHE_ENV, str(tmp_path))
+    monkeypatch.setenv(diskcache.CACHE_ENV, str(tmp_path))
     monkeypatch.setattr(mesh, "UNIT_BLOCK", 32)
     monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])
     np.testing.assert_array_equal(mesh.unit_influence(70), assemble_unit(96)[:70, :70])
@@ -113,7 +113,7 @@ def test_unit_matrix_disk_cache_is_written_reused_and_survives_a_bad_file(tmp_pa
     np.testing.assert_array_equal(mesh.unit_influence(20), assemble_unit(32)[:20, :20])
     # switched off: nothing written
     off = tmp_path / "off"
-    monkeypatch.setenv(mesh.CACHE_ENV, "off")
+    monkeypatch.setenv(diskcache.CACHE_ENV, "off")
     monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])
     mesh.unit_influence(20)
-    assert mesh.cache_dir() is None and not off.exists()
+    assert diskcache.cache_dir() is None and not off.exists()
