@@ -221,7 +221,7 @@ SCENE_LIMITS = {a.name: a.limits for a in AXES.values() if a.limits}
 PRESETS = {
     "fast": dict(mesh="graded", band_resolution=9.0, grading=1.1, step=0.25, da_max=1.0,
                  prony_rtol=1e-3, tol=1e-6, pull_off_rtol=0.03, max_nodes=400),
-    "balanced": dict(mesh="graded", band_resolution=16.0, grading=1.1, step=0.1, da_max=0.5,
+    "balanced": dict(mesh="graded", band_resolution=16.0, grading=1.1, step=0.1, da_max=0.6,
                      prony_rtol=1e-4, tol=1e-7, pull_off_rtol=0.01, max_nodes=1000),
     "accurate": dict(mesh="graded", band_resolution=36.0, grading=1.05, step=0.05, da_max=0.25,
                      prony_rtol=1e-6, tol=1e-9, pull_off_rtol=0.003, max_nodes=2500),
