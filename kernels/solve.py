@@ -8,10 +8,12 @@ where A is the influence matrix (already scaled by the node spacing), sigma the
 Lennard-Jones law and (C_eff, H) the hereditary-integral coefficients of the step.
 
 Newton's Jacobian J = I - C_eff A diag(sigma'(h)) is factorized on the interacting nodes
-only and kept from step to step, corrected by low rank where the stiffness moved
-(:mod:`kernels.jacobian`); it is refactorized when the corrections outgrow their cache,
-when an iteration contracts the residual poorly, or when a line search fails with a
-stale factorization. The line search (on |F|_2) keeps every gap positive.
+and kept from step to step, exact in the crack-tip zone (its Schur complement refreshed as
+the stiffness there moves) and as factorized in the contact interior (:mod:`kernels.jacobian`);
+it is refactorized when the crack tip leaves the zone, when an iteration contracts the
+residual by less than SLOW_CONTRACTION, when a line search fails with a stale factorization,
+and at every iteration of the retries of a step whose solve failed. The line search (on
+|F|_2) keeps every gap positive.
 
 On a coarse mesh the discrete equilibrium path can fold (the crack tip snaps from node to
 node); the loop then looks for the snapped state (:func:`snap`, :func:`relax`).
@@ -29,8 +31,8 @@ from numba import njit
 from .history import history_vector, step_coefficients, update_modes
 from .interface import crossing_radius, lj_traction, lj_traction_and_stiffness
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
-from .jacobian import (STATE_VALID, factorize, invalidate, new_jacobian_cache,  # noqa: F401
-                       newton_direction)
+from .jacobian import (STATE_EXACT, STATE_VALID, factorize, invalidate,  # noqa: F401
+                       new_jacobian_cache, newton_direction)
 
 STATUS_DONE = 0
 STATUS_NEWTON_FAILED = 1
@@ -43,18 +45,21 @@ STAT_ITER = 0                 # Newton iterations
 STAT_FACTOR = 1               # factorizations (restricted base or dense fallback)
 STAT_REJECTED = 2             # steps rejected by the step control
 STAT_FAILED_SOLVES = 3        # Newton solves that did not converge
-STAT_COLUMNS = 4              # low-rank correction columns J_b^-1 A[:, i]
-STAT_REFACTOR_OVERFLOW = 5    # refactorizations: the corrections outgrew the cache
+STAT_ZONE = 4                 # refactorizations of the crack-tip zone's Schur complement
+STAT_REFACTOR_ZONE = 5        # refactorizations: the crack tip left the zone
 STAT_REFACTOR_LINESEARCH = 6  # refactorizations: a line search failed with a stale base
 STAT_JUMPS = 7                # folds of the discrete path (snap / relax)
 STAT_SUBSET = 8               # sum of |S| (factorized nodes) over the factorizations
 STAT_RESIDUALS = 9            # residual evaluations (one N x N mat-vec each)
 STAT_REFACTOR_SLOW = 10       # refactorizations: an iteration contracted poorly
-N_STATS = 11
+STAT_REFACTOR_RETRY = 11      # refactorizations: exact Newton on the retry of a failed step
+N_STATS = 12
 
 #: an iteration with a stale factorization that reduces |F|_2 by less than this factor
-#: refactorizes before the next one
-SLOW_CONTRACTION = 0.5
+#: refactorizes before the next one (fresh, the chord iteration contracts by 1e-4 to 1e-3 on
+#: the reference scenes; 0.5 let it crawl at 0.46 for ten iterations; 0.1 and 0.03 cost
+#: the same on the vs-numpy scenes, 0.03 refactorizes 5x more on the fast n = 0.4 one)
+SLOW_CONTRACTION = 0.1
 
 #: the pull-off is past once the load has recovered by this fraction of |P_min| ...
 RECOVERY = 0.05
@@ -132,8 +137,10 @@ def _norm2(F):
 
 
 @njit(cache=True)
-def _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats, reason):
-    m = factorize(h, A, ceff, h0, c, factor, e_base, slot_of, state)
+def _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E, base_nodes,
+                 pivots, state, stats, reason):
+    m = factorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E, base_nodes,
+                  pivots, state)
     stats[STAT_FACTOR] += 1
     stats[STAT_SUBSET] += m
     if reason >= 0:
@@ -141,14 +148,15 @@ def _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats, reaso
 
 
 @njit(cache=True)
-def newton(h, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, node_of,
-           state, params, capacitance, e_corr, stats):
+def newton(h, g, A, ceff, H, h0, c, tol, max_iter, base, zone_cols, zone_rows,
+           coupling, schur, E, base_nodes, pivots, state, stats):
     """Solve F(h) = 0 in place, starting from ``h``. Returns True on convergence.
 
     The Jacobian factorization in the cache (:func:`kernels.jacobian.new_jacobian_cache`)
-    is reused and corrected (:func:`kernels.jacobian.newton_direction`); it is rebuilt when
-    too many nodes need a correction, when a stale one contracts the residual by less than
-    SLOW_CONTRACTION, or when a line search fails with a stale one.
+    is reused, its crack-tip zone kept exact (:func:`kernels.jacobian.newton_direction`); it
+    is rebuilt when the crack tip left the zone, when a stale one contracts the residual by
+    less than SLOW_CONTRACTION, when a line search fails with a stale one, and at every
+    iteration while ``state[STATE_EXACT]`` is set.
     """
     N = h.size
     sig = np.empty(N)
@@ -163,19 +171,25 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, n
         return True
     fresh = False
     if state[STATE_VALID] == 0:
-        _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats, -1)
+        _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
+                     base_nodes, pivots, state, stats, -1)
         fresh = True
     for it in range(max_iter):
         stats[STAT_ITER] += 1
-        lj_traction_and_stiffness(h, h0, c, sig, d)
-        dh, ok = newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of, state,
-                                  params, capacitance, e_corr, stats, STAT_COLUMNS)
-        if not ok:
-            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
-                         STAT_REFACTOR_OVERFLOW)
+        if state[STATE_EXACT] == 1 and not fresh:
+            _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
+                         base_nodes, pivots, state, stats, STAT_REFACTOR_RETRY)
             fresh = True
-            dh, ok = newton_direction(F, d, A, ceff, factor, e_base, W, slot_of, node_of,
-                                      state, params, capacitance, e_corr, stats, STAT_COLUMNS)
+        lj_traction_and_stiffness(h, h0, c, sig, d)
+        dh, ok = newton_direction(F, d, A, ceff, base, zone_cols, zone_rows, coupling, schur, E,
+                                  base_nodes, pivots, state, stats, STAT_ZONE)
+        if not ok:
+            _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
+                         base_nodes, pivots, state, stats,
+                         STAT_REFACTOR_ZONE)
+            fresh = True
+            dh, ok = newton_direction(F, d, A, ceff, base, zone_cols, zone_rows, coupling, schur,
+                                      E, base_nodes, pivots, state, stats, STAT_ZONE)
             if not ok:       # singular even on a fresh factorization: give up
                 return False
         lam = positive_step(h, dh)
@@ -197,7 +211,8 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, n
         if not accepted:
             if fresh:        # a line search failed on an exact Jacobian: give up
                 return False
-            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
+            _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
+                         base_nodes, pivots, state, stats,
                          STAT_REFACTOR_LINESEARCH)
             fresh = True
             continue
@@ -208,7 +223,8 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, n
         if norm <= tol:
             return True
         if not fresh and nt2 > SLOW_CONTRACTION * n2:
-            _refactorize(h, A, ceff, h0, c, factor, e_base, slot_of, state, stats,
+            _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
+                         base_nodes, pivots, state, stats,
                          STAT_REFACTOR_SLOW)
             fresh = True
         else:
@@ -269,8 +285,8 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
 
 
 @njit(cache=True)
-def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, factor, e_base, W, slot_of,
-         node_of, state, params, capacitance, e_corr, stats):
+def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, base, zone_cols, zone_rows, coupling,
+         schur, E, base_nodes, pivots, state, stats):
     """Newton from the gap profile outside the crack tip shifted inward by 1 to 6 nodes.
 
     Near a fold of the discrete path the stable state the tip snaps to is, locally, the
@@ -289,8 +305,8 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, factor, e_base, W, s
                 hp[i] = h[i + shift]
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
-        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, factor, e_base, W, slot_of, node_of,
-                  state, params, capacitance, e_corr, stats):
+        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, base, zone_cols, zone_rows, coupling,
+                  schur, E, base_nodes, pivots, state, stats):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -374,8 +390,8 @@ def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
 @njit(cache=True)
 def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io,
            step_max, step_min, da_max, step_tol, tol, max_iter, max_steps, stop_mode, min_travel,
-           tip_lo, tip_hi, factor, e_base, W, slot_of, node_of, state, params,
-           capacitance, e_corr,
+           tip_lo, tip_hi, base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots,
+               state,
            t_out, d_out, P_out, a_out, ai_out, h_out, stats):
     """Unload at constant rate from the state ``h_init`` with the Prony recursion.
 
@@ -410,8 +426,9 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         :func:`stop_reached`.
     tip_lo, tip_hi : radii the crack tip must stay within (the well-resolved band of a
         graded mesh); leaving them ends the run with STATUS_LEFT_BAND.
-    factor, e_base, W, slot_of, node_of, state, params, capacitance, e_corr : Jacobian
-        cache arrays        (:func:`new_jacobian_cache`); may carry the factorization of the initial solve.
+    base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state : Jacobian
+        cache arrays (:func:`new_jacobian_cache`); may carry the factorization of the
+        initial solve.
     t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
     h_out : (N,) receives the gap of the last accepted step.
     stats : int64 array of length N_STATS (incremented).
@@ -476,11 +493,12 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         quadratic = predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp)
         h_pred[:] = hp
         # -- solve
-        ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, factor, e_base, W, slot_of,
-                    node_of, state, params, capacitance, e_corr, stats)
+        ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, base, zone_cols, zone_rows,
+                    coupling, schur, E, base_nodes, pivots, state, stats)
         if not ok:
             stats[STAT_FAILED_SOLVES] += 1
             state[STATE_VALID] = 0
+            state[STATE_EXACT] = 1
             easy = 0
             if dd > max(dd_min, SNAP_STEP_FRACTION * dd_max) * 1.0001:
                 dd = max(0.5 * dd, dd_min)
@@ -489,8 +507,8 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
             # for the snapped state by Newton from the profile shifted inward by 1..6 nodes,
             # else by pseudo-transient relaxation from the last state
             stats[STAT_JUMPS] += 1
-            ok = snap(h, hp, g, A, ceff, H, h0, c, tol_gap, max_iter, r, hm, factor, e_base, W,
-                      slot_of, node_of, state, params, capacitance, e_corr,
+            ok = snap(h, hp, g, A, ceff, H, h0, c, tol_gap, max_iter, r, hm, base, zone_cols,
+                      zone_rows, coupling, schur, E, base_nodes, pivots, state,
                       stats)
             if not ok:
                 hp[:] = h
@@ -518,6 +536,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         else:
             err = np.inf
         # -- accept
+        state[STATE_EXACT] = 0
         update_modes(e, b, q, sig_new, sigma)
         h_prev2[:] = h_prev
         h_prev[:] = h

@@ -463,9 +463,10 @@ def _nodes_used(res) -> int:
 
 def kernel_counters(scene, numerics) -> dict:
     """Counters of the unloading kernel on one run (``kernels.solve`` STAT_*), per step:
-    residual evaluations (one N x N mat-vec each), Newton iterations, correction columns
-    (one application of the restricted inverse each), factorizations and the mean size of
-    the factorized block |S|/N."""
+    residual evaluations (one N x N mat-vec each), Newton iterations, refactorizations of the
+    crack-tip zone's Schur complement (``zone_refreshes``), factorizations of the contact
+    (with the reason of the refactorizations) and the mean size of the interacting set
+    |S|/N."""
     from kernels import solve as ks
 
     from . import solver
@@ -484,8 +485,11 @@ def kernel_counters(scene, numerics) -> dict:
     st, steps, N = captured["stats"], max(res.steps, 1), _nodes_used(res)
     return {"residual_matvecs_per_step": st[ks.STAT_RESIDUALS] / steps,
             "newton_iterations_per_step": st[ks.STAT_ITER] / steps,
-            "columns_per_step": st[ks.STAT_COLUMNS] / steps,
+            "zone_refreshes_per_step": st[ks.STAT_ZONE] / steps,
             "factorizations": int(st[ks.STAT_FACTOR]),
+            "refactorizations": {"tip_left_zone": int(st[ks.STAT_REFACTOR_ZONE]),
+                                 "slow_contraction": int(st[ks.STAT_REFACTOR_SLOW]),
+                                 "line_search": int(st[ks.STAT_REFACTOR_LINESEARCH])},
             "steps_per_factorization": steps / max(st[ks.STAT_FACTOR], 1),
             "subset_fraction": st[ks.STAT_SUBSET] / max(st[ks.STAT_FACTOR], 1) / N,
             "note": "counters include the relaxed start's elastic solves when not cached"}

@@ -218,6 +218,10 @@ def transfer(run, old, new, form: str = "auto") -> None:
     """
     old_r, new_r = old.mesh.r, new.mesh.r
     h = CubicSpline(old_r, run.h)(new_r)
+    # the spline passes through its knots only to rounding (which depends on the BLAS
+    # kernels of the CPU): the common nodes take their old gap exactly
+    _, i_old, i_new = np.intersect1d(old.mesh.lattice, new.mesh.lattice, return_indices=True)
+    h[i_new] = run.h[i_old]
     h = np.maximum(h, 0.5 * float(np.min(run.h)))
     run.cache = new_jacobian_cache(new_r.size)
     if run.q.shape[0] == 0:

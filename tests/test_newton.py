@@ -1,5 +1,6 @@
-"""The restricted, low-rank-corrected Newton step of the kernel against a dense numpy solve of
-the same system, and the Newton solve against the residual it claims to zero."""
+"""The Newton step of the kernel (kept factorization of the contact, crack-tip zone exact)
+against a dense numpy solve of the Jacobian it documents, and the Newton solve against the
+residual it claims to zero."""
 import numpy as np
 import pytest
 
@@ -10,67 +11,110 @@ from sweep.mesh import uniform_mesh
 from sweep.solver import lj_constants
 
 
-def _problem(N=60, seed=1):
+def _problem(N=200, seed=1, contact=1.8):
     rng = np.random.default_rng(seed)
     mesh = uniform_mesh(N, 3.0)
     A = np.array(mesh.influence)
     h0, c = lj_constants(3.24)
     r = np.asarray(mesh.r)
-    # a contact-like gap: h0 inside r < 1.5, opening outside, with a perturbation
-    h = np.maximum(h0 * (1.0 + 0.2 * rng.random(N)), 0.5 * (r - 1.5) ** 2 + h0)
+    # a contact-like gap: about h0 inside r < contact, opening outside, with a perturbation
+    h = np.maximum(h0 * (1.0 + 0.15 * rng.random(N)), 0.5 * (r - contact) ** 2 + h0)
+    h += np.where(r > contact + 0.4, 5.0 * (r - contact - 0.4) ** 2, 0.0)   # far field open
     return A, h, h0, c, rng
 
 
-def _dense_jacobian(A, h, h0, c, ceff):
+def _stiffness(h, h0, c, ceff):
     sig, d = np.empty(h.size), np.empty(h.size)
     lj_traction_and_stiffness(h, h0, c, sig, d)
-    return np.eye(h.size) - ceff * A * d[None, :], d
+    return ceff * d, d
 
 
 def _factorize(h, A, ceff, h0, c, cache):
-    return jac.factorize(h, A, ceff, h0, c, cache[jac.CACHE_FACTOR], cache[jac.CACHE_E_BASE],
-                         cache[jac.CACHE_SLOT_OF], cache[jac.CACHE_STATE])
+    return jac.factorize(h, A, ceff, h0, c, *cache)
 
 
-@pytest.mark.parametrize("moved", [3, 25])
-def test_woodbury_newton_step_equals_dense_solve(moved):
+def _direction(F, d, A, ceff, cache, stats):
+    return jac.newton_direction(F, d, A, ceff, *cache, stats, ks.STAT_ZONE)
+
+
+def _sets(cache):
+    st = cache[jac.CACHE_STATE]
+    return st[jac.STATE_SUBSET], st[jac.STATE_ZONE_LO], st[jac.STATE_ZONE_HI]
+
+
+def test_factorized_jacobian_inverts_the_restricted_jacobian():
+    # at the state it was factorized at, the direction is the dense solve of J with the
+    # far field (columns beyond S) left out, and those columns are the identity to
+    # within SUBSET_EPS
     A, h, h0, c, rng = _problem()
-    ceff = 0.7
-    cache = jac.new_jacobian_cache(h.size, kmax=40, eta=0.0)      # eta = 0: exact corrections
-    _factorize(h, A, ceff, h0, c, cache)
-    # the stiffness moves at a few nodes (the crack tip region)
-    h2 = h.copy()
-    idx = rng.choice(h.size, moved, replace=False)
-    h2[idx] *= 1.0 + 0.3 * rng.random(moved)
-    J, d = _dense_jacobian(A, h2, h0, c, ceff)
-    F = rng.standard_normal(h.size)
-    stats = np.zeros(ks.N_STATS, np.int64)
-    dh, ok = jac.newton_direction(F, d, A, ceff, *cache, stats, ks.STAT_COLUMNS)
-    assert ok
-    assert stats[ks.STAT_COLUMNS] == moved            # one column per moved node
-    np.testing.assert_allclose(dh, -np.linalg.solve(J, F), rtol=1e-9, atol=1e-12)
-
-
-def test_restricted_factorization_inverts_the_base_jacobian():
-    # the base keeps only the interacting prefix S (far-field stiffness set to zero): its
-    # inverse applied to any vector must equal a dense solve with that base Jacobian
-    A, h, h0, c, rng = _problem(N=80, seed=2)
-    r = np.linspace(0.0, 3.0, 80)
-    h = h + np.where(r > 2.0, 5.0 * (r - 2.0) ** 2, 0.0)     # a far field wide open
     ceff = 0.55
     cache = jac.new_jacobian_cache(h.size)
     m = _factorize(h, A, ceff, h0, c, cache)
-    _, d = _dense_jacobian(A, h, h0, c, ceff)
-    assert 0 < m < h.size                                # the far field is left out
-    e_b = np.where(np.arange(h.size) < m, ceff * d, 0.0)
-    np.testing.assert_array_equal(cache[jac.CACHE_E_BASE], e_b)
-    J_b = np.eye(h.size) - A * e_b[None, :]
-    X = rng.standard_normal((h.size, 3))
-    Y = jac.apply_base(X, cache[jac.CACHE_FACTOR], cache[jac.CACHE_E_BASE], m)
-    np.testing.assert_allclose(J_b @ Y, X, atol=1e-10)
-    # the columns left out are the identity to within SUBSET_EPS
+    m_, lo, hi = _sets(cache)
+    E, d = _stiffness(h, h0, c, ceff)
+    assert 0 < lo < hi < m < h.size                      # interior, zone, tail and far field
+    tip = jac.crack_tip_index(d)
+    assert lo == tip - jac.ZONE_IN and hi == min(tip + jac.ZONE_OUT, m)
+    E_b = np.where(np.arange(h.size) < m, E, 0.0)
+    F = rng.standard_normal(h.size)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    dh, ok = _direction(F, d, A, ceff, cache, stats)
+    assert ok
+    J_b = np.eye(h.size) - A * E_b[None, :]
+    np.testing.assert_allclose(dh, -np.linalg.solve(J_b, F), rtol=1e-9, atol=1e-12)
     far = np.arange(m, h.size)
-    assert np.all(np.diag(A)[far] * np.abs(ceff * d[far]) <= jac.SUBSET_EPS)
+    assert np.all(np.diag(A)[far] * np.abs(E[far]) <= jac.SUBSET_EPS)
+
+
+@pytest.mark.parametrize("where", ["zone", "interior"])
+def test_zone_exact_and_interior_as_factorized(where):
+    # the stiffness moves: in the crack-tip zone the direction follows it exactly (its
+    # Schur complement is refactorized); in the interior it stays as factorized (a chord
+    # step): either way the direction is the dense solve of that documented Jacobian
+    A, h, h0, c, rng = _problem(seed=2)
+    ceff = 0.7
+    cache = jac.new_jacobian_cache(h.size)
+    m = _factorize(h, A, ceff, h0, c, cache)
+    _, lo, hi = _sets(cache)
+    E_old, _ = _stiffness(h, h0, c, ceff)
+    h2 = h.copy()
+    nodes = np.arange(lo, hi) if where == "zone" else np.arange(0, lo - jac.ZONE_MARGIN)
+    idx = rng.choice(nodes, 12, replace=False)
+    h2[idx] = np.minimum(h2[idx] * (1.0 + 0.05 * rng.random(12)), 1.19 * h0)
+    E_new, d_new = _stiffness(h2, h0, c, ceff)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    stats[ks.STAT_ZONE] = 0
+    F = rng.standard_normal(h.size)
+    dh, ok = _direction(F, d_new, A, ceff, cache, stats)
+    assert ok
+    i = np.arange(h.size)
+    E_used = np.where(i < m, E_old, 0.0)
+    E_used[lo:hi] = E_new[lo:hi]                          # the zone as it is now
+    J_used = np.eye(h.size) - A * E_used[None, :]
+    np.testing.assert_allclose(dh, -np.linalg.solve(J_used, F), rtol=1e-9, atol=1e-12)
+    assert stats[ks.STAT_ZONE] == 1                      # one refresh of the zone
+    if where == "interior":                              # a chord step, not the exact one
+        J = np.eye(h.size) - A * np.where(i < m, E_new, 0.0)[None, :]
+        assert np.max(np.abs(dh + np.linalg.solve(J, F))) > 1e-6
+
+
+def test_crack_tip_leaving_the_zone_asks_for_a_new_factorization():
+    A, h, h0, c, rng = _problem(seed=3)
+    ceff = 0.7
+    cache = jac.new_jacobian_cache(h.size)
+    _factorize(h, A, ceff, h0, c, cache)
+    _, lo, hi = _sets(cache)
+    F = rng.standard_normal(h.size)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    h2 = h.copy()
+    h2[lo + jac.ZONE_MARGIN - 1:] = np.maximum(h2[lo + jac.ZONE_MARGIN - 1:], 1.3 * h0)
+    _, d2 = _stiffness(h2, h0, c, ceff)
+    assert jac.crack_tip_index(d2) < lo + jac.ZONE_MARGIN  # the tip receded past the margin
+    _, ok = _direction(F, d2, A, ceff, cache, stats)
+    assert not ok
+    _factorize(h2, A, ceff, h0, c, cache)                 # refactorized there, it fits again
+    dh, ok = _direction(F, d2, A, ceff, cache, stats)
+    assert ok and np.all(np.isfinite(dh))
 
 
 def test_newton_solves_the_discrete_equilibrium():
@@ -116,26 +160,3 @@ def test_relaxed_state_is_cached_per_mesh_and_reused_unchanged():
     h4, _ = relaxed_state(el2, a0=1.4, mesh_key=key)
     assert el2.stats[ks.STAT_ITER] > 0
     assert abs(el2.radius(h4) - 1.4) < r[1]
-
-
-def test_capacitance_updates_keep_the_newton_step_exact():
-    # corrected nodes move again (rank-1 updates of the capacitance inverse) and new nodes
-    # join (bordering), over several calls: with eta = 0 every step must stay the exact
-    # dense solve of the current Jacobian
-    A, h, h0, c, rng = _problem(N=70, seed=4)
-    ceff = 0.6
-    cache = jac.new_jacobian_cache(h.size, kmax=50, eta=0.0)
-    _factorize(h, A, ceff, h0, c, cache)
-    stats = np.zeros(ks.N_STATS, np.int64)
-    h2 = h.copy()
-    moved = set()
-    for call in range(4):
-        idx = rng.choice(h.size, 6, replace=False)
-        moved.update(int(i) for i in idx)
-        h2[idx] *= 1.0 + 0.3 * rng.random(6)
-        J, d = _dense_jacobian(A, h2, h0, c, ceff)
-        F = rng.standard_normal(h.size)
-        dh, ok = jac.newton_direction(F, d, A, ceff, *cache, stats, ks.STAT_COLUMNS)
-        assert ok
-        assert stats[ks.STAT_COLUMNS] == len(moved)    # a column per node, kept across calls
-        np.testing.assert_allclose(dh, -np.linalg.solve(J, F), rtol=1e-8, atol=1e-11)
