@@ -335,6 +335,26 @@ PREDICT_FLOOR = 0.5
 
 
 @njit(cache=True)
+def predict_cubic(h, h_prev, h_prev2, h_prev3, dt, dt_prev, dt_prev2, dt_prev3, hp):
+    """Starting gap of Newton: cubic (Lagrange) extrapolation through the last four
+    accepted states, floored at PREDICT_FLOOR of the last gap; False (nothing written)
+    before four states exist."""
+    if not dt_prev3 > 0.0:
+        return False
+    t1 = -dt_prev
+    t2 = t1 - dt_prev2
+    t3 = t2 - dt_prev3
+    l0 = (dt - t1) * (dt - t2) * (dt - t3) / ((-t1) * (-t2) * (-t3))
+    l1 = dt * (dt - t2) * (dt - t3) / (t1 * (t1 - t2) * (t1 - t3))
+    l2 = dt * (dt - t1) * (dt - t3) / (t2 * (t2 - t1) * (t2 - t3))
+    l3 = dt * (dt - t1) * (dt - t2) / (t3 * (t3 - t1) * (t3 - t2))
+    for i in range(h.size):
+        hp[i] = max(l0 * h[i] + l1 * h_prev[i] + l2 * h_prev2[i] + l3 * h_prev3[i],
+                    PREDICT_FLOOR * h[i])
+    return True
+
+
+@njit(cache=True)
 def predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp):
     """Starting gap of the next solve: quadratic (Lagrange) extrapolation through the last
     three accepted states (linear after one, constant at the start), floored at
@@ -450,6 +470,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
     h = h_init.copy()
     h_prev = h_init.copy()
     h_prev2 = h_init.copy()
+    h_prev3 = h_init.copy()
     hp = np.empty(N)
     h_pred = np.empty(N)
     sigma_pred = np.empty(N)
@@ -481,6 +502,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
     dd = step_io[0] * h0 if step_io[0] > 0.0 else dd_max
     dt_prev = 0.0
     dt_prev2 = 0.0
+    dt_prev3 = 0.0
     easy = 0
     status = STATUS_STEP_LIMIT
     while n <= max_steps:
@@ -492,9 +514,21 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
             g[i] = -(delta - dd) + h0 + r2half[i]
         quadratic = predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp)
         h_pred[:] = hp
+        # Newton starts from the cubic extrapolation (where four states exist): on the
+        # vs-numpy scenes its residual is several times smaller, and 1.2-1.8 Newton
+        # iterations per step remain instead of 1.7-2.4; the quadratic one (h_pred) stays
+        # the step-error estimate
+        cubic = predict_cubic(h, h_prev, h_prev2, h_prev3, dt, dt_prev, dt_prev2, dt_prev3, hp)
         # -- solve
         ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, base, zone_cols, zone_rows,
                     coupling, schur, E, base_nodes, pivots, state, stats)
+        if not ok and cubic:
+            # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
+            # cubic start can overshoot: again from the quadratic one before the step halves
+            stats[STAT_FAILED_SOLVES] += 1
+            hp[:] = h_pred
+            ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, base, zone_cols,
+                        zone_rows, coupling, schur, E, base_nodes, pivots, state, stats)
         if not ok:
             stats[STAT_FAILED_SOLVES] += 1
             state[STATE_VALID] = 0
@@ -538,10 +572,12 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         # -- accept
         state[STATE_EXACT] = 0
         update_modes(e, b, q, sig_new, sigma)
+        h_prev3[:] = h_prev2
         h_prev2[:] = h_prev
         h_prev[:] = h
         h[:] = hp
         sigma[:] = sig_new
+        dt_prev3 = dt_prev2
         dt_prev2 = dt_prev
         dt_prev = dt
         t += dt
