@@ -2,9 +2,10 @@
 (Numba kernels).
 
 Numba's ``np.dot``/``np.linalg`` need contiguous arrays and offer no LU solve; the kernels of
-:mod:`kernels.jacobian` work on the leading k x k block of a preallocated (kmax, kmax) array
-and on the first k columns of an (N, kmax) one. The routines of ``scipy.linalg.cython_blas``
-and ``cython_lapack`` take such blocks through their leading dimension. Their addresses are
+:mod:`kernels.jacobian` factorize and solve blocks of preallocated flat buffers and multiply
+by row blocks of the influence matrix (a leading dimension other than the block's width).
+The routines of ``scipy.linalg.cython_blas`` and ``cython_lapack`` take such blocks through
+their leading dimension. Their addresses are
 registered with LLVM under a symbol name at import, so the compiled kernels refer to them by
 name (and stay cacheable, as Numba's own LAPACK bindings do).
 

@@ -39,7 +39,7 @@ recedes through ZONE_IN - ZONE_MARGIN nodes between two factorizations), when a 
 becomes stiff, or when the caller finds the iteration contracting poorly
 (:func:`kernels.solve.newton`).
 
-The cache is a tuple of arrays (Numba passes it unpacked), positions named by CACHE_*.
+The cache is a tuple of arrays (passed whole to the kernels), positions named by CACHE_*.
 """
 from __future__ import annotations
 
@@ -99,7 +99,8 @@ N_STATE = 7
 
 
 def new_jacobian_cache(N):
-    """Work arrays that carry the factorized Jacobian between solves and steps.
+    """Work arrays that carry the factorized Jacobian between solves and steps, as one
+    tuple that the kernels take whole.
 
     Returns (base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state),
     positions named by the CACHE_* constants, ``state`` indexed by STATE_*.
@@ -126,10 +127,10 @@ def crack_tip_index(d):
 
 
 @njit(cache=True)
-def factorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E, base_nodes,
-              pivots, state):
-    """Factorize the Jacobian at ``h``: choose S, Z and B, factorize K, form X and C.
-    Returns m = |S|."""
+def factorize(h, A, ceff, h0, c, cache):
+    """Factorize the Jacobian at ``h`` into ``cache``: choose S, Z and B, factorize K, form
+    X and C. Returns m = |S|."""
+    base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state = cache
     N = h.size
     zmax = zone_cols.size // N
     sig = np.empty(N)
@@ -202,9 +203,9 @@ def _refresh_zone(Ez, coupling, schur, pivots, N, z):
 
 
 @njit(cache=True)
-def apply_inverse(v, A, base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots,
-                  state):
+def apply_inverse(v, A, cache):
     """x = J^-1 v for the approximate Jacobian of the cache (stiffness ``E``)."""
+    base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state = cache
     N = v.size
     m = state[STATE_SUBSET]
     lo = state[STATE_ZONE_LO]
@@ -243,8 +244,7 @@ def apply_inverse(v, A, base, zone_cols, zone_rows, coupling, schur, E, base_nod
 
 
 @njit(cache=True)
-def newton_direction(F, d, A, ceff, base, zone_cols, zone_rows, coupling, schur, E,
-                     base_nodes, pivots, state, stats, stat_zone):
+def newton_direction(F, d, A, ceff, cache, stats, stat_zone):
     """Newton step dh = -J^-1 F with the interior's stiffness as factorized and the crack-tip
     zone's as it is now (its Schur complement refactorized when it moved by more than
     ZONE_ETA; ``stats[stat_zone]`` counts those).
@@ -253,6 +253,7 @@ def newton_direction(F, d, A, ceff, base, zone_cols, zone_rows, coupling, schur,
     tip left the zone's inner part, a far-field node became stiff, or Sigma is singular):
     the caller refactorizes.
     """
+    _, _, _, coupling, schur, E, _, pivots, state = cache
     N = F.size
     m = state[STATE_SUBSET]
     lo = state[STATE_ZONE_LO]
@@ -283,8 +284,7 @@ def newton_direction(F, d, A, ceff, base, zone_cols, zone_rows, coupling, schur,
             E[lo + k] = Ez[k]
         state[STATE_SCHUR_VALID] = 1
         stats[stat_zone] += 1
-    x = apply_inverse(F, A, base, zone_cols, zone_rows, coupling, schur, E, base_nodes,
-                      pivots, state)
+    x = apply_inverse(F, A, cache)
     for i in range(N):
         x[i] = -x[i]
     return x, True

@@ -31,8 +31,8 @@ from numba import njit
 from .history import history_vector, step_coefficients, update_modes
 from .interface import crossing_radius, lj_traction, lj_traction_and_stiffness
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
-from .jacobian import (STATE_EXACT, STATE_VALID, factorize, invalidate,  # noqa: F401
-                       new_jacobian_cache, newton_direction)
+from .jacobian import (CACHE_STATE, STATE_EXACT, STATE_VALID, factorize,  # noqa: F401
+                       invalidate, new_jacobian_cache, newton_direction)
 
 STATUS_DONE = 0
 STATUS_NEWTON_FAILED = 1
@@ -137,10 +137,8 @@ def _norm2(F):
 
 
 @njit(cache=True)
-def _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E, base_nodes,
-                 pivots, state, stats, reason):
-    m = factorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E, base_nodes,
-                  pivots, state)
+def _refactorize(h, A, ceff, h0, c, cache, stats, reason):
+    m = factorize(h, A, ceff, h0, c, cache)
     stats[STAT_FACTOR] += 1
     stats[STAT_SUBSET] += m
     if reason >= 0:
@@ -148,8 +146,7 @@ def _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur,
 
 
 @njit(cache=True)
-def newton(h, g, A, ceff, H, h0, c, tol, max_iter, base, zone_cols, zone_rows,
-           coupling, schur, E, base_nodes, pivots, state, stats):
+def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
     """Solve F(h) = 0 in place, starting from ``h``. Returns True on convergence.
 
     The Jacobian factorization in the cache (:func:`kernels.jacobian.new_jacobian_cache`)
@@ -158,6 +155,7 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, base, zone_cols, zone_rows,
     less than SLOW_CONTRACTION, when a line search fails with a stale one, and at every
     iteration while ``state[STATE_EXACT]`` is set.
     """
+    state = cache[CACHE_STATE]
     N = h.size
     sig = np.empty(N)
     d = np.empty(N)
@@ -171,25 +169,19 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, base, zone_cols, zone_rows,
         return True
     fresh = False
     if state[STATE_VALID] == 0:
-        _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
-                     base_nodes, pivots, state, stats, -1)
+        _refactorize(h, A, ceff, h0, c, cache, stats, -1)
         fresh = True
     for it in range(max_iter):
         stats[STAT_ITER] += 1
         if state[STATE_EXACT] == 1 and not fresh:
-            _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
-                         base_nodes, pivots, state, stats, STAT_REFACTOR_RETRY)
+            _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_RETRY)
             fresh = True
         lj_traction_and_stiffness(h, h0, c, sig, d)
-        dh, ok = newton_direction(F, d, A, ceff, base, zone_cols, zone_rows, coupling, schur, E,
-                                  base_nodes, pivots, state, stats, STAT_ZONE)
+        dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
         if not ok:
-            _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
-                         base_nodes, pivots, state, stats,
-                         STAT_REFACTOR_ZONE)
+            _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_ZONE)
             fresh = True
-            dh, ok = newton_direction(F, d, A, ceff, base, zone_cols, zone_rows, coupling, schur,
-                                      E, base_nodes, pivots, state, stats, STAT_ZONE)
+            dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
             if not ok:       # singular even on a fresh factorization: give up
                 return False
         lam = positive_step(h, dh)
@@ -211,9 +203,7 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, base, zone_cols, zone_rows,
         if not accepted:
             if fresh:        # a line search failed on an exact Jacobian: give up
                 return False
-            _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
-                         base_nodes, pivots, state, stats,
-                         STAT_REFACTOR_LINESEARCH)
+            _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_LINESEARCH)
             fresh = True
             continue
         for i in range(N):
@@ -223,9 +213,7 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, base, zone_cols, zone_rows,
         if norm <= tol:
             return True
         if not fresh and nt2 > SLOW_CONTRACTION * n2:
-            _refactorize(h, A, ceff, h0, c, base, zone_cols, zone_rows, coupling, schur, E,
-                         base_nodes, pivots, state, stats,
-                         STAT_REFACTOR_SLOW)
+            _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_SLOW)
             fresh = True
         else:
             fresh = False
@@ -285,8 +273,7 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
 
 
 @njit(cache=True)
-def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, base, zone_cols, zone_rows, coupling,
-         schur, E, base_nodes, pivots, state, stats):
+def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, cache, stats):
     """Newton from the gap profile outside the crack tip shifted inward by 1 to 6 nodes.
 
     Near a fold of the discrete path the stable state the tip snaps to is, locally, the
@@ -305,8 +292,7 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, base, zone_cols, zon
                 hp[i] = h[i + shift]
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
-        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, base, zone_cols, zone_rows, coupling,
-                  schur, E, base_nodes, pivots, state, stats):
+        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -410,9 +396,7 @@ def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
 @njit(cache=True)
 def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io,
            step_max, step_min, da_max, step_tol, tol, max_iter, max_steps, stop_mode, min_travel,
-           tip_lo, tip_hi, base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots,
-               state,
-           t_out, d_out, P_out, a_out, ai_out, h_out, stats):
+           tip_lo, tip_hi, cache, t_out, d_out, P_out, a_out, ai_out, h_out, stats):
     """Unload at constant rate from the state ``h_init`` with the Prony recursion.
 
     Resumable: a run may be continued (in chunks of ``max_steps``, or on another mesh after
@@ -446,9 +430,9 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         :func:`stop_reached`.
     tip_lo, tip_hi : radii the crack tip must stay within (the well-resolved band of a
         graded mesh); leaving them ends the run with STATUS_LEFT_BAND.
-    base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state : Jacobian
-        cache arrays (:func:`new_jacobian_cache`); may carry the factorization of the
-        initial solve.
+    cache : tuple
+        The Jacobian cache (:func:`new_jacobian_cache`); may carry the factorization of
+        the initial solve.
     t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
     h_out : (N,) receives the gap of the last accepted step.
     stats : int64 array of length N_STATS (incremented).
@@ -457,6 +441,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
     -------
     (status, n_records)
     """
+    state = cache[CACHE_STATE]
     N = h_init.size
     M = weights.size
     hm = 3.0 ** (1.0 / 6.0) * h0
@@ -520,15 +505,13 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
         # the step-error estimate
         cubic = predict_cubic(h, h_prev, h_prev2, h_prev3, dt, dt_prev, dt_prev2, dt_prev3, hp)
         # -- solve
-        ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, base, zone_cols, zone_rows,
-                    coupling, schur, E, base_nodes, pivots, state, stats)
+        ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, cache, stats)
         if not ok and cubic:
             # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
             # cubic start can overshoot: again from the quadratic one before the step halves
             stats[STAT_FAILED_SOLVES] += 1
             hp[:] = h_pred
-            ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, base, zone_cols,
-                        zone_rows, coupling, schur, E, base_nodes, pivots, state, stats)
+            ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, cache, stats)
         if not ok:
             stats[STAT_FAILED_SOLVES] += 1
             state[STATE_VALID] = 0
@@ -541,9 +524,7 @@ def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io
             # for the snapped state by Newton from the profile shifted inward by 1..6 nodes,
             # else by pseudo-transient relaxation from the last state
             stats[STAT_JUMPS] += 1
-            ok = snap(h, hp, g, A, ceff, H, h0, c, tol_gap, max_iter, r, hm, base, zone_cols,
-                      zone_rows, coupling, schur, E, base_nodes, pivots, state,
-                      stats)
+            ok = snap(h, hp, g, A, ceff, H, h0, c, tol_gap, max_iter, r, hm, cache, stats)
             if not ok:
                 hp[:] = h
                 ok = relax(hp, g, A, ceff, H, h0, c, tol_gap, RELAX_MAX_ITER, stats)

@@ -58,7 +58,7 @@ def unload_exact(A, r, wP, h_init, delta0, scene, numerics, h0, c, material, sto
         H = -(hist - ceff * sigma)
         g = -(delta - dd) + h0 + 0.5 * r**2
         hp = h.copy()
-        ok = newton(hp, g, A, ceff, H, h0, c, numerics.tol * h0, MAX_NEWTON_ITER, *cache, stats)
+        ok = newton(hp, g, A, ceff, H, h0, c, numerics.tol * h0, MAX_NEWTON_ITER, cache, stats)
         if not ok:
             invalidate(cache)
             if dd <= numerics.min_step * h0 * 1.0001:

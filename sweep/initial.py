@@ -56,7 +56,7 @@ class ElasticSolver:
         h = np.array(guess, dtype=float)
         g = -delta + self.h0 + 0.5 * self.r**2
         ok = newton(h, g, self.A, 1.0, self.zero, self.h0, self.c, self.tol * self.h0,
-                    MAX_NEWTON_ITER_INITIAL, *self.cache, self.stats)
+                    MAX_NEWTON_ITER_INITIAL, self.cache, self.stats)
         if not ok:
             invalidate(self.cache)   # refactorize next time
         return ok, h

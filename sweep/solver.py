@@ -197,7 +197,7 @@ def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int
                            pb.c, pb.prony_weights, pb.prony_times, run.q, run.n, run.step,
                            numerics.step, numerics.min_step, numerics.da_max * pb.mesh.spacing,
                            STEP_TOL, numerics.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
-                           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *tip_range, *run.cache,
+                           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *tip_range, run.cache,
                            *run.records, h_out, run.stats)
     run.h = h_out
     return int(status)

@@ -269,7 +269,7 @@ def _reequilibrate(run, new, h, ceff, H):
     h_eq = h.copy()
     stats = run.stats if run.stats is not None else np.zeros(N_STATS, dtype=np.int64)
     ok = newton(h_eq, g, new.A, ceff, H, new.h0, new.c, new.numerics.tol * new.h0,
-                REEQUILIBRATE_ITER, *new_jacobian_cache(h.size), stats)
+                REEQUILIBRATE_ITER, new_jacobian_cache(h.size), stats)
     return h_eq if ok else None
 
 

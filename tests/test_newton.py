@@ -30,11 +30,11 @@ def _stiffness(h, h0, c, ceff):
 
 
 def _factorize(h, A, ceff, h0, c, cache):
-    return jac.factorize(h, A, ceff, h0, c, *cache)
+    return jac.factorize(h, A, ceff, h0, c, cache)
 
 
 def _direction(F, d, A, ceff, cache, stats):
-    return jac.newton_direction(F, d, A, ceff, *cache, stats, ks.STAT_ZONE)
+    return jac.newton_direction(F, d, A, ceff, cache, stats, ks.STAT_ZONE)
 
 
 def _sets(cache):
@@ -131,7 +131,7 @@ def test_newton_solves_the_discrete_equilibrium():
     cache = ks.new_jacobian_cache(120)
     stats = np.zeros(ks.N_STATS, np.int64)
     hs = h_start.copy()
-    assert ks.newton(hs, g, A, ceff, H, h0, c, 1e-10 * h0, 40, *cache, stats)
+    assert ks.newton(hs, g, A, ceff, H, h0, c, 1e-10 * h0, 40, cache, stats)
     sig, d = np.empty(120), np.empty(120)
     lj_traction_and_stiffness(hs, h0, c, sig, d)
     assert np.max(np.abs(hs - g - A @ (ceff * sig - H))) < 1e-10 * h0

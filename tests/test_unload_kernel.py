@@ -33,7 +33,7 @@ def _run(chunk):
                            pb.prony_weights, pb.prony_times, q, n, step, NUMERICS.step,
                            NUMERICS.min_step, NUMERICS.da_max * pb.mesh.spacing, STEP_TOL, NUMERICS.tol,
                            MAX_NEWTON_ITER, limit, pb.stop_mode,
-                           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range, *cache, *out,
+                           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range, cache, *out,
                            h_out, stats)
         calls += 1
         h = h_out
