@@ -16,7 +16,7 @@ export NUMBA_NUM_THREADS ?= 1
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
 	@echo "make test   - create/update .venv and run the test suite"
-	@echo "make bench  - speed benchmarks of issue 9 (results/bench.json, ~10 min)"
+	@echo "make bench  - speed benchmarks of issue 9 (results/bench.json, ~4 min)"
 	@echo "make tradeoff [QUICK=1] - accuracy vs time over a grid of numerics (results/tradeoff/)"
 	@echo "make coverage-kernels - kernel tests with NUMBA_DISABLE_JIT=1 under coverage"
 	@echo "make reproduce - the paper's campaigns, fits, figures and results/REPORT.md"
