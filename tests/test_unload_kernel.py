@@ -1,7 +1,8 @@
 """The unloading kernel is resumable: a run continued in chunks (state handed back and
 forth: gap, Prony modes, step, records) reproduces the run done in one go.
 
-This is the interface a tip-following mesh and a wall-time budget build on.
+This is the interface a tip-following mesh and a wall-time budget build on. Its step
+predictors are exact for polynomials in time of their order.
 """
 import numpy as np
 
@@ -111,3 +112,30 @@ def test_grown_steps_keep_the_pull_off(monkeypatch):
     assert steps.max() > 1.5 * num.step and np.all(steps <= 8 * num.step * (1 + 1e-9))
     assert abs(grown.pull_off / capped.pull_off - 1) < 1e-6
     assert abs(grown.crack_speed / capped.crack_speed - 1) < 1e-4
+
+
+def test_predictors_are_exact_for_polynomials_of_their_order():
+    # Lagrange extrapolation through the accepted states at uneven steps (the step halves
+    # and doubles): the quadratic predictor reproduces a quadratic in time, the cubic one a
+    # cubic, at the next step; the cubic one waits for four states
+    from kernels.solve import predict, predict_cubic
+    t = np.array([0.0, 0.3, 0.45, 0.55])                 # accepted times, last = now
+    dt = 0.2
+    x = np.linspace(1.0, 2.0, 7)                         # one gap per node, above the floor
+
+    def gap(tau, order):
+        return 3.0 + x * tau + 0.5 * x**2 * tau**2 + (0.2 * x * tau**3 if order == 3 else 0.0)
+
+    dts = np.diff(t)[::-1]                               # dt_prev, dt_prev2, dt_prev3
+    hp = np.empty_like(x)
+    h, h1, h2, h3 = (gap(tau, 2) for tau in t[::-1])
+    assert predict(h, h1, h2, dt, dts[0], dts[1], hp)
+    np.testing.assert_allclose(hp, gap(t[-1] + dt, 2), rtol=1e-13)
+    h, h1, h2, h3 = (gap(tau, 3) for tau in t[::-1])
+    assert predict_cubic(h, h1, h2, h3, dt, dts[0], dts[1], dts[2], hp)
+    np.testing.assert_allclose(hp, gap(t[-1] + dt, 3), rtol=1e-13)
+    predict(h, h1, h2, dt, dts[0], dts[1], hp)
+    assert np.max(np.abs(hp - gap(t[-1] + dt, 3))) > 1e-4  # the quadratic one is not exact
+    hp[:] = -1.0
+    assert not predict_cubic(h, h1, h2, h3, dt, dts[0], dts[1], 0.0, hp)
+    assert np.all(hp == -1.0)                            # nothing written before four states
