@@ -92,8 +92,7 @@ STATE_BASE = 4
 #: state[STATE_SCHUR_VALID]: 1 when Sigma's LU is that of the stiffness in CACHE_E
 STATE_SCHUR_VALID = 5
 #: state[STATE_EXACT]: 1 to refactorize at every Newton iteration (exact Newton: set by the
-#: time stepper for the retries of a step whose solve failed, near a fold of the path, where
-#: the chord iteration on a stale interior does not converge)
+#: time stepper for the retries of a step whose solve failed, near a fold of the path)
 STATE_EXACT = 6
 N_STATE = 7
 
