@@ -175,9 +175,7 @@ def factorize(h, A, ceff, h0, c, cache):
         for l in range(z):
             C[k, l] = A[lo + k, lo + l]
     if b > 0 and z > 0:
-        XT = zone_cols[:z * b].reshape((z, b))
-        R = zone_rows[:z * b].reshape((z, b))
-        C += R @ XT.T
+        C += zone_rows[:z * b].reshape((z, b)) @ zone_cols[:z * b].reshape((z, b)).T
     state[STATE_VALID] = 1
     state[STATE_SUBSET] = m
     state[STATE_ZONE_LO] = lo
@@ -274,13 +272,10 @@ def newton_direction(F, d, A, ceff, cache, stats, stat_zone):
             moved = True
             break
     if moved:
-        Ez = np.empty(z)
         for k in range(z):
-            Ez[k] = ceff * d[lo + k]
-        if not _refresh_zone(Ez, coupling, schur, pivots, N, z):
-            return np.empty(0), False
-        for k in range(z):
-            E[lo + k] = Ez[k]
+            E[lo + k] = ceff * d[lo + k]
+        if not _refresh_zone(E[lo:hi], coupling, schur, pivots, N, z):
+            return np.empty(0), False       # (E is made again by the refactorization)
         state[STATE_SCHUR_VALID] = 1
         stats[stat_zone] += 1
     x = apply_inverse(F, A, cache)
