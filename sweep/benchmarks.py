@@ -602,12 +602,6 @@ class _fresh_disk_cache:
         _fresh_loky_workers()
 
 
-def _start_group(scene) -> tuple:
-    """Scenes sharing a relaxed start (the cached initial state): same material ratio k,
-    Tabor parameter and initial state; n and the rate do not enter it."""
-    return (scene.k, scene.mu, scene.a0, scene.delta0)
-
-
 def bench_scale(plan: "BenchPlan") -> dict:
     """The issue's scale: minutes for the whole of ``plan.scale_config`` (10,640 scenes over
     the paper's ranges) at -j{jobs}, from a seeded random sample of ``plan.scale_sample``
@@ -625,7 +619,7 @@ def bench_scale(plan: "BenchPlan") -> dict:
     import pandas as pd
 
     from .models import simulate_scene
-    from .scheduler import run_sweep
+    from .scheduler import run_sweep, start_group
     from .store import load
 
     cfg = load_config_path(plan.scale_config)
@@ -647,8 +641,8 @@ def bench_scale(plan: "BenchPlan") -> dict:
             seq[label] = time.perf_counter() - t
     n = len(scenes)
     total = len(cfg.tasks())
-    groups_sample = len({_start_group(s) for s in scenes})
-    groups_full = len({_start_group(s) for _, s in cfg.tasks()})
+    groups_sample = len({start_group(s) for s in scenes})
+    groups_full = len({start_group(s) for _, s in cfg.tasks()})
     setup_per_group = max(seq["cold"] - seq["warm"], 0.0) / max(groups_sample, 1)
     speedup = seq["cold"] / wall if wall > 0 else float("nan")
     cpu_full = total * seq["warm"] / max(n, 1) + groups_full * plan.jobs * setup_per_group

@@ -317,3 +317,29 @@ def test_dispatch_order_runs_the_largest_scenes_first():
     deep = scheduler.estimated_cost(Scene(n=0.8, k=0.1, mu=3.24, delta0=11.0, rate=1.0), num)
     shallow = scheduler.estimated_cost(Scene(n=0.8, k=0.1, mu=3.24, delta0=1.0, rate=1.0), num)
     assert deep > shallow > 0.0
+
+
+def test_dispatch_chunks_keep_start_groups_together_and_balance():
+    """Each chunk holds scenes of one start group (one relaxed start per chunk), the chunks
+    are a permutation of the grid, no chunk exceeds its scene cap or (unless it is one
+    scene) a quarter of a worker's share of the cost, and they run largest first."""
+    num = Numerics.preset("fast")
+    todo = [(f"s{i}", Scene(n=n, k=0.1, mu=3.24, a0=a0, rate=rate))
+            for i, (n, a0, rate) in enumerate(
+                (n, a0, rate) for n in (0.4, 0.8) for a0 in (1.0, 2.0, 8.0)
+                for rate in (1.0, 10.0, 1e2, 1e3, 1e4, 1e6))]
+    chunks = scheduler.dispatch_chunks(todo, num, n_jobs=2)
+    flat = [sid for chunk in chunks for sid, _ in chunk]
+    assert sorted(flat) == sorted(sid for sid, _ in todo)
+    assert all(len({scheduler.start_group(s) for _, s in chunk}) == 1 for chunk in chunks)
+    cost = {sid: scheduler.estimated_cost(s, num) for sid, s in todo}
+    cap = scheduler.CHUNK_COST_FRACTION * sum(cost.values()) / 2
+    totals = [sum(cost[sid] for sid, _ in chunk) for chunk in chunks]
+    assert all(t <= cap * (1 + 1e-12) or len(c) == 1 for t, c in zip(totals, chunks))
+    assert all(len(c) <= scheduler.CHUNK_SCENES for c in chunks)
+    assert totals == sorted(totals, reverse=True)
+    # the three a0 = 8 groups' scenes are the largest: the first chunk is one of them
+    assert chunks[0][0][1].a0 == 8.0
+    # fewer chunks than scenes: small groups travel together
+    assert len(chunks) < len(todo)
+    assert scheduler.dispatch_chunks([], num, 2) == []
