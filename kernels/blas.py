@@ -28,9 +28,11 @@ def _bind(module: str, name: str, nargs: int):
 
 
 _dgemv = _bind("blas", "dgemv", 11)
-_dger = _bind("blas", "dger", 9)
+_sgemv = _bind("blas", "sgemv", 11)
 _dgetrf = _bind("lapack", "dgetrf", 6)
+_sgetrf = _bind("lapack", "sgetrf", 6)
 _dgetrs = _bind("lapack", "dgetrs", 9)
+_sgetrs = _bind("lapack", "sgetrs", 9)
 
 _N = ord("N")
 _T = ord("T")
@@ -46,8 +48,8 @@ def _ints(*values):
 
 @njit(cache=True)
 def _gemv(trans, M, rows, cols, x, y, alpha, beta):
-    """dgemv on the Fortran view of M[:rows, :cols] (cols x rows): ``trans`` T gives
-    M @ x into y[:rows], N gives M^T @ x into y[:cols]."""
+    """dgemv (sgemv for float32 ``M``, ``x``, ``y``) on the Fortran view of M[:rows, :cols]
+    (cols x rows): ``trans`` T gives M @ x into y[:rows], N gives M^T @ x into y[:cols]."""
     n_out = rows if trans == _T else cols
     if n_out == 0:
         return
@@ -57,51 +59,57 @@ def _gemv(trans, M, rows, cols, x, y, alpha, beta):
         return
     code = np.array([trans], np.uint8)
     dims = _ints(cols, rows, M.shape[1], 1)
-    ab = np.array([alpha, beta])
-    _dgemv(code.ctypes, dims[0:].ctypes, dims[1:].ctypes, ab[0:].ctypes, M.ctypes,
-           dims[2:].ctypes, x.ctypes, dims[3:].ctypes, ab[1:].ctypes, y.ctypes, dims[3:].ctypes)
+    ab = np.array([alpha, beta], M.dtype)
+    if M.itemsize == 4:
+        _sgemv(code.ctypes, dims[0:].ctypes, dims[1:].ctypes, ab[0:].ctypes, M.ctypes,
+               dims[2:].ctypes, x.ctypes, dims[3:].ctypes, ab[1:].ctypes, y.ctypes,
+               dims[3:].ctypes)
+    else:
+        _dgemv(code.ctypes, dims[0:].ctypes, dims[1:].ctypes, ab[0:].ctypes, M.ctypes,
+               dims[2:].ctypes, x.ctypes, dims[3:].ctypes, ab[1:].ctypes, y.ctypes,
+               dims[3:].ctypes)
 
 
 @njit(cache=True)
 def gemv_rows(M, rows, cols, x, y, alpha, beta):
-    """y[:rows] = alpha M[:rows, :cols] @ x[:cols] + beta y[:rows] (M row-major, C order)."""
+    """y[:rows] = alpha M[:rows, :cols] @ x[:cols] + beta y[:rows] (M row-major, C order;
+    M, x and y all float64 or all float32)."""
     _gemv(_T, M, rows, cols, x, y, alpha, beta)
 
 
 @njit(cache=True)
 def gemv_cols(M, rows, cols, x, y, alpha, beta):
-    """y[:cols] = alpha M[:rows, :cols]^T @ x[:rows] + beta y[:cols] (M row-major)."""
+    """y[:cols] = alpha M[:rows, :cols]^T @ x[:rows] + beta y[:cols] (M row-major; M, x and
+    y all float64 or all float32)."""
     _gemv(_N, M, rows, cols, x, y, alpha, beta)
 
 
 @njit(cache=True)
-def ger_rows(M, rows, cols, alpha, x, y):
-    """M[:rows, :cols] += alpha x[:rows] y[:cols]^T (M row-major)."""
-    if rows == 0 or cols == 0:
-        return
-    dims = _ints(cols, rows, M.shape[1], 1)
-    a = np.array([alpha])
-    _dger(dims[0:].ctypes, dims[1:].ctypes, a.ctypes, y.ctypes, dims[3:].ctypes, x.ctypes,
-          dims[3:].ctypes, M.ctypes, dims[2:].ctypes)
-
-
-@njit(cache=True)
 def lu_factor(K, piv):
-    """LU factorization (partial pivoting) of the square C-order ``K`` in place, pivots in
-    ``piv`` (int32). The factors are those of K^T to LAPACK; :func:`lu_solve` accounts for
-    it. Returns LAPACK's info (0: success, > 0: exactly singular)."""
+    """LU factorization (partial pivoting) of the square C-order ``K`` (float64, or float32:
+    single precision) in place, pivots in ``piv`` (int32). The factors are those of K^T to
+    LAPACK; :func:`lu_solve` accounts for it. Returns LAPACK's info (0: success, > 0:
+    exactly singular)."""
     dims = _ints(K.shape[0], 0)
-    _dgetrf(dims.ctypes, dims.ctypes, K.ctypes, dims.ctypes, piv.ctypes, dims[1:].ctypes)
+    if K.itemsize == 4:
+        _sgetrf(dims.ctypes, dims.ctypes, K.ctypes, dims.ctypes, piv.ctypes, dims[1:].ctypes)
+    else:
+        _dgetrf(dims.ctypes, dims.ctypes, K.ctypes, dims.ctypes, piv.ctypes, dims[1:].ctypes)
     return dims[1]
 
 
 @njit(cache=True)
 def lu_solve(K, piv, B):
     """Solve K X = B^T in place of B for the factors of :func:`lu_factor`: ``B`` (p, n)
-    C order holds the p right-hand sides as rows (and receives the solutions)."""
+    C order, of K's dtype, holds the p right-hand sides as rows (and receives the
+    solutions)."""
     if B.shape[0] == 0:
         return
     trans = np.array([_T], np.uint8)
     dims = _ints(K.shape[0], B.shape[0], 0)
-    _dgetrs(trans.ctypes, dims[0:].ctypes, dims[1:].ctypes, K.ctypes, dims[0:].ctypes,
-            piv.ctypes, B.ctypes, dims[0:].ctypes, dims[2:].ctypes)
+    if K.itemsize == 4:
+        _sgetrs(trans.ctypes, dims[0:].ctypes, dims[1:].ctypes, K.ctypes, dims[0:].ctypes,
+                piv.ctypes, B.ctypes, dims[0:].ctypes, dims[2:].ctypes)
+    else:
+        _dgetrs(trans.ctypes, dims[0:].ctypes, dims[1:].ctypes, K.ctypes, dims[0:].ctypes,
+                piv.ctypes, B.ctypes, dims[0:].ctypes, dims[2:].ctypes)

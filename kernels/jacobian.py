@@ -22,7 +22,8 @@ O(1) per step. The nodes are split accordingly (radial order, by index):
 The approximate Jacobian is J with E frozen on B at its value when factorized (E_b), zero on
 F and exact on Z (its value at the last refresh of the zone). Block elimination of B:
 
-    K = I - A_BB diag(E_b)             b x b, LU (LAPACK dgetrf through :mod:`kernels.blas`)
+    K = I - A_BB diag(E_b)             b x b, LU in single precision (LAPACK sgetrf through
+                                       :mod:`kernels.blas`; see FACTOR_DTYPE)
     X = K^-1 A_BZ                      z columns, with the factorization
     C = A_ZZ + A_ZB diag(E_b) X        z x z, with the factorization
     Sigma = I - C diag(E_Z)            z x z, refactorized whenever E_Z moved (O(z^3))
@@ -71,9 +72,17 @@ ZONE_MAX = ZONE_IN + ZONE_OUT
 #: for the same iterations)
 ZONE_ETA = 1e-2
 
-CACHE_BASE = 0       # flat (N*N): LU of K (b*b)
-CACHE_ZONE_COLS = 1  # flat (ZONE_MAX*N): X^T (z rows of length b)
-CACHE_ZONE_ROWS = 2  # flat (ZONE_MAX*N): A_ZB diag(E_b) (z rows of length b)
+#: precision of K's factors, X and A_ZB diag(E_b): single. They make the chord part of
+#: Newton, whose direction is already off by the interior's drift since the factorization
+#: (about 1e-2 per step); single precision adds cond(K) * 6e-8, about 1e-4 at cond(K) = 1e3-2e4
+#: measured on the vs-numpy scenes, and halves the factorization's and the solves' time
+#: (both bound by memory traffic and SIMD width). The zone's C and Sigma, which make the
+#: exact part, and every residual stay double.
+FACTOR_DTYPE = np.float32
+
+CACHE_BASE = 0       # flat (N*N) FACTOR_DTYPE: LU of K (b*b)
+CACHE_ZONE_COLS = 1  # flat (ZONE_MAX*N) FACTOR_DTYPE: X^T (z rows of length b)
+CACHE_ZONE_ROWS = 2  # flat (ZONE_MAX*N) FACTOR_DTYPE: A_ZB diag(E_b) (z rows of length b)
 CACHE_COUPLING = 3   # flat (ZONE_MAX^2): C (z*z)
 CACHE_SCHUR = 4      # flat (ZONE_MAX^2): LU of Sigma (z*z)
 CACHE_E = 5          # (N): the approximate Jacobian's stiffness: E_b on B, E_Z on Z, 0 on F
@@ -105,9 +114,9 @@ def new_jacobian_cache(N):
     positions named by the CACHE_* constants, ``state`` indexed by STATE_*.
     """
     z = min(ZONE_MAX, N)
-    return (np.empty(N * N), np.empty(z * N), np.empty(z * N), np.empty(z * z),
-            np.empty(z * z), np.zeros(N), np.zeros(N, np.int64), np.zeros(N + z, np.int32),
-            np.zeros(N_STATE, np.int64))
+    return (np.empty(N * N, FACTOR_DTYPE), np.empty(z * N, FACTOR_DTYPE),
+            np.empty(z * N, FACTOR_DTYPE), np.empty(z * z), np.empty(z * z), np.zeros(N),
+            np.zeros(N, np.int64), np.zeros(N + z, np.int32), np.zeros(N_STATE, np.int64))
 
 
 def invalidate(cache):
@@ -175,7 +184,10 @@ def factorize(h, A, ceff, h0, c, cache):
         for l in range(z):
             C[k, l] = A[lo + k, lo + l]
     if b > 0 and z > 0:
-        C += zone_rows[:z * b].reshape((z, b)) @ zone_cols[:z * b].reshape((z, b)).T
+        RX = zone_rows[:z * b].reshape((z, b)) @ zone_cols[:z * b].reshape((z, b)).T
+        for k in range(z):
+            for l in range(z):
+                C[k, l] += RX[k, l]
     state[STATE_VALID] = 1
     state[STATE_SUBSET] = m
     state[STATE_ZONE_LO] = lo
@@ -212,22 +224,25 @@ def apply_inverse(v, A, cache):
     x = v.copy()
     if m == 0:
         return x
-    y = np.empty((1, b))
+    y = np.empty((1, b), base.dtype)
     for p in range(b):
         y[0, p] = v[base_nodes[p]]
     if b > 0:
         lu_solve(base[:b * b].reshape((b, b)), pivots[:b], y)
     if z > 0:
-        rz = np.empty((1, z))
+        rz = np.empty((1, z), base.dtype)
         for k in range(z):
             rz[0, k] = v[lo + k]
         if b > 0:
             gemv_rows(zone_rows[:z * b].reshape((z, b)), z, b, y[0], rz[0], 1.0, 1.0)
-        lu_solve(schur[:z * z].reshape((z, z)), pivots[N:N + z], rz)
-        w = np.empty(z)
+        xz = np.empty((1, z))
         for k in range(z):
-            x[lo + k] = rz[0, k]
-            w[k] = E[lo + k] * rz[0, k]
+            xz[0, k] = rz[0, k]
+        lu_solve(schur[:z * z].reshape((z, z)), pivots[N:N + z], xz)
+        w = np.empty(z, base.dtype)
+        for k in range(z):
+            x[lo + k] = xz[0, k]
+            w[k] = E[lo + k] * xz[0, k]
         if b > 0:
             gemv_cols(zone_cols[:z * b].reshape((z, b)), z, b, w, y[0], 1.0, 1.0)
     for p in range(b):
