@@ -89,6 +89,7 @@ CACHE_E = 5          # (N): the approximate Jacobian's stiffness: E_b on B, E_Z 
 CACHE_BASE_NODES = 6  # (N) int64: the nodes of B, in order (rows/columns of K)
 CACHE_PIVOTS = 7     # (N + ZONE_MAX) int32: pivots of K, then of Sigma
 CACHE_STATE = 8      # int64, indexed by STATE_*
+CACHE_CONTRACTION = 9  # (1): the chord iteration's contraction estimate (kernels.solve.newton)
 #: state[STATE_VALID]: 1 when the cache holds a factorization, 0 to refactorize
 STATE_VALID = 0
 #: state[STATE_SUBSET]: m, the size of the interacting prefix S = [0, m)
@@ -110,13 +111,14 @@ def new_jacobian_cache(N):
     """Work arrays that carry the factorized Jacobian between solves and steps, as one
     tuple that the kernels take whole.
 
-    Returns (base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state),
-    positions named by the CACHE_* constants, ``state`` indexed by STATE_*.
+    Returns (base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state,
+    contraction), positions named by the CACHE_* constants, ``state`` indexed by STATE_*.
     """
     z = min(ZONE_MAX, N)
     return (np.empty(N * N, FACTOR_DTYPE), np.empty(z * N, FACTOR_DTYPE),
             np.empty(z * N, FACTOR_DTYPE), np.empty(z * z), np.empty(z * z), np.zeros(N),
-            np.zeros(N, np.int64), np.zeros(N + z, np.int32), np.zeros(N_STATE, np.int64))
+            np.zeros(N, np.int64), np.zeros(N + z, np.int32), np.zeros(N_STATE, np.int64),
+            np.ones(1))
 
 
 def invalidate(cache):
@@ -138,7 +140,7 @@ def crack_tip_index(d):
 def factorize(h, A, ceff, h0, c, cache):
     """Factorize the Jacobian at ``h`` into ``cache``: choose S, Z and B, factorize K, form
     X and C. Returns m = |S|."""
-    base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state = cache
+    base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state = cache[:9]
     N = h.size
     zmax = zone_cols.size // N
     sig = np.empty(N)
@@ -214,7 +216,7 @@ def _refresh_zone(Ez, coupling, schur, pivots, N, z):
 @njit(cache=True)
 def apply_inverse(v, A, cache):
     """x = J^-1 v for the approximate Jacobian of the cache (stiffness ``E``)."""
-    base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state = cache
+    base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state = cache[:9]
     N = v.size
     m = state[STATE_SUBSET]
     lo = state[STATE_ZONE_LO]
@@ -265,7 +267,7 @@ def newton_direction(F, d, A, ceff, cache, stats, stat_zone):
     tip left the zone's inner part, a far-field node became stiff, or Sigma is singular):
     the caller refactorizes.
     """
-    _, _, _, coupling, schur, E, _, pivots, state = cache
+    _, _, _, coupling, schur, E, _, pivots, state = cache[:9]
     N = F.size
     m = state[STATE_SUBSET]
     lo = state[STATE_ZONE_LO]

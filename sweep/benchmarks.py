@@ -465,7 +465,8 @@ def _nodes_used(res) -> int:
 
 def kernel_counters(scene, numerics) -> dict:
     """Counters of the unloading kernel on one run (``kernels.solve`` STAT_*), per step:
-    residual evaluations (one N x N mat-vec each), Newton iterations, refactorizations of the
+    residual evaluations (one N x N mat-vec each), Newton iterations, solves ended on the
+    predicted residual (``kernels.solve.PREDICTED_RESIDUAL``), refactorizations of the
     crack-tip zone's Schur complement (``zone_refreshes``), factorizations of the contact
     (with the reason of the refactorizations) and the mean size of the interacting set
     |S|/N."""
@@ -488,6 +489,7 @@ def kernel_counters(scene, numerics) -> dict:
     return {"residual_matvecs_per_step": st[ks.STAT_RESIDUALS] / steps,
             "newton_iterations_per_step": st[ks.STAT_ITER] / steps,
             "zone_refreshes_per_step": st[ks.STAT_ZONE] / steps,
+            "predicted_solves_per_step": st[ks.STAT_PREDICTED] / steps,
             "factorizations": int(st[ks.STAT_FACTOR]),
             "refactorizations": {"tip_left_zone": int(st[ks.STAT_REFACTOR_ZONE]),
                                  "slow_contraction": int(st[ks.STAT_REFACTOR_SLOW]),

@@ -279,7 +279,9 @@ class Numerics:
         Maximum relative error of the Prony approximation of Chat over the scene's time
         window (ignored with ``exact=True``).
     tol : float
-        Newton tolerance on the gap, in units of h0 (max norm of the residual).
+        Newton tolerance on the gap, in units of h0 (max norm of the residual; computed, or
+        predicted below a tenth of it from the measured contraction of the iteration,
+        ``kernels.solve.PREDICTED_RESIDUAL``).
     max_steps : int
         Hard cap on the number of time steps (a run that hits it is ``failed``).
     time_budget_s : float

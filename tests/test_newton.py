@@ -148,6 +148,36 @@ def test_newton_solves_the_discrete_equilibrium():
     assert np.max(np.abs(hs - h_start)) > 1e-3 * h0          # it did move
 
 
+def test_solves_ended_on_the_predicted_residual_meet_the_tolerance():
+    # a continuation in the indentation (linear predictor): where the residual predicted
+    # after the first update (the contraction last measured times |F|) is below
+    # PREDICTED_RESIDUAL tol, the solve ends without computing it; computed here by numpy,
+    # it must still be within tol, for those solves and for the others
+    from sweep.initial import ElasticSolver, relaxed_state
+    N = 120
+    A, _, h0, c, _ = _problem(N=N, seed=3)
+    r = np.arange(N) * 3.0 / (N - 1)
+    h, _ = relaxed_state(ElasticSolver(A, r, h0, c, 1e-10), delta0=1.0)
+    ceff, tol = 0.8, 1e-8 * h0
+    H = -0.05 * np.exp(-r)
+    cache = ks.new_jacobian_cache(N)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    prev = h.copy()
+    sig, d = np.empty(N), np.empty(N)
+    ended = {True: [], False: []}
+    for n, delta in enumerate(1.0 - np.arange(1, 60) * 1e-4):
+        g = -delta + h0 + 0.5 * r**2
+        guess = 2.0 * h - prev if n > 0 else h.copy()
+        before = stats[ks.STAT_PREDICTED]
+        assert ks.newton(guess, g, A, ceff, H, h0, c, tol, 40, cache, stats)
+        lj_traction_and_stiffness(guess, h0, c, sig, d)
+        residual = np.max(np.abs(guess - g - A @ (ceff * sig - H)))
+        ended[bool(stats[ks.STAT_PREDICTED] > before)].append(residual / tol)
+        prev, h = h, guess
+    assert len(ended[True]) >= 10 and len(ended[False]) >= 10   # measured 29 and 30
+    assert max(ended[True]) <= 1.0 and max(ended[False]) <= 1.0     # measured 0.58, 0.57
+
+
 def test_relaxed_state_is_cached_per_mesh_and_reused_unchanged():
     from sweep.initial import ElasticSolver, relaxed_state
     A, _, h0, c, _ = _problem(N=100, seed=4)
