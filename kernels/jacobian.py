@@ -72,19 +72,19 @@ ZONE_MAX = ZONE_IN + ZONE_OUT
 #: for the same iterations)
 ZONE_ETA = 1e-2
 
-#: precision of K's factors, X and A_ZB diag(E_b): single. They make the chord part of
-#: Newton, whose direction is already off by the interior's drift since the factorization
-#: (about 1e-2 per step); single precision adds cond(K) * 6e-8, about 1e-4 at cond(K) = 1e3-2e4
-#: measured on the vs-numpy scenes, and halves the factorization's and the solves' time
-#: (both bound by memory traffic and SIMD width). The zone's C and Sigma, which make the
-#: exact part, and every residual stay double.
+#: precision of K's factors, X, A_ZB diag(E_b) and Sigma's factors: single. They make the
+#: Newton direction, which is already off by the interior's drift since the factorization
+#: (about 1e-2 per step); single precision adds cond * 6e-8, about 1e-4 at cond(K) =
+#: 1e3-2e4 measured on the vs-numpy scenes, and halves the time of the factorizations and of
+#: the triangular solves (bound by memory traffic and SIMD width). C, from which Sigma is
+#: made at each refresh, and every residual stay double.
 FACTOR_DTYPE = np.float32
 
 CACHE_BASE = 0       # flat (N*N) FACTOR_DTYPE: LU of K (b*b)
 CACHE_ZONE_COLS = 1  # flat (ZONE_MAX*N) FACTOR_DTYPE: X^T (z rows of length b)
 CACHE_ZONE_ROWS = 2  # flat (ZONE_MAX*N) FACTOR_DTYPE: A_ZB diag(E_b) (z rows of length b)
 CACHE_COUPLING = 3   # flat (ZONE_MAX^2): C (z*z)
-CACHE_SCHUR = 4      # flat (ZONE_MAX^2): LU of Sigma (z*z)
+CACHE_SCHUR = 4      # flat (ZONE_MAX^2) FACTOR_DTYPE: LU of Sigma (z*z)
 CACHE_E = 5          # (N): the approximate Jacobian's stiffness: E_b on B, E_Z on Z, 0 on F
 CACHE_BASE_NODES = 6  # (N) int64: the nodes of B, in order (rows/columns of K)
 CACHE_PIVOTS = 7     # (N + ZONE_MAX) int32: pivots of K, then of Sigma
@@ -116,7 +116,7 @@ def new_jacobian_cache(N):
     """
     z = min(ZONE_MAX, N)
     return (np.empty(N * N, FACTOR_DTYPE), np.empty(z * N, FACTOR_DTYPE),
-            np.empty(z * N, FACTOR_DTYPE), np.empty(z * z), np.empty(z * z), np.zeros(N),
+            np.empty(z * N, FACTOR_DTYPE), np.empty(z * z), np.empty(z * z, FACTOR_DTYPE), np.zeros(N),
             np.zeros(N, np.int64), np.zeros(N + z, np.int32), np.zeros(N_STATE, np.int64),
             np.ones(1))
 
@@ -237,9 +237,7 @@ def apply_inverse(v, A, cache):
             rz[0, k] = v[lo + k]
         if b > 0:
             gemv_rows(zone_rows[:z * b].reshape((z, b)), z, b, y[0], rz[0], 1.0, 1.0)
-        xz = np.empty((1, z))
-        for k in range(z):
-            xz[0, k] = rz[0, k]
+        xz = rz
         lu_solve(schur[:z * z].reshape((z, z)), pivots[N:N + z], xz)
         w = np.empty(z, base.dtype)
         for k in range(z):
