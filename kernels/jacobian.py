@@ -116,9 +116,9 @@ def new_jacobian_cache(N):
     """
     z = min(ZONE_MAX, N)
     return (np.empty(N * N, FACTOR_DTYPE), np.empty(z * N, FACTOR_DTYPE),
-            np.empty(z * N, FACTOR_DTYPE), np.empty(z * z), np.empty(z * z, FACTOR_DTYPE), np.zeros(N),
-            np.zeros(N, np.int64), np.zeros(N + z, np.int32), np.zeros(N_STATE, np.int64),
-            np.ones(1))
+            np.empty(z * N, FACTOR_DTYPE), np.empty(z * z), np.empty(z * z, FACTOR_DTYPE),
+            np.zeros(N), np.zeros(N, np.int64), np.zeros(N + z, np.int32),
+            np.zeros(N_STATE, np.int64), np.ones(1))
 
 
 def invalidate(cache):
@@ -237,12 +237,11 @@ def apply_inverse(v, A, cache):
             rz[0, k] = v[lo + k]
         if b > 0:
             gemv_rows(zone_rows[:z * b].reshape((z, b)), z, b, y[0], rz[0], 1.0, 1.0)
-        xz = rz
-        lu_solve(schur[:z * z].reshape((z, z)), pivots[N:N + z], xz)
+        lu_solve(schur[:z * z].reshape((z, z)), pivots[N:N + z], rz)
         w = np.empty(z, base.dtype)
         for k in range(z):
-            x[lo + k] = xz[0, k]
-            w[k] = E[lo + k] * xz[0, k]
+            x[lo + k] = rz[0, k]
+            w[k] = E[lo + k] * rz[0, k]
         if b > 0:
             gemv_cols(zone_cols[:z * b].reshape((z, b)), z, b, w, y[0], 1.0, 1.0)
     for p in range(b):

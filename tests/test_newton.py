@@ -43,10 +43,10 @@ def _sets(cache):
 
 
 def _assert_solves(dh, J, F):
-    """dh = -J^{-1} F to within single precision: K's factors, X and A_ZB diag(E_b) are
-    float32 (kernels.jacobian.FACTOR_DTYPE), so the normwise error bound of an LU solve is
-    cond(J) * eps32 (measured here about 300 times below it; a wrong factorization or a
-    wrong set of nodes is off by order one)."""
+    """dh = -J^{-1} F to within single precision: K's and Sigma's factors, X and
+    A_ZB diag(E_b) are float32 (kernels.jacobian.FACTOR_DTYPE), so the normwise error bound
+    of an LU solve is cond(J) * eps32 (measured here about 300 times below it; a wrong
+    factorization or a wrong set of nodes is off by order one)."""
     ref = -np.linalg.solve(J, F)
     error = np.linalg.norm(dh - ref) / np.linalg.norm(ref)
     assert error <= np.linalg.cond(J) * np.finfo(np.float32).eps, error
