@@ -499,6 +499,97 @@ def kernel_counters(scene, numerics) -> dict:
             "note": "counters include the relaxed start's elastic solves when not cached"}
 
 
+def compare_results(before, after) -> dict:
+    """Agreement of two results files of the same scenes (two engine versions, say): scenes
+    in both, status changes, and over the scenes ``ok`` in both the relative differences
+    |after / before - 1| of the pull-off and the crack speed (max and median), with the sums
+    of the scenes' wall times."""
+    from .store import load
+
+    a = load(before).set_index("scene_id")
+    b = load(after).set_index("scene_id")
+    common = a.index.intersection(b.index)
+    only = {"only_before": int(len(a) - common.size), "only_after": int(len(b) - common.size)}
+    a, b = a.loc[common], b.loc[common]
+    ok = (a.status == "ok") & (b.status == "ok")
+    out = {"scenes": int(common.size), **only,
+           "status_changed": int((a.status != b.status).sum()), "ok_in_both": int(ok.sum()),
+           "wall_s_sum": {"before": float(a.wall_s.sum()), "after": float(b.wall_s.sum())}}
+    for column in ("pull_off", "crack_speed"):
+        rel = (b[column][ok] / a[column][ok] - 1.0).abs()
+        out[column] = {"max_rel_diff": float(rel.max()), "median_rel_diff": float(rel.median())}
+    return out
+
+
+def newton_diagnosis(scene, numerics, at_step: int = 300, ahead: int = 10) -> dict:
+    """Why Newton costs what it does on one scene: the kernel counters of the whole run
+    (:func:`kernel_counters`) and, from the accepted states at steps ``at_step`` .. +
+    ``ahead`` (runs cut there by ``max_steps``): the spectral radius of the chord map
+    I - J_used^-1 J after 1 and ``ahead`` steps, with the crack-tip zone exact and the rest
+    as factorized at ``at_step`` (dense eigenvalues: the staleness of the Jacobian), and the
+    cubic predictor's error |h_pred - h| / h0 (max over the nodes, where, and median) for
+    each of the last steps (the distance Newton starts from)."""
+    from kernels.interface import lj_traction_and_stiffness
+    from kernels.jacobian import ZONE_IN, ZONE_OUT, crack_tip_index
+
+    from . import solver
+    captured = {}
+    orig = solver.unload
+
+    def capture(*args):
+        out = orig(*args)
+        captured.setdefault("calls", []).append((args, out[1]))
+        return out
+    steps = list(range(at_step - 3, at_step + ahead + 1))
+    gaps, times = {}, {}
+    solver.unload = capture
+    try:
+        for k in steps:
+            captured.clear()
+            solver.simulate(scene, dataclasses.replace(numerics, max_steps=k))
+            # the run's own kernel call (an error-indicator solve on a cheaper mesh may follow)
+            args, n = captured["calls"][0]
+            gaps[k], times[k] = args[-2].copy(), float(args[-7][n - 1])   # h_out, t_out
+    finally:
+        solver.unload = orig
+    A, h0, c = args[0], args[6], args[7]
+    N = A.shape[0]
+
+    def stiffness(h):
+        sig, d = np.empty(N), np.empty(N)
+        lj_traction_and_stiffness(h, h0, c, sig, d)
+        return d
+    d0 = stiffness(gaps[at_step])
+    tip = crack_tip_index(d0)
+    lo, hi = max(tip - ZONE_IN, 0), min(tip + ZONE_OUT, N)
+    chord = {}
+    for k in (at_step + 1, at_step + ahead):
+        d1 = stiffness(gaps[k])
+        used = d0.copy()
+        used[lo:hi] = d1[lo:hi]
+        J_used, J = np.eye(N) - A * used[None, :], np.eye(N) - A * d1[None, :]
+        M = np.eye(N) - np.linalg.solve(J_used, J)
+        chord[str(k - at_step)] = float(np.max(np.abs(np.linalg.eigvals(M))))
+    predictor = []
+    for k in steps[4:]:
+        t = [times[k - 4 + i] for i in range(4)]
+        pred = np.zeros(N)
+        for i in range(4):
+            weight = 1.0
+            for j in range(4):
+                if j != i:
+                    weight *= (times[k] - t[j]) / (t[i] - t[j])
+            pred += weight * gaps[k - 4 + i]
+        err = np.abs(pred - gaps[k]) / h0
+        predictor.append({"step": k, "dt": float(times[k] - t[-1]), "max": float(err.max()),
+                          "node": int(np.argmax(err)), "tip_node": int(tip),
+                          "median": float(np.median(err))})
+    return {"scene": dataclasses.asdict(scene), "nodes": N,
+            "counters": kernel_counters(scene, numerics),
+            "zone": [int(lo), int(hi)], "chord_spectral_radius_after_steps": chord,
+            "cubic_predictor_error_h0": predictor}
+
+
 def bench_step_over_matvec(plan: BenchPlan) -> dict:
     """Time per step over the time of one dense N x N mat-vec at the mesh's N, with the
     kernel's counters (:func:`kernel_counters`)."""
@@ -1034,6 +1125,32 @@ def tradeoff_cmd(quick, out):
     """Accuracy vs wall time over a grid of numerics: table.csv, pareto.png, presets.json."""
     report = write_tradeoff(out, quick=quick, progress=lambda m: click.echo(m, err=True))
     click.echo(json.dumps(report["presets"], indent=2, default=str))
+
+
+@bench.command("compare")
+@click.argument("before", type=click.Path(exists=True, dir_okay=False))
+@click.argument("after", type=click.Path(exists=True, dir_okay=False))
+def compare_cmd(before, after):
+    """Agreement of two results files of the same scenes (e.g. two engine versions)."""
+    _write(compare_results(before, after), None)
+
+
+@bench.command("newton-diagnosis")
+@click.option("--n", type=float, default=0.2, show_default=True)
+@click.option("--k", type=float, default=0.5, show_default=True)
+@click.option("--mu", type=float, default=3.24, show_default=True)
+@click.option("--rate", type=float, default=0.1, show_default=True)
+@click.option("--delta0", type=float, default=43.1661, show_default=True)
+@click.option("--preset", default="fast", show_default=True)
+@click.option("--max-nodes", type=int, default=1000, show_default=True)
+@click.option("--at-step", type=int, default=300, show_default=True)
+@click.option("--out", default=None, help="JSON report path.")
+def newton_diagnosis_cmd(n, k, mu, rate, delta0, preset, max_nodes, at_step, out):
+    """Newton's cost on one scene: counters, the chord map's contraction and the predictor's
+    error at the crack tip (default: the scale campaign's costliest kind of scene)."""
+    from .scene import Numerics, Scene
+    _write(newton_diagnosis(Scene(n=n, k=k, mu=mu, rate=rate, delta0=delta0),
+                            Numerics.preset(preset, max_nodes=max_nodes), at_step), out)
 
 
 @bench.command("presets")

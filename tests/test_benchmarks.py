@@ -165,3 +165,51 @@ def test_bench_json_keys_with_a_tiny_plan():
     d = rep["prony_speedup_detail"][str(plan.prony_steps[0])]
     assert d["prony_steps"] == d["exact_steps"]               # same fixed steps
     assert abs(d["pull_off_rel_diff"]) < 1e-2
+
+
+def test_compare_results_reports_status_changes_and_relative_differences(tmp_path):
+    # two results files of the same three scenes (plus one only in the first): one status
+    # changed, the others differ by known relative amounts
+    from sweep.benchmarks import compare_results
+    from sweep.store import ResultStore
+
+    def write(path, rows):
+        st = ResultStore(path, config_hash="synthetic", config_name="t",
+                         config_text="name: t\n", n_scenes=len(rows))
+        st.prepare(resume=False)
+        st.begin(fresh=True)
+        for row in rows:
+            st.append(row)
+        st.finish(complete=True)
+
+    before = [dict(scene_id="a", status="ok", pull_off=2.0, crack_speed=1.0, wall_s=1.0),
+              dict(scene_id="b", status="ok", pull_off=4.0, crack_speed=3.0, wall_s=2.0),
+              dict(scene_id="c", status="ok", pull_off=1.0, crack_speed=1.0, wall_s=1.0),
+              dict(scene_id="d", status="ok", pull_off=1.0, crack_speed=1.0, wall_s=1.0)]
+    after = [dict(scene_id="a", status="ok", pull_off=2.002, crack_speed=1.0, wall_s=0.5),
+             dict(scene_id="b", status="ok", pull_off=4.0, crack_speed=3.3, wall_s=1.0),
+             dict(scene_id="c", status="failed", pull_off=float("nan"),
+                  crack_speed=float("nan"), wall_s=0.1)]
+    write(tmp_path / "before.h5", before)
+    write(tmp_path / "after.h5", after)
+    out = compare_results(tmp_path / "before.h5", tmp_path / "after.h5")
+    assert out["scenes"] == 3 and out["only_before"] == 1 and out["only_after"] == 0
+    assert out["status_changed"] == 1 and out["ok_in_both"] == 2
+    assert out["pull_off"]["max_rel_diff"] == pytest.approx(1e-3)
+    assert out["pull_off"]["median_rel_diff"] == pytest.approx(5e-4)
+    assert out["crack_speed"]["max_rel_diff"] == pytest.approx(0.1)
+    assert out["wall_s_sum"] == pytest.approx({"before": 4.0, "after": 1.6})
+
+
+def test_newton_diagnosis_pairs_states_with_their_times():
+    # on a smooth stretch of a small scene the cubic extrapolation through the accepted
+    # states, at their times, must predict the next state closely in the contact interior
+    # (a mismatched state or time makes it miss by O(h0)), and the chord map one step after
+    # a factorization must contract
+    from sweep.benchmarks import newton_diagnosis
+    out = newton_diagnosis(Scene(n=0.8, k=0.1, mu=3.24, delta0=3.6, rate=1e4),
+                           Numerics.preset("fast"), at_step=30, ahead=3)
+    rows = out["cubic_predictor_error_h0"]
+    assert len(rows) == 3 and all(r["median"] < 1e-3 for r in rows)
+    assert 0.0 <= out["chord_spectral_radius_after_steps"]["1"] < 0.5
+    assert out["counters"]["newton_iterations_per_step"] >= 1.0
