@@ -59,40 +59,40 @@ coverage-kernels: $(STAMP)
 	  --cov-report=term-missing $(KERNEL_TESTS) -k "not uniform_pressure and not hertz"
 
 bench: $(STAMP)
-	$(BIN)/python -m sweep.benchmarks all --out results/bench.json
+	$(BIN)/python -m sweep.bench.benchmarks all --out results/bench.json
 
 tradeoff: $(STAMP)
-	$(BIN)/python -m sweep.benchmarks tradeoff $(if $(filter 1,$(QUICK)),--quick) --out results/tradeoff
+	$(BIN)/python -m sweep.bench.benchmarks tradeoff $(if $(filter 1,$(QUICK)),--quick) --out results/tradeoff
 
 # converged references of the tradeoff and vs-numpy scenes (configs/references.json; slow)
 bench-reference: $(STAMP)
-	$(BIN)/python -m sweep.benchmarks reference
+	$(BIN)/python -m sweep.bench.benchmarks reference
 
 bench-detail: $(STAMP)
-	$(BIN)/python -m sweep.benchmarks scene --out results/bench/scene.json
-	$(BIN)/python -m sweep.benchmarks presets --out results/bench/presets.json
-	$(BIN)/python -m sweep.benchmarks scheduler --out results/bench/scheduler.json
-	$(BIN)/python -m sweep.benchmarks store --out results/bench/store.json
+	$(BIN)/python -m sweep.bench.benchmarks scene --out results/bench/scene.json
+	$(BIN)/python -m sweep.bench.benchmarks presets --out results/bench/presets.json
+	$(BIN)/python -m sweep.bench.benchmarks scheduler --out results/bench/scheduler.json
+	$(BIN)/python -m sweep.bench.benchmarks store --out results/bench/store.json
 
 # issue 10: the whole Tabor range. Stability at the extremes of (n, k, rate, a0, mu) (144
 # scenes; QUICK=1 the covering subset), the tip-following mesh's convergence at mu = 30 and
 # 100, the elastic pull-off against mu (quasi-static branch)
 extremes: $(STAMP)
-	$(BIN)/python -m sweep.extremes $(if $(filter 1,$(QUICK)),--quick)
+	$(BIN)/python -m sweep.bench.extremes $(if $(filter 1,$(QUICK)),--quick)
 
 tip-convergence: $(STAMP)
-	$(BIN)/python -m sweep.tip_following --mu 30 100
-	$(BIN)/python -m sweep.tip_following --mu 30 --k 0.1 --a0 3 --rate 316.227766
+	$(BIN)/python -m sweep.engine.tip_following --mu 30 100
+	$(BIN)/python -m sweep.engine.tip_following --mu 30 --k 0.1 --a0 3 --rate 316.227766
 
 elastic-table: $(STAMP)
-	$(BIN)/python -m sweep.quasistatic
+	$(BIN)/python -m sweep.engine.quasistatic
 
 bench-convergence: $(STAMP)
-	$(BIN)/python -m sweep.benchmarks convergence --mu 6 --out results/bench/convergence_mu6.json
+	$(BIN)/python -m sweep.bench.benchmarks convergence --mu 6 --out results/bench/convergence_mu6.json
 
 # -- reproduction of the paper (results/REPORT.md) ----------------------------------------
 # Each campaign target runs (or resumes) its sweep, then writes fit.json/figures with
-# `python -m sweep.reproduce`, and records its own wall time in <dir>/make_wall_s.txt.
+# `python -m sweep.paper.reproduce`, and records its own wall time in <dir>/make_wall_s.txt.
 # QUICK=1 runs the thinned grids of configs/quick/ into results/quick/ (a smoke run, never
 # the committed report).
 ifeq ($(QUICK),1)
@@ -134,15 +134,15 @@ reproduce: threshold vr figures
 	@$(MAKE) --no-print-directory report
 
 pdms: $(STAMP)
-	$(BIN)/python -m sweep.pdms --out results/pdms
+	$(BIN)/python -m sweep.paper.pdms --out results/pdms
 
 agreement: $(STAMP)
-	$(BIN)/python -m sweep.agreement --out results/agreement/agreement.json
+	$(BIN)/python -m sweep.bench.agreement --out results/agreement/agreement.json
 
 # the costly high-mu point of the agreement (about 35 min on a loaded 2-core machine); make
 # agreement merges its rows into results/agreement/agreement.md
 agreement-high-mu: $(STAMP)
-	$(BIN)/python -m sweep.agreement --mus 15 --no-a0-scan --out results/agreement/agreement_mu15.json
+	$(BIN)/python -m sweep.bench.agreement --mus 15 --no-a0-scan --out results/agreement/agreement_mu15.json
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache .coverage

@@ -2,12 +2,12 @@
 
 Public API (units and conventions: see ``sweep.units`` and docs/design.md section 2)::
 
-    from sweep import Scene, Numerics, simulate
+    from . import Scene, Numerics, simulate
     result = simulate(Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=316.2), Numerics.preset("balanced"))
 """
 from . import threads as _threads
 
-__version__ = "0.1.0"
+from ._version import __version__  # noqa: E402,F401
 
 # One BLAS thread per process unless the user says otherwise (see sweep.threads); before
 # numpy is imported by the modules below.
@@ -15,9 +15,9 @@ _threads.limit_env(_threads.BLAS_VARS)
 
 from .errors import InputError  # noqa: E402
 from .scene import PRESETS, Numerics, Result, Scene, scene_id  # noqa: E402
-from .solver import simulate, warm_up  # noqa: E402
-from .store import load, load_trajectory  # noqa: E402  (results files of sweeps)
-from .scheduler import run_sweep  # noqa: E402  (the Python entry point of `sweep run`)
+from .engine.bem import simulate, warm_up  # noqa: E402
+from .campaign.store import load, load_trajectory  # noqa: E402  (results files of sweeps)
+from .campaign.scheduler import run_sweep  # noqa: E402  (the Python entry point of `sweep run`)
 
 __all__ = ["InputError", "PRESETS", "Numerics", "Result", "Scene", "scene_id", "simulate",
            "warm_up", "load", "load_trajectory", "run_sweep", "__version__"]

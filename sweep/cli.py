@@ -223,7 +223,7 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
 def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, **values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .errors import as_float
-    from .models import simulate_scene
+    from .engine.models import simulate_scene
     from .scene import Numerics
 
     si_values = {name: values.pop(name) for name in _SI_OPTIONS}
@@ -281,7 +281,7 @@ def _scene_si(axes, as_json, values):
     from click.core import ParameterSource
 
     from .errors import as_float
-    from .si import SIScene, run_si
+    from .campaign.si import SIScene, run_si
 
     ctx = click.get_current_context()
     clash = [f"--{name}" for name in ("k", "mu", "a0", "delta0", "rate")
@@ -323,7 +323,7 @@ def plot_command(results, out):
     """Plot pull-off vs rate (and P(a) trajectories, if stored) of a results file."""
     from pathlib import Path
 
-    from .plots import plot_sweep
+    from .analysis.plots import plot_sweep
 
     if not Path(results).exists():
         raise InputError(f"results: no such file {results!r}")
@@ -354,7 +354,7 @@ def plot_command(results, out):
 def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_timeout,
             consolidate_every):
     """Run (or resume) the sweep described by the YAML file CONFIG."""
-    from .scheduler import SweepRuntimeError, run_sweep
+    from .campaign.scheduler import SweepRuntimeError, run_sweep
 
     try:
         report = run_sweep(config, jobs=jobs, backend=backend, scheduler=scheduler, out=out,
@@ -376,12 +376,12 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
               help="With --si: also write every SI and dimensionless column as CSV.")
 def info_cmd(results, slowest, as_si, csv_out):
     """Summarize a results file: counts by status, parameter ranges, slowest scenes."""
-    from .store import summary
+    from .campaign.store import summary
 
     if not Path(results).exists():
         raise InputError(f"no results at {results}")
     if as_si:
-        from .si import si_table
+        from .campaign.si import si_table
 
         df = si_table(results)
         if csv_out:
@@ -421,7 +421,7 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
     FILE.csv holds a master curve (omega_rad_s,E_storage_Pa,E_loss_Pa) or a temperature
     sweep (T_C,f_Hz,E_storage_Pa,E_loss_Pa), shifted to --tref with the WLF equation.
     """
-    from .dma import fit_maxwell, fit_mpl, kramers_kronig_check, plot_dma, read_dma_csv
+    from .analysis.dma import fit_maxwell, fit_mpl, kramers_kronig_check, plot_dma, read_dma_csv
     from .errors import as_float, check_int
 
     c = parse_floats("wlf", wlf)
@@ -476,7 +476,7 @@ def _load_results(path: str):
     """The runs table of the results file ``path``, or an InputError naming it."""
     from pathlib import Path
 
-    from .store import load
+    from .campaign.store import load
 
     if not Path(path).is_file():
         raise InputError(f"results: no such file {path!r}")
@@ -528,7 +528,7 @@ def fit_group():
 @_with_fit_options
 def fit_threshold_cmd(results, slope, saturation, boot, as_json):
     """Threshold radius a0t per (n, rate) and the collapse fit P_po = A a0t^B of an a0 sweep."""
-    from .analysis import threshold_analysis
+    from .analysis.fits import threshold_analysis
     from .errors import check_positive
 
     slope = check_positive("slope", slope)
@@ -561,7 +561,7 @@ def fit_threshold_cmd(results, slope, saturation, boot, as_json):
 @_with_fit_options
 def fit_vr_cmd(results, saturation, boot, as_json):
     """Crack speed at pull-off vs rate, vhat = A rhat_PB^B, and Persson-Brener vs the BEM."""
-    from .analysis import vr_analysis
+    from .analysis.fits import vr_analysis
 
     sat, n_boot = _fit_numbers(saturation, boot)
     out = vr_analysis(_load_results(results), sat, n_boot)
@@ -589,8 +589,8 @@ def fit_vr_cmd(results, saturation, boot, as_json):
 
 
 def _add_reproduce() -> None:
-    """``sweep reproduce ...``: the paper's fits, figures and report (sweep/reproduce.py)."""
-    from .reproduce import cli as reproduce_group
+    """``sweep reproduce ...``: the paper's fits, figures and report (sweep/paper/reproduce.py)."""
+    from .paper.reproduce import cli as reproduce_group
 
     cli.add_command(reproduce_group, "reproduce")
 

@@ -28,7 +28,7 @@ from .errors import InputError, check_choice, check_int, check_range
 MATERIALS = ("mpl", "sls")
 MESHES = ("uniform", "graded")
 STOPS = ("pulloff", "separation")
-#: Models a scene can ask for (sweep.models maps each to its simulate function).
+#: Models a scene can ask for (sweep.engine.models maps each to its simulate function).
 MODEL_NAMES = ("bem", "crack", "pb", "elastic", "auto")
 
 
@@ -77,8 +77,8 @@ class Scene:
         Ratio of relaxed to glassy modulus E0/Einf, in (0, 1]; ``k = 1`` is elastic.
     mu : float
         Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.01, 1000]: the hereditary BEM
-        takes [0.01, 100] (sweep.problem.BEM_MU_RANGE; above about 8 on a mesh that follows
-        the crack tip, :mod:`sweep.tip_following`), the elastic branch is validated up to
+        takes [0.01, 100] (sweep.engine.problem.BEM_MU_RANGE; above about 8 on a mesh that follows
+        the crack tip, :mod:`sweep.engine.tip_following`), the elastic branch is validated up to
         100, the crack-front and pb models (large contacts against l0, e.g. the paper's
         PDMS at mu = 103) take the whole range.
     rate : float
@@ -96,7 +96,7 @@ class Scene:
         Stop right after the load minimum has passed and recovered ("pulloff"), or follow
         the whole curve until the contact is lost ("separation").
     model : {"bem", "crack", "pb", "auto"}
-        Which model runs the scene (:mod:`sweep.models`): the BEM (default), the crack-front
+        Which model runs the scene (:mod:`sweep.engine.models`): the BEM (default), the crack-front
         model, the paper's closed-form PB estimate, or "auto" (the BEM where its mesh fits the
         numerics' node count, else the crack-front model); ``Result.model_used`` records it.
     """
@@ -122,7 +122,7 @@ class Scene:
                          choices=MATERIALS, order=0)
     stop: str = axis("pulloff", help="stop after the pull-off, or follow the curve to "
                      "separation", choices=STOPS, order=1, plot_group=False)
-    model: str = axis("bem", help="model that runs the scene (sweep.models): the BEM, the "
+    model: str = axis("bem", help="model that runs the scene (sweep.engine.models): the BEM, the "
                       "crack-front model, the closed-form PB estimate, the quasi-static "
                       "elastic branch, or auto",
                       choices=MODEL_NAMES, order=-1)
@@ -243,7 +243,7 @@ class Numerics:
         "uniform": equal spacing from 0 to the domain. "graded" (the presets): fine spacing
         across the crack band the tip sweeps (from just outside the initial contact radius
         down to below the pull-off radius), element lengths growing by ``grading`` per
-        element inside the contact and outside it (see :mod:`sweep.mesh`).
+        element inside the contact and outside it (see :mod:`sweep.engine.mesh`).
     band_resolution : float
         Graded mesh: node spacings per process zone l0 = 1.693/mu^2 a_ref in the crack band
         (the fine spacing is l0 / band_resolution).
@@ -270,7 +270,7 @@ class Numerics:
     step : float
         Largest indentation step, in units of h0, where the crack tip moves or the load
         evolves fast (the adaptive step exceeds it, up to 8 times, only where the
-        predictor's load error is below 1e-3: sweep.solver.STEP_TOL).
+        predictor's load error is below 1e-3: sweep.engine.bem.STEP_TOL).
     min_step : float
         Smallest indentation step in units of h0 before a run is declared failed.
     da_max : float
@@ -366,7 +366,7 @@ class Numerics:
 #: Version of the id form below. Version 1: the JSON of ``{"scene": ..., "numerics": ...}``
 #: with every field of :data:`ID_V1_FIELDS` and, of fields added since, those not at their
 #: default. A change of the form itself (not the addition of a defaulted field, which keeps
-#: every id) must raise this number and teach :mod:`sweep.store` to migrate older files.
+#: every id) must raise this number and teach :mod:`sweep.campaign.store` to migrate older files.
 SCENE_ID_VERSION = 1
 
 #: The fields of Scene and Numerics when ids were introduced (version 1). They are always
@@ -459,7 +459,7 @@ class Result:
         Wall-clock time of the run in seconds.
     model_used : str
         The model that ran ("bem", "crack", "pb"; "" when a model's simulate function was
-        called directly rather than through :func:`sweep.models.simulate_scene`).
+        called directly rather than through :func:`sweep.engine.models.simulate_scene`).
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
     """

@@ -1,6 +1,6 @@
 """Slow, obviously-correct reference implementation of the axisymmetric adhesive BEM.
 
-Plain numpy/scipy (no Numba), written independently of ``kernels/`` and ``sweep/solver.py``;
+Plain numpy/scipy (no Numba), written independently of ``kernels/`` and ``sweep/engine/bem.py``;
 only ``sweep.errors`` may be imported from the package. Used by the tests to check the fast
 solver on small problems (N ~ 60..200 nodes, coarse indentation steps).
 

@@ -3,7 +3,7 @@ the summary table, on the committed measurements (no BEM run here)."""
 import json
 from pathlib import Path
 
-from sweep.agreement import main, merged, summary
+from sweep.bench.agreement import main, merged, summary
 
 DIR = Path(__file__).resolve().parents[1] / "results" / "agreement"
 

@@ -1,4 +1,4 @@
-"""sweep.analysis on synthetic data with known answers, and the `sweep fit` commands."""
+"""sweep.analysis.fits on synthetic data with known answers, and the `sweep fit` commands."""
 import json
 import math
 
@@ -7,11 +7,11 @@ import pandas as pd
 import pytest
 from scipy.optimize import brentq
 
-from sweep import analysis as an
+from sweep.analysis import fits as an
 from sweep import units
 from sweep.cli import main
 from sweep.errors import InputError
-from sweep.store import ResultStore
+from sweep.campaign.store import ResultStore
 from sweep.theory import pb_gamma_eff
 
 

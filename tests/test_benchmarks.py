@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from sweep import Numerics, Scene, simulate
-from sweep.benchmarks import (ROOT, BenchPlan, _bracket, bench_all, campaign_sample,
+from sweep.bench.benchmarks import (ROOT, BenchPlan, _bracket, bench_all, campaign_sample,
                               plain_time_at)
-from sweep.config import load_config
-from sweep.plain_solver import plain_unload
-from sweep.tradeoff import (PRESETS, grid, numerics_fields, pareto_front, plot_pareto,
+from sweep.campaign.config import load_config
+from sweep.bench.plain_solver import plain_unload
+from sweep.bench.tradeoff import (PRESETS, grid, numerics_fields, pareto_front, plot_pareto,
                             relative_error, suggest_presets, to_numerics, write_table)
 
 
@@ -170,8 +170,8 @@ def test_bench_json_keys_with_a_tiny_plan():
 def test_compare_results_reports_status_changes_and_relative_differences(tmp_path):
     # two results files of the same three scenes (plus one only in the first): one status
     # changed, the others differ by known relative amounts
-    from sweep.benchmarks import compare_results
-    from sweep.store import ResultStore
+    from sweep.bench.benchmarks import compare_results
+    from sweep.campaign.store import ResultStore
 
     def write(path, rows):
         st = ResultStore(path, config_hash="synthetic", config_name="t",
@@ -206,7 +206,7 @@ def test_newton_diagnosis_pairs_states_with_their_times():
     # states, at their times, must predict the next state closely in the contact interior
     # (a mismatched state or time makes it miss by O(h0)), and the chord map one step after
     # a factorization must contract
-    from sweep.benchmarks import newton_diagnosis
+    from sweep.bench.benchmarks import newton_diagnosis
     out = newton_diagnosis(Scene(n=0.8, k=0.1, mu=3.24, delta0=3.6, rate=1e4),
                            Numerics.preset("fast"), at_step=30, ahead=3)
     rows = out["cubic_predictor_error_h0"]

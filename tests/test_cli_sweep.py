@@ -18,9 +18,9 @@ import pytest
 
 from sweep import simulate
 from sweep.cli import main
-from sweep.config import load_config
-from sweep.scheduler import run_sweep
-from sweep.store import load, parts_dir, read_attrs
+from sweep.campaign.config import load_config
+from sweep.campaign.scheduler import run_sweep
+from sweep.campaign.store import load, parts_dir, read_attrs
 
 ROOT = Path(__file__).resolve().parents[1]
 SWEEP = [sys.executable, "-m", "sweep.cli"]

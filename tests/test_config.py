@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests import reference
-from sweep.config import AXIS_DEFAULTS, config_from_dict, load_config, parse_config
+from sweep.campaign.config import AXIS_DEFAULTS, config_from_dict, load_config, parse_config
 from sweep.errors import InputError
 from sweep.scene import Numerics, Scene, scene_id
 

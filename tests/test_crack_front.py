@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from sweep import Scene
-from sweep.crack_front import (
+from sweep.engine.crack_front import (
     GentSchultzLaw, constant_gamma_pull_off, crack_front_load, energy_release_rate,
     pb_law_for_scene, simulate_crack, unload,
 )

@@ -1,10 +1,11 @@
-"""The on-disk cache (sweep.diskcache) of Prony series: written once, read back identical,
+"""The on-disk cache (sweep.engine.diskcache) of Prony series: written once, read back identical,
 never used across a change of the fitting code, harmless when damaged or switched off.
 (The unit-spacing influence matrix's use of it: tests/test_mesh.py.)"""
 import numpy as np
 import pytest
 
-from sweep import diskcache, problem
+from sweep.engine import diskcache
+from sweep.engine import problem
 
 
 @pytest.fixture

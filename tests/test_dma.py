@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from sweep.cli import main
-from sweep.dma import (
+from sweep.analysis.dma import (
     DMAData, fit_maxwell, fit_mpl, kramers_kronig_check, read_dma_csv, wlf_log_shift,
 )
 from sweep.errors import InputError

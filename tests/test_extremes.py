@@ -1,7 +1,7 @@
 """Stability at the extremes of (n, k, rate, a0, mu) (issue 10, item 5): every scene ends ok
 with a finite pull-off inside bounds that do not come from the BEM (the relaxed elastic
 pull-off of the quasi-static branch below, and exactly at the slowest rate; 2/k or the
-cohesive limit of a frozen contact above; sweep.extremes), or failed with a reason.
+cohesive limit of a frozen contact above; sweep.bench.extremes), or failed with a reason.
 
 The quick suite runs a covering subset (every value of every axis); the full product
 (144 scenes, minutes) is marked slow and printed by `make extremes`.
@@ -10,8 +10,9 @@ import math
 
 import pytest
 
-from sweep import Numerics, Scene, extremes
-from sweep.models import simulate_scene
+from sweep.bench import extremes
+from sweep import Numerics, Scene
+from sweep.engine.models import simulate_scene
 
 
 def _check(d):

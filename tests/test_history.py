@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from kernels.history import history_vector, step_coefficients, update_modes
+from sweep.kernels.history import history_vector, step_coefficients, update_modes
 from sweep.materials import MPLRetardation
 from tests import naive as nv
 

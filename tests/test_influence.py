@@ -4,7 +4,7 @@ import pytest
 from scipy import integrate
 from scipy.special import ellipe, ellipkm1
 
-from kernels.influence import assemble_unit, ellipk_complement, load_weights
+from sweep.kernels.influence import assemble_unit, ellipk_complement, load_weights
 from tests.naive import _kernel_s, influence_matrix_quad
 
 
@@ -27,7 +27,7 @@ def test_matrix_matches_quadrature_of_the_elliptic_kernel():
 @pytest.mark.parametrize("dr", [0.01, 0.37])
 def test_matrix_scales_with_spacing(dr):
     # The engine builds the matrix once per N at unit spacing and multiplies by the spacing
-    # (sweep.solver.influence_matrix). Check that law against scipy quadrature done at the
+    # (sweep.engine.bem.influence_matrix). Check that law against scipy quadrature done at the
     # spacing itself, in physical coordinates: A_ij = int phi_j(s) G(r_i, s) s ds over the
     # two linear pieces of the hat of node j (log singularity at s = r_i on a piece end).
     N = 30
@@ -112,23 +112,23 @@ def test_graded_matrix_matches_quadrature_of_the_elliptic_kernel():
     # element lengths growing by 1.25 inward and outward of a fine band, and a jump
     r = np.concatenate([[0.0, 0.9, 1.62, 2.2, 2.6], 2.6 + 0.3 * np.arange(1, 8),
                         [4.8, 5.3, 6.0, 7.0, 8.2]])
-    from kernels.influence import assemble_nodes
+    from sweep.kernels.influence import assemble_nodes
     np.testing.assert_allclose(assemble_nodes(r), _graded_quad(r), rtol=1e-9, atol=1e-12)
 
 
 def test_node_assembly_on_uniform_nodes_matches_the_uniform_quadrature():
     # the uniform mesh is the special case r_j = j dr of the node assembly
-    from kernels.influence import assemble_nodes
+    from sweep.kernels.influence import assemble_nodes
     dr = 0.037
     np.testing.assert_allclose(assemble_nodes(np.arange(30) * dr),
                                influence_matrix_quad(30, dr, tail="full"), rtol=1e-9, atol=1e-14)
 
 
 def test_lattice_combination_equals_direct_assembly_on_a_graded_mesh():
-    # sweep.mesh builds graded meshes on the lattice of the fine spacing and combines the
+    # sweep.engine.mesh builds graded meshes on the lattice of the fine spacing and combines the
     # cached unit matrix; the direct assembly of the same nodes is a second method
-    from kernels.influence import assemble_nodes
-    from sweep.mesh import crack_band, graded_mesh
+    from sweep.kernels.influence import assemble_nodes
+    from sweep.engine.mesh import crack_band, graded_mesh
     mesh = graded_mesh(5.0, crack_band(2.5, 0.08), 0.02, 1.15)
     d = np.diff(mesh.lattice)
     assert d.min() == 1 and d.max() >= 5                 # really graded
@@ -137,7 +137,7 @@ def test_lattice_combination_equals_direct_assembly_on_a_graded_mesh():
 
 
 def test_graded_load_weights_integrate_piecewise_linear_traction_exactly():
-    from kernels.influence import load_weights_nodes
+    from sweep.kernels.influence import load_weights_nodes
     # sigma = 1 - r on [0, 1] sampled on graded nodes (exact: pi/3); and int r dr = R^2/2
     r = np.array([0.0, 0.3, 0.5, 0.6, 0.65, 0.7, 0.8, 1.0, 1.4, 2.0])
     sigma = np.clip(1 - r, 0, None)

@@ -1,6 +1,6 @@
 """The hereditary BEM on the DMT side (mu down to 0.01): mesh from the tip zone and the LJ tail.
 
-Independent values: the elastic quasi-static branch (sweep.quasistatic, its own mesh, the
+Independent values: the elastic quasi-static branch (sweep.engine.quasistatic, its own mesh, the
 LJ tail beyond the mesh in closed form) for k = 1 and for very slow rates (the relaxed
 elastic limit); the physical bounds of a viscoelastic pull-off at any rate.
 """
@@ -8,9 +8,10 @@ import math
 
 import pytest
 
-from sweep import Numerics, Scene, simulate, units
-from sweep import quasistatic as qs
-from sweep.problem import prepare, tip_zone
+from sweep import units
+from sweep import Numerics, Scene, simulate
+from sweep.engine import quasistatic as qs
+from sweep.engine.problem import prepare, tip_zone
 
 
 def test_tip_zone_is_the_process_zone_on_the_jkr_side_and_sqrt_h0_on_the_dmt_side():

@@ -1,10 +1,10 @@
-"""Graded meshes (sweep.mesh), the stop rule and the error indicator of a result."""
+"""Graded meshes (sweep.engine.mesh), the stop rule and the error indicator of a result."""
 import numpy as np
 import pytest
 
-from kernels.solve import stop_reached
+from sweep.kernels.solve import stop_reached
 from sweep import Numerics, Scene, simulate
-from sweep.mesh import crack_band, graded_mesh, graded_mesh_with_nodes, uniform_mesh
+from sweep.engine.mesh import crack_band, graded_mesh, graded_mesh_with_nodes, uniform_mesh
 
 
 def test_graded_mesh_is_fine_in_the_band_and_grows_geometrically_outside():
@@ -75,7 +75,7 @@ def test_graded_and_uniform_meshes_agree_at_the_same_spacing():
 
 
 def test_unit_matrix_grows_by_blocks_to_the_fully_assembled_one():
-    from kernels.influence import assemble_unit, grow_unit
+    from sweep.kernels.influence import assemble_unit, grow_unit
     full = assemble_unit(90)
     grown = grow_unit(assemble_unit(37), 90)
     np.testing.assert_array_equal(grown, full)        # the same quadrature, entry by entry
@@ -84,8 +84,9 @@ def test_unit_matrix_grows_by_blocks_to_the_fully_assembled_one():
 
 def test_unit_matrix_disk_cache_is_written_reused_and_survives_a_bad_file(tmp_path,
                                                                          monkeypatch):
-    from kernels.influence import assemble_unit
-    from sweep import diskcache, mesh
+    from sweep.kernels.influence import assemble_unit
+    from sweep.engine import diskcache
+    from sweep.engine import mesh
     monkeypatch.setenv(diskcache.CACHE_ENV, str(tmp_path))
     monkeypatch.setattr(mesh, "UNIT_BLOCK", 32)
     monkeypatch.setattr(mesh, "_UNIT", [np.zeros((0, 0))])

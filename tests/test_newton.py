@@ -4,11 +4,11 @@ residual it claims to zero."""
 import numpy as np
 import pytest
 
-from kernels import jacobian as jac
-from kernels import solve as ks
-from kernels.interface import lj_traction_and_stiffness
-from sweep.mesh import uniform_mesh
-from sweep.solver import lj_constants
+from sweep.kernels import jacobian as jac
+from sweep.kernels import solve as ks
+from sweep.kernels.interface import lj_traction_and_stiffness
+from sweep.engine.mesh import uniform_mesh
+from sweep.engine.bem import lj_constants
 
 
 def _problem(N=200, seed=1, contact=1.8):
@@ -130,7 +130,7 @@ def test_crack_tip_leaving_the_zone_asks_for_a_new_factorization():
 def test_newton_solves_the_discrete_equilibrium():
     # from the relaxed elastic state at delta = 1, one unloading-like step: new indentation,
     # C_eff < 1 and a history vector; Newton must zero the residual computed here by numpy
-    from sweep.initial import ElasticSolver, relaxed_state
+    from sweep.engine.initial import ElasticSolver, relaxed_state
     A, _, h0, c, rng = _problem(N=120, seed=3)
     r = np.arange(120) * 3.0 / 119
     el = ElasticSolver(A, r, h0, c, 1e-10)
@@ -153,7 +153,7 @@ def test_solves_ended_on_the_predicted_residual_meet_the_tolerance():
     # after the first update (the contraction last measured times |F|) is below
     # PREDICTED_RESIDUAL tol, the solve ends without computing it; computed here by numpy,
     # it must still be within tol, for those solves and for the others
-    from sweep.initial import ElasticSolver, relaxed_state
+    from sweep.engine.initial import ElasticSolver, relaxed_state
     N = 120
     A, _, h0, c, _ = _problem(N=N, seed=3)
     r = np.arange(N) * 3.0 / (N - 1)
@@ -179,7 +179,7 @@ def test_solves_ended_on_the_predicted_residual_meet_the_tolerance():
 
 
 def test_relaxed_state_is_cached_per_mesh_and_reused_unchanged():
-    from sweep.initial import ElasticSolver, relaxed_state
+    from sweep.engine.initial import ElasticSolver, relaxed_state
     A, _, h0, c, _ = _problem(N=100, seed=4)
     r = np.arange(100) * 3.0 / 99
     key = ("test-mesh", 100, 3.0 / 99)

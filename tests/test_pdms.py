@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from sweep import pdms
-from sweep.pdms import (PDMS_CASE, compute, full_amplification_vhat, own_fits, paper_fits,
+from sweep.paper import pdms
+from sweep.paper.pdms import (PDMS_CASE, compute, full_amplification_vhat, own_fits, paper_fits,
                         threshold_radius_hat, unloading_speed_for_vhat)
 from sweep.theory import A_PULL_OFF_FORCE, pb_gamma_eff
 from tests.reference import paper_values

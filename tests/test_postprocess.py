@@ -1,8 +1,8 @@
-"""Pull-off refinement (sweep.postprocess.refine_minimum) against closed forms."""
+"""Pull-off refinement (sweep.engine.postprocess.refine_minimum) against closed forms."""
 import numpy as np
 import pytest
 
-from sweep.postprocess import refine_minimum
+from sweep.engine.postprocess import refine_minimum
 
 
 @pytest.mark.parametrize("vertex_t", [0.3, 0.5, 0.7, 1.2])

@@ -1,4 +1,4 @@
-"""Elastic quasi-static pull-off (sweep.quasistatic) against independent values and limits.
+"""Elastic quasi-static pull-off (sweep.engine.quasistatic) against independent values and limits.
 
 Independent checks (the influence matrix on graded nodes is tested in test_influence.py): the
 pull-off at mu = 3.24 against the independent solver
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from sweep import Numerics, Scene, simulate
-from sweep import quasistatic as qs
+from sweep.engine import quasistatic as qs
 from sweep.errors import InputError
 from tests import reference
 
@@ -143,13 +143,13 @@ def test_elastic_scenes_of_a_sweep_take_the_quasistatic_branch():
     # the issue's example (mu = 10, k = 1): the hereditary BEM ran 616 s and failed; through
     # the model registry (what `sweep scene` and sweeps call) it is the equilibrium branch,
     # within 1 % of JKR's 1.5 (the LJ excess at mu = 10 is 0.0093, measured above)
-    from sweep.models import simulate_scene
+    from sweep.engine.models import simulate_scene
 
     res = simulate_scene(Scene(n=0.5, k=1.0, mu=10.0, a0=2.5, rate=1.0))
     assert res.ok and res.model_used == "elastic"
     assert res.pull_off == pytest.approx(1.5, rel=1e-2) and res.pull_off > 1.5
     # an explicit domain asks for the hereditary BEM on that domain
-    from sweep.models import wants_quasistatic
+    from sweep.engine.models import wants_quasistatic
     assert not wants_quasistatic(Scene(n=0.5, k=1.0, mu=3.24, a0=2.0, rate=1.0),
                                  Numerics.preset("balanced", domain=5.0))
 

@@ -1,10 +1,10 @@
-"""The reproduction pipeline (python -m sweep.reproduce): fit files, figures and REPORT.md
+"""The reproduction pipeline (python -m sweep.paper.reproduce): fit files, figures and REPORT.md
 from synthetic results files with known fits (no simulation: fast)."""
 import json
 
 import pytest
 
-from sweep.reproduce import main
+from sweep.paper.reproduce import main
 from tests.test_analysis import synthetic_threshold_runs, synthetic_vr_runs, write_results
 
 pytest.importorskip("matplotlib")

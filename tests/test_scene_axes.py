@@ -12,7 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from sweep import Numerics, Result, Scene, config, store
+from sweep.campaign import config
+from sweep.campaign import store
+from sweep import Numerics, Result, Scene
 from sweep.cli import cli
 from sweep.errors import InputError
 from sweep.scene import AXES, RESULT_SCALARS, SCENE_AXES

@@ -16,10 +16,10 @@ import h5py
 from tests import reference
 from sweep import Numerics, Scene, scene_id
 from sweep.cli import main
-from sweep.config import parse_config
+from sweep.campaign.config import parse_config
 from sweep.scene import SCENE_ID_VERSION, axis
-from sweep.scheduler import run_sweep
-from sweep.store import load, load_trajectory, read_attrs
+from sweep.campaign.scheduler import run_sweep
+from sweep.campaign.store import load, load_trajectory, read_attrs
 
 V1_FILE = reference.DATA / "results_v1.h5"
 

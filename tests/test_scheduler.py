@@ -14,13 +14,13 @@ import time
 import numpy as np
 import pytest
 
-from sweep import scheduler
-from sweep.config import config_from_dict
+from sweep.campaign import scheduler
+from sweep.campaign.config import config_from_dict
 from sweep.errors import InputError
 from sweep.scene import Numerics, Result, Scene
-from sweep.scheduler import Progress, SweepRuntimeError, run_scene, run_sweep
-from sweep.solver import simulate
-from sweep.store import load, load_trajectory, parts_dir, read_attrs
+from sweep.campaign.scheduler import Progress, SweepRuntimeError, run_scene, run_sweep
+from sweep.engine.bem import simulate
+from sweep.campaign.store import load, load_trajectory, parts_dir, read_attrs
 
 
 def fake_simulate(scene, numerics):
@@ -132,7 +132,7 @@ def test_one_thread_per_worker(tmp_path, monkeypatch):
 
 
 def test_worker_warms_numba_cache_once(monkeypatch):
-    import sweep.solver as solver
+    import sweep.engine.bem as solver
     calls = []
     monkeypatch.setattr(solver, "warm_up", lambda: calls.append(1) or 0.0, raising=False)
     monkeypatch.setattr(solver, "simulate", fake_simulate)
@@ -287,7 +287,7 @@ def test_consolidation_interval(tmp_path):
 
 
 def test_grid_is_expanded_and_hashed_once_per_run(tmp_path, monkeypatch):
-    import sweep.config as config_module
+    import sweep.campaign.config as config_module
     calls = []
     real = config_module.scene_id
     monkeypatch.setattr(config_module, "scene_id", lambda s, n: calls.append(1) or real(s, n))

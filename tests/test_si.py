@@ -8,8 +8,8 @@ import pytest
 from sweep import Scene
 from sweep.cli import main
 from sweep.errors import InputError
-from sweep.models import MODELS, pb_estimate, simulate_model
-from sweep.si import SIScene, run_si
+from sweep.engine.models import MODELS, pb_estimate, simulate_model
+from sweep.campaign.si import SIScene, run_si
 from sweep.theory import jkr_load
 from tests.reference import paper_values
 
@@ -122,7 +122,7 @@ def test_cli_scene_si_options_need_si(capsys):
 
 
 def test_scene_model_field_and_auto_choice():
-    from sweep.models import bem_node_budget, bem_nodes_needed, choose_model, simulate_scene
+    from sweep.engine.models import bem_node_budget, bem_nodes_needed, choose_model, simulate_scene
     from sweep.scene import Numerics
 
     assert Scene(n=0.8, a0=3.0, rate=1.0).model == "bem"
@@ -140,7 +140,7 @@ def test_scene_model_field_and_auto_choice():
 
 
 def test_config_model_axis(tmp_path):
-    from sweep.config import parse_config
+    from sweep.campaign.config import parse_config
 
     cfg = parse_config("name: m\ngrid: {n: 0.8, a0: 3.0, rate: 1, model: [crack, pb]}\n")
     assert [s.model for s in cfg.scenes()] == ["crack", "pb"]
@@ -151,7 +151,7 @@ def test_config_model_axis(tmp_path):
 
 def test_sweep_runs_the_scene_models(tmp_path):
     import sweep
-    from sweep.scheduler import run_sweep
+    from sweep.campaign.scheduler import run_sweep
 
     p = tmp_path / "c.yaml"
     p.write_text("name: c\ngrid: {n: 0.8, a0: 3.0, rate: [1, 100], model: [crack, pb]}\n"
@@ -165,7 +165,7 @@ def test_sweep_runs_the_scene_models(tmp_path):
 def test_si_config_runs_and_gives_rows_back_in_si(tmp_path, capsys):
     """`units: si` end to end: sweep run, then the rows in both systems from the file alone
     (si_table and `sweep info --si`); pull_off_N = pull_off pi dg R, 1.5 pi dg R closed form."""
-    from sweep.si import si_table
+    from sweep.campaign.si import si_table
 
     p = tmp_path / "si.yaml"
     p.write_text("name: si\nunits: si\ngrid:\n  model: [crack, pb]\n  R: 5.19e-3\n"
@@ -198,12 +198,12 @@ def test_si_config_runs_and_gives_rows_back_in_si(tmp_path, capsys):
 
 
 def test_shipped_pdms_config_runs_and_matches_make_pdms(tmp_path):
-    """`sweep run configs/pdms.yaml` end to end (in-process), against sweep.pdms, which runs
+    """`sweep run configs/pdms.yaml` end to end (in-process), against sweep.paper.pdms, which runs
     the same case through its own SI conversion (PDMS_CASE) at a tighter tolerance."""
     from pathlib import Path
 
-    from sweep import pdms
-    from sweep.si import si_table
+    from sweep.paper import pdms
+    from sweep.campaign.si import si_table
 
     cfg = Path(__file__).resolve().parents[1] / "configs" / "pdms.yaml"
     out = tmp_path / "p.h5"

@@ -1,14 +1,14 @@
 """The adaptive time steps keep the pull-off within the preset's tolerance.
 
 Independent value: the same scene and mesh at ten times smaller steps (step and da_max
-divided by 10, no growth beyond the step: sweep.solver.STEP_TOL = 0).
+divided by 10, no growth beyond the step: sweep.engine.bem.STEP_TOL = 0).
 """
 import dataclasses
 
 import numpy as np
 import pytest
 
-from sweep import solver
+from sweep.engine import bem as solver
 from sweep.scene import Numerics, Scene
 
 SCENES = [Scene(n=0.8, k=0.2, mu=3.24, a0=1.5, rate=10.0),

@@ -11,7 +11,7 @@ import pytest
 
 import sweep
 from sweep.errors import InputError
-from sweep.store import (JOURNAL, ResultStore, StoreBusyError, load, load_trajectory,
+from sweep.campaign.store import (JOURNAL, ResultStore, StoreBusyError, load, load_trajectory,
                          parts_dir, read_attrs, summary)
 
 TEMPLATE = {"scene_id": "", "n": 0.0, "a0": None, "material": "mpl", "num_nodes": 0,

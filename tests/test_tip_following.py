@@ -1,6 +1,6 @@
-"""The BEM on a mesh refined around the crack tip that follows it (sweep.tip_following).
+"""The BEM on a mesh refined around the crack tip that follows it (sweep.engine.tip_following).
 
-Independent checks: the same scene on the fixed-band graded mesh (sweep.solver.simulate),
+Independent checks: the same scene on the fixed-band graded mesh (sweep.engine.bem.simulate),
 where both run; the state transfer between meshes against its exact values (common nodes,
 a cubic). Not here: the elastic limit (k = 1 or a very slow rate) through the hereditary
 kernel at mu = 30 -- the tip snaps node to node about every other step (measured: 1939
@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from sweep import Numerics, Scene, simulate
-from sweep import models
-from sweep import tip_following as tf
-from sweep.solver import UnloadingState
+from sweep.engine import models
+from sweep.engine import tip_following as tf
+from sweep.engine.bem import UnloadingState
 
 
 def test_remesh_jumps_measures_the_jump_of_the_old_transfer():
@@ -39,7 +39,7 @@ def test_window_leaves_room_in_the_direction_of_motion():
 
 
 def _window_problems(scene, num, old_band, new_band):
-    from sweep.problem import prepare
+    from sweep.engine.problem import prepare
     return prepare(scene, num, old_band), prepare(scene, num, new_band)
 
 
@@ -49,7 +49,7 @@ def test_transfer_keeps_common_nodes_and_the_displacement_of_each_mode(form):
     they make -- A q_i (relaxed form) or A (sigma - q_i), the history mode i has forgotten
     (glassy form) -- is the old one at the common nodes and interpolated between (not q_i
     itself: the coarse nodes would sample its sharp features)."""
-    from kernels.interface import lj_traction
+    from sweep.kernels.interface import lj_traction
 
     scene = Scene(n=0.8, k=0.1, mu=6.0, a0=3.0, rate=10**2.5)
     num = Numerics.preset("fast", max_nodes=2000)
@@ -126,7 +126,7 @@ def test_a_strongly_viscoelastic_scene_remeshes_continuously_and_matches_the_fix
     tractions (the transfer before the fix) the load jumped by 2.56 from -7.59 at the
     second re-meshing: the continuity check must fail that run with the reason, never
     report a number."""
-    from kernels.interface import lj_traction
+    from sweep.kernels.interface import lj_traction
 
     scene = Scene(n=0.8, k=0.1, mu=6.0, a0=3.0, rate=10**2.5)
     num = Numerics.preset("fast", pull_off_rtol=0.0, max_nodes=2000)
@@ -210,7 +210,7 @@ def test_a_scene_beyond_its_budget_is_refused_after_the_probe_with_what_it_needs
     assert res.status == "failed"
     assert res.reason.startswith("time budget: needs at least"), res.reason
     assert "time_budget_s" in res.reason and "steps" in res.reason
-    from sweep.solver import CHUNK_STEPS
+    from sweep.engine.bem import CHUNK_STEPS
     assert res.steps <= tf.PROBE_STEPS + CHUNK_STEPS       # after the probe or one chunk
     need = int(res.reason.split("needs at least ")[1].split()[0])
     assert need > 40000

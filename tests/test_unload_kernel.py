@@ -6,11 +6,11 @@ predictors are exact for polynomials in time of their order.
 """
 import numpy as np
 
-from kernels.solve import N_STATS, STATUS_DONE, STATUS_STEP_LIMIT, new_jacobian_cache, unload
-from sweep.initial import ElasticSolver, relaxed_state
-from sweep.problem import prepare
+from sweep.kernels.solve import N_STATS, STATUS_DONE, STATUS_STEP_LIMIT, new_jacobian_cache, unload
+from sweep.engine.initial import ElasticSolver, relaxed_state
+from sweep.engine.problem import prepare
 from sweep.scene import Numerics, Scene
-from sweep.solver import MAX_NEWTON_ITER, STEP_TOL, STOP_TRAVEL_SPACINGS
+from sweep.engine.bem import MAX_NEWTON_ITER, STEP_TOL, STOP_TRAVEL_SPACINGS
 
 SCENE = Scene(n=0.8, k=0.2, mu=3.24, a0=1.5, rate=10.0)
 NUMERICS = Numerics(mesh="uniform", nodes=120, domain=3.0, step=0.25, da_max=1.0,
@@ -57,7 +57,7 @@ def test_unloading_resumed_in_chunks_reproduces_one_run():
 
 
 def test_solver_in_small_chunks_gives_the_same_result(monkeypatch):
-    from sweep import solver
+    from sweep.engine import bem as solver
     one = solver.simulate(SCENE, NUMERICS)
     monkeypatch.setattr(solver, "CHUNK_STEPS", 4)
     chunked = solver.simulate(SCENE, NUMERICS)
@@ -69,7 +69,7 @@ def test_solver_in_small_chunks_gives_the_same_result(monkeypatch):
 def test_time_budget_ends_a_run_failed_with_the_reason(monkeypatch):
     import dataclasses
 
-    from sweep import solver
+    from sweep.engine import bem as solver
     monkeypatch.setattr(solver, "CHUNK_STEPS", 2)
     res = solver.simulate(SCENE, dataclasses.replace(NUMERICS, time_budget_s=1e-6))
     assert res.status == "failed"
@@ -78,7 +78,7 @@ def test_time_budget_ends_a_run_failed_with_the_reason(monkeypatch):
 
 
 def test_step_control_grows_beyond_step_max_only_where_smooth():
-    from kernels.solve import EASY_STEPS, SMOOTH_STEP_FACTOR, next_step
+    from sweep.kernels.solve import EASY_STEPS, SMOOTH_STEP_FACTOR, next_step
     dd_max, da_max, tol = 1.0, 1.0, 1e-3
 
     def run(da, err, dd=dd_max, steps=EASY_STEPS):
@@ -99,7 +99,7 @@ def test_step_control_grows_beyond_step_max_only_where_smooth():
 
 
 def test_grown_steps_keep_the_pull_off(monkeypatch):
-    from sweep import solver
+    from sweep.engine import bem as solver
     # a large contact: the crack tip recedes slowly over hundreds of steps (~1 s per run)
     scene = Scene(n=0.6, k=0.1, mu=3.24, a0=8.0, rate=10**2.5)
     num = Numerics.preset("fast", pull_off_rtol=0.0, max_nodes=1000)
@@ -118,7 +118,7 @@ def test_predictors_are_exact_for_polynomials_of_their_order():
     # Lagrange extrapolation through the accepted states at uneven steps (the step halves
     # and doubles): the quadratic predictor reproduces a quadratic in time, the cubic one a
     # cubic, at the next step; the cubic one waits for four states
-    from kernels.solve import predict, predict_cubic
+    from sweep.kernels.solve import predict, predict_cubic
     t = np.array([0.0, 0.3, 0.45, 0.55])                 # accepted times, last = now
     dt = 0.2
     x = np.linspace(1.0, 2.0, 7)                         # one gap per node, above the floor

@@ -47,13 +47,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from kernels.influence import assemble_nodes, load_weights_nodes
-from kernels.interface import lj_traction_and_stiffness
+from ..kernels.influence import assemble_nodes, load_weights_nodes
+from ..kernels.interface import lj_traction_and_stiffness
 
-from . import units
-from .errors import check_range
+from .. import units
+from ..errors import check_range
 from .initial import jkr_gap_guess
-from .theory import jkr_indentation
+from ..theory import jkr_indentation
 
 #: gap at the crack tip (max LJ tension) per h0
 TIP_GAP = 3.0 ** (1.0 / 6.0)
@@ -352,7 +352,7 @@ def pull_off_table(mus=TABLE_MU, **options) -> list[dict]:
     Rows: mu, pull_off, a, delta, nodes, seconds, converged, md_pull_off (the MD value at
     the equivalent lambda, :func:`sweep.theory.maugis_dugdale_pull_off`).
     """
-    from .theory import maugis_dugdale_pull_off, maugis_lambda
+    from ..theory import maugis_dugdale_pull_off, maugis_lambda
 
     rows = []
     for mu in mus:
@@ -363,7 +363,7 @@ def pull_off_table(mus=TABLE_MU, **options) -> list[dict]:
     return rows
 
 
-if __name__ == "__main__":      # python -m sweep.quasistatic: the table of the issue
+if __name__ == "__main__":      # python -m sweep.engine.quasistatic: the table of the issue
     print(f"{'mu':>6} {'pull_off':>9} {'(P-1.5)mu':>9} {'a':>7} {'delta':>8} {'nodes':>5} "
           f"{'s':>6} {'MD':>7}")
     for row in pull_off_table():
@@ -384,7 +384,7 @@ def simulate_elastic(scene, numerics=None):
     ``steps`` = equilibrium solves, ``factorizations`` = Newton iterations (one dense solve
     each). A numerical failure gives ``status="failed"`` with the reason, never raises.
     """
-    from .scene import Numerics, Result
+    from ..scene import Numerics, Result
 
     if numerics is None:
         numerics = Numerics.preset("balanced")

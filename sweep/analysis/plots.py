@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 
 
 def _pyplot():
@@ -33,10 +33,10 @@ def plot_sweep(path, out=None) -> Path:
     out : str or Path, optional
         Output PNG; default: the results file with the suffix ``.png``.
     """
-    from .config import AXES
-    from .scene import AXES as AXIS_INFO
-    from .store import load, load_trajectory
-    from .theory import jkr_load
+    from ..campaign.config import AXES
+    from ..scene import AXES as AXIS_INFO
+    from ..campaign.store import load, load_trajectory
+    from ..theory import jkr_load
 
     plt = _pyplot()
     path = Path(path)

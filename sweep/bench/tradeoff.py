@@ -10,7 +10,7 @@ worst error over the scenes is below each target: the suggested presets).
 
 The references (``configs/references.json``) are runs of the engine on much finer numerics
 (:data:`REFERENCE_OVERRIDES`: the accurate preset with twice the nodes, half the step and
-Prony rtol 1e-7), computed once by ``python -m sweep.benchmarks reference``. Each carries its
+Prony rtol 1e-7), computed once by ``python -m sweep.bench.benchmarks reference``. Each carries its
 own uncertainty estimate, the relative difference to the accurate preset (for a method of
 first order or higher that bounds the reference's error): errors below it are not resolved.
 
@@ -27,9 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene import PRESETS, Numerics, Scene
+from ..scene import PRESETS, Numerics, Scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 REFERENCES = ROOT / "configs" / "references.json"
 
 #: the converged reference: the accurate preset refined in space, time and Prony fit, on a
@@ -172,7 +172,7 @@ def load_references(path: str | Path = REFERENCES) -> dict:
 
 def compute_reference(scene: dict) -> dict:
     """Reference values of one scene: the refined run and the accurate preset beside it."""
-    from .solver import simulate
+    from ..engine.bem import simulate
     sc = Scene(**scene)
     ref = simulate(sc, Numerics.preset("accurate", **existing(REFERENCE_OVERRIDES)))
     acc = simulate(sc, Numerics.preset("accurate"))
@@ -190,14 +190,14 @@ def reference_for(name: str, scene: dict, refs: dict, fallback: Numerics | None 
     ref = refs.get(name)
     if ref is not None and ref["scene"] == scene and ref["status"] == "ok":
         return {**ref, "source": "configs/references.json (refined run)"}
-    from .solver import simulate
+    from ..engine.bem import simulate
     num = fallback or Numerics.preset("accurate")
     res = simulate(Scene(**scene), num)
     return {"scene": scene, "pull_off": res.pull_off, "crack_speed": res.crack_speed,
             "status": res.status, "domain": res.domain_used, "numerics": num.to_dict(),
             "uncertainty_pull_off": math.nan, "uncertainty_crack_speed": math.nan,
             "source": "computed now with the numerics given (no stored reference: run "
-                      "`python -m sweep.benchmarks reference`)"}
+                      "`python -m sweep.bench.benchmarks reference`)"}
 
 
 # ---------------------------------------------------------------------- the trade
@@ -207,7 +207,7 @@ def run_tradeoff(quick: bool = False, repeat: int = 1, progress=print,
     """Run the grid on the reference scenes; rows with errors against the references.
     With ``partial``, the table so far is rewritten there after each scene (a long run
     that is stopped keeps its finished scenes)."""
-    from .solver import simulate, warm_up
+    from ..engine.bem import simulate, warm_up
     warm_up()
     refs = load_references()
     points = grid(quick)

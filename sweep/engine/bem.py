@@ -2,12 +2,12 @@
 
 Orchestration only; each concept has its module:
 
-1. :mod:`sweep.problem` derives the scene's numbers once (LJ constants, process zone,
-   domain, mesh from :mod:`sweep.mesh` with its cached influence matrix, Prony series);
-2. :mod:`sweep.initial` solves the relaxed initial state (elastic LJ at delta0 or a0);
+1. :mod:`sweep.engine.problem` derives the scene's numbers once (LJ constants, process zone,
+   domain, mesh from :mod:`sweep.engine.mesh` with its cached influence matrix, Prony series);
+2. :mod:`sweep.engine.initial` solves the relaxed initial state (elastic LJ at delta0 or a0);
 3. the unloading kernel ``kernels.solve.unload`` (Prony recursion) or, with
-   ``numerics.exact``, :mod:`sweep.exact` (exact hereditary integral);
-4. :mod:`sweep.postprocess`: pull-off |min P| (parabola through the samples around the
+   ``numerics.exact``, :mod:`sweep.engine.exact` (exact hereditary integral);
+4. :mod:`sweep.engine.postprocess`: pull-off |min P| (parabola through the samples around the
    minimum), the state there and the crack speed -da/dt;
 5. the error indicator: the error expected from the crack-band resolution (a bound of the
    measured convergence) and, where that is not well below ``numerics.pull_off_rtol``, the
@@ -25,16 +25,16 @@ import time
 
 import numpy as np
 
-from kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_DOMAIN, STATUS_LEFT_BAND,
+from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_DOMAIN, STATUS_LEFT_BAND,
                            STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT, invalidate, stop_reached,
                            unload)
 
-from . import units
+from .. import units
 from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
 from .postprocess import crack_speed_at, refine_minimum
 from .problem import Problem, Refused, lj_constants, material_of, prepare  # noqa: F401 (re-exported)
-from .scene import Numerics, Result, Scene
+from ..scene import Numerics, Result, Scene
 
 #: Newton iterations per solve: a good step converges in 2-5 (quadratic predictor); a solve
 #: that needs more is better retried with a smaller step or taken for a fold

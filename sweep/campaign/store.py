@@ -68,8 +68,8 @@ from typing import TYPE_CHECKING
 import h5py
 import numpy as np
 
-from .errors import InputError
-from .scene import SCENE_AXES, SCENE_ID_VERSION
+from ..errors import InputError
+from ..scene import SCENE_AXES, SCENE_ID_VERSION
 
 try:
     import fcntl
@@ -334,7 +334,7 @@ def provenance() -> dict:
     """Versions and git commit of the code that writes a results file."""
     import numba
 
-    from . import __version__
+    from .._version import __version__
 
     commit = "unknown"
     here = Path(__file__).resolve().parent

@@ -48,8 +48,8 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 from scipy.optimize import least_squares, nnls
 
-from .errors import InputError, check_int, check_range
-from .materials import MPLRetardation, Prony
+from ..errors import InputError, check_int, check_range
+from ..materials import MPLRetardation, Prony
 
 __all__ = [
     "WLF_PAPER", "DMAData", "MPLFit", "MaxwellFit", "KKCheck",

@@ -55,9 +55,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import PchipInterpolator
 
-from . import units
-from .errors import InputError, check_choice, check_positive, check_range
-from .theory import (A_PULL_OFF_FORCE, jkr_contact_radius, jkr_indentation, pb_gamma_eff,
+from .. import units
+from ..errors import InputError, check_choice, check_positive, check_range
+from ..theory import (A_PULL_OFF_FORCE, jkr_contact_radius, jkr_indentation, pb_gamma_eff,
                      pb_gamma_eff_spectrum)
 
 __all__ = ["GentSchultzLaw", "PerssonBrenerLaw", "CrackFrontSolution", "unload",
@@ -399,7 +399,7 @@ def simulate_crack(scene, numerics=None):
     at the JKR state of that radius (the BEM's ``a0`` is the LJ max-tension radius, which tends
     to it as mu grows).
     """
-    from .scene import Numerics, Result
+    from ..scene import Numerics, Result
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t_start = time.perf_counter()

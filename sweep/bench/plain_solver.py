@@ -26,13 +26,13 @@ from functools import lru_cache
 import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
-from kernels.influence import assemble_unit, load_weights
+from ..kernels.influence import assemble_unit, load_weights
 
-from . import units
-from .materials import SLS, MPLRetardation
-from .scene import Scene
-from .initial import jkr_gap_guess
-from .postprocess import crack_speed_at, refine_minimum
+from .. import units
+from ..materials import SLS, MPLRetardation
+from ..scene import Scene
+from ..engine.initial import jkr_gap_guess
+from ..engine.postprocess import crack_speed_at, refine_minimum
 
 #: Newton tolerance on the gap, in units of h0 (max norm of the residual)
 TOL = 1e-8

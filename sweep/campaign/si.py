@@ -19,9 +19,9 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from .errors import InputError, check_choice, check_positive, check_range
-from .theory import jkr_contact_radius, jkr_pull_off
-from .units import PhysicalScale
+from ..errors import InputError, check_choice, check_positive, check_range
+from ..theory import jkr_contact_radius, jkr_pull_off
+from ..units import PhysicalScale
 
 __all__ = ["SIScene", "run_si", "SI_MODELS", "SI_AXES", "si_table"]
 
@@ -29,7 +29,7 @@ SI_MODELS = ("bem", "crack", "pb", "auto")
 
 
 def _si_axis(name, unit, help, lo=0.0, hi=None, lo_open=True, required=True, order=0):
-    from .scene import Axis
+    from ..scene import Axis
 
     return Axis(name=name, default=None, required=required, help=help, unit=unit,
                 limits=(lo, hi), lo_open=lo_open, choices=None, label=name, order=order,
@@ -134,7 +134,7 @@ class SIScene:
 
     def to_scene(self, **extra):
         """The :class:`sweep.Scene` (raises InputError outside the Scene's ranges, e.g. mu)."""
-        from .scene import Scene
+        from ..scene import Scene
 
         d = self.dimensionless()
         if d["a0"] is None:
@@ -199,7 +199,7 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
     si : SIScene
     model : {"bem", "crack", "pb", "auto"}
         "bem" needs a :class:`sweep.Scene` (its ranges, e.g. mu <= 100); "crack" and "pb" run
-        at any Tabor parameter; "auto" is :func:`sweep.models.choose_model` within the Scene's
+        at any Tabor parameter; "auto" is :func:`sweep.engine.models.choose_model` within the Scene's
         ranges and "crack" beyond them (``model`` in the output says which ran).
     numerics : sweep.Numerics, optional
         BEM discretization.
@@ -212,21 +212,21 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
         ``vhat``, ``a0``, ``delta0`` ...) and their SI values (``pull_off_N``, ``a_pulloff_m``,
         ``crack_speed_m_s``, ...) with ``mu``, ``l0_m``, ``jkr_pull_off_N``.
     """
-    from . import units
-    from .crack_front import pb_law_for_scene, unload
-    from .models import pb_estimate, simulate_model
+    from .. import units
+    from ..engine.crack_front import pb_law_for_scene, unload
+    from ..engine.models import pb_estimate, simulate_model
 
     model = check_choice("model", model, SI_MODELS)
     d = si.dimensionless()
     if model == "auto":
-        from .models import choose_model
-        from .scene import SCENE_LIMITS
+        from ..engine.models import choose_model
+        from ..scene import SCENE_LIMITS
 
         lo, hi = SCENE_LIMITS["mu"]
         model = choose_model(si.to_scene(), numerics) if lo <= d["mu"] <= hi else "crack"
     res = {"model": model}
     if model == "bem":
-        from .problem import BEM_MU_RANGE
+        from ..engine.problem import BEM_MU_RANGE
 
         lo, hi = BEM_MU_RANGE
         if d["k"] < 1.0 and not lo <= d["mu"] <= hi:

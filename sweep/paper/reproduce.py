@@ -1,13 +1,13 @@
 r"""Reproduction of the paper: turn this project's runs into fit files, figures and a report.
 
 The Makefile targets call this module after ``sweep run`` (``sweep reproduce ...``, or
-``python -m sweep.reproduce ...``):
+``python -m sweep.paper.reproduce ...``):
 
 =================  =========================================================================
 command            writes (in OUTDIR)
 =================  =========================================================================
-``threshold RUNS``  ``fit.json`` (:func:`sweep.analysis.threshold_analysis`), ``threshold.png``
-``vr RUNS``         ``fit.json`` (:func:`sweep.analysis.vr_analysis`), ``v_vs_r.png``,
+``threshold RUNS``  ``fit.json`` (:func:`sweep.analysis.fits.threshold_analysis`), ``threshold.png``
+``vr RUNS``         ``fit.json`` (:func:`sweep.analysis.fits.vr_analysis`), ``v_vs_r.png``,
                     ``pb_vs_bem.png``
 ``fig3 RUNS``       ``fig3.png`` (trajectories P(a))
 ``aconv RUNS``      ``aconv.png``, ``aconv.json`` (the pull-offs plotted)
@@ -30,20 +30,20 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 
-PAPER_VALUES = Path(__file__).resolve().parent.parent / "tests" / "data" / "paper_values.yaml"
+PAPER_VALUES = Path(__file__).resolve().parents[2] / "tests" / "data" / "paper_values.yaml"
 
 
 def _load_results(path):
-    from .cli import _load_results as load_results  # sweep.cli imports this module
+    from ..cli import _load_results as load_results  # sweep.cli imports this module
 
     return load_results(path)
 
 
 def _provenance(path) -> dict:
     """Where a fit came from: the results file and the attributes its writer recorded."""
-    from .store import read_attrs
+    from ..campaign.store import read_attrs
 
     a = read_attrs(path)
     keep = ("config_name", "config_hash", "git_commit", "n_scenes", "n_finished", "complete",
@@ -64,7 +64,7 @@ def _cost(df) -> dict:
 
 
 def _write_json(obj, path: Path) -> Path:
-    from .cli import to_jsonable
+    from ..cli import to_jsonable
 
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".json.tmp")
@@ -100,7 +100,7 @@ def cli():
 @click.argument("outdir")
 def threshold_cmd(runs, outdir):
     """fit.json and threshold.png of the threshold-radius sweep RUNS."""
-    from . import analysis
+    from ..analysis import fits as analysis
     from .figures import threshold_figure
 
     p = _paper()["threshold_radius"]["collapse_fit"]
@@ -115,7 +115,7 @@ def threshold_cmd(runs, outdir):
 @click.argument("outdir")
 def vr_cmd(runs, outdir):
     """fit.json, v_vs_r.png and pb_vs_bem.png of the crack speed sweep RUNS."""
-    from . import analysis
+    from ..analysis import fits as analysis
     from .figures import pb_vs_bem_figure, vr_figure
 
     p = _paper()["pb_theory"]["v_vs_r_fit"]
@@ -138,7 +138,7 @@ def vr_cmd(runs, outdir):
 def fig3_cmd(runs, outdir):
     """fig3.png: the P(a) trajectories of the Fig. 3 sweep RUNS."""
     from .figures import fig3_figure
-    from .store import load_trajectory
+    from ..campaign.store import load_trajectory
 
     df = _load_results(runs)
     trajs = {}
@@ -180,9 +180,9 @@ def aconv_cmd(runs, outdir):
 @click.option("--vr", "vr_runs", default=None, help="v_vs_r results file for the BEM markers.")
 def theory_cmd(outdir, vr_runs):
     """mplplot.png, pb_bem.png, b1.png and theory.json (Persson-Brener power laws)."""
-    from . import analysis
+    from ..analysis import fits as analysis
     from .figures import b1_figure, mplplot_figure, pb_bem_figure
-    from .theory import pb_gamma_eff
+    from ..theory import pb_gamma_eff
 
     out = Path(outdir)
     mplplot_figure(out / "mplplot.png")
@@ -245,7 +245,7 @@ def _git_commit() -> str:
 def main(argv=None) -> int:
     """``sweep reproduce ARGS``: the error mapping of :func:`sweep.cli.main` (exit 2 on bad
     input, one line)."""
-    from .cli import main as sweep_main
+    from ..cli import main as sweep_main
 
     return sweep_main(["reproduce", *(sys.argv[1:] if argv is None else argv)])
 

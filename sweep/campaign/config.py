@@ -26,11 +26,11 @@ of a sweep uses the same ``numerics`` (default: the "balanced" preset); ``numeri
 combine a ``preset`` with explicit overrides (``{preset: fast, nodes: 120}``).
 ``output`` defaults to ``results/<name>.h5``.
 
-``units: si``: the grid holds the SI fields of :data:`sweep.si.SI_AXES` (``R, E0, Einf, nu,
+``units: si``: the grid holds the SI fields of :data:`sweep.campaign.si.SI_AXES` (``R, E0, Einf, nu,
 n, tau0, dg, h0, speed`` and one of ``preload``, ``a0``, ``indentation``) besides ``model``,
-``material``, ``stop``; every point becomes a :class:`sweep.si.SIScene` and its
+``material``, ``stop``; every point becomes a :class:`sweep.campaign.si.SIScene` and its
 dimensionless :class:`Scene` (the one hashed, stored and run; :meth:`SweepConfig.si_tasks`
-maps ids back to the SI points, :func:`sweep.si.si_table` gives stored rows in SI).
+maps ids back to the SI points, :func:`sweep.campaign.si.si_table` gives stored rows in SI).
 
 YAML 1.1 reads ``1e6`` as a string; numeric strings such as ``"1e6"`` are accepted as
 numbers wherever a number is expected. Configs are read with a safe loader (no Python
@@ -52,13 +52,13 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from .errors import InputError, as_float, check_choice, check_int, check_range
-from .scene import AXES as SCENE_AXIS_INFO
-from .scene import Numerics, Scene, scene_id
+from ..errors import InputError, as_float, check_choice, check_int, check_range
+from ..scene import AXES as SCENE_AXIS_INFO
+from ..scene import Numerics, Scene, scene_id
 
 #: Top-level keys of a config file.
 TOP_KEYS = ("name", "description", "units", "grid", "numerics", "store", "output")
-#: Values of ``units``: the grid in the dimensionless Scene axes, or in SI (sweep.si.SI_AXES).
+#: Values of ``units``: the grid in the dimensionless Scene axes, or in SI (sweep.campaign.si.SI_AXES).
 UNITS = ("dimensionless", "si")
 #: Categorical Scene axes an SI grid takes as they are.
 SI_SCENE_AXES = ("model", "material", "stop")
@@ -346,7 +346,7 @@ def _si_point(point: dict, where: str):
 
 
 def _check_si_grid(where: str, grid, problems: list[str]) -> dict | None:
-    """Validate a ``units: si`` grid: SI fields (sweep.si.SI_AXES) and model/material/stop."""
+    """Validate a ``units: si`` grid: SI fields (sweep.campaign.si.SI_AXES) and model/material/stop."""
     from .si import SI_AXES, SI_INITIAL
 
     allowed = (*SI_SCENE_AXES, *SI_AXES)

@@ -2,7 +2,7 @@ r"""Analysis of sweep results: the paper's variables and fits (pandas in, pandas
 
 Every function takes the runs table of :func:`sweep.load` (one row per scene) or arrays,
 and returns a :class:`pandas.DataFrame` or a plain dict (JSON-ready: floats, lists, str).
-No plotting here (see :mod:`sweep.figures`). Units are those of docs/design.md section 2:
+No plotting here (see :mod:`sweep.paper.figures`). Units are those of docs/design.md section 2:
 
 ==================  ===========================================================
 column              meaning
@@ -36,9 +36,9 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq, minimize_scalar
 
-from . import units
-from .errors import InputError, check_positive, check_range
-from .theory import jkr_pull_off, pb_gamma_eff, pb_gamma_eff_spectrum
+from .. import units
+from ..errors import InputError, check_positive, check_range
+from ..theory import jkr_pull_off, pb_gamma_eff, pb_gamma_eff_spectrum
 
 __all__ = [
     "paper_variables",

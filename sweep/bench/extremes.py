@@ -1,11 +1,11 @@
 r"""Stability at the extremes of the scene space: every corner of (n, k, rate, a0, mu).
 
-Each scene runs with the model a user gets (:func:`sweep.models.simulate_scene`, model
+Each scene runs with the model a user gets (:func:`sweep.engine.models.simulate_scene`, model
 "bem": the fixed-band or tip-following BEM, the quasi-static branch for k = 1) and is
 judged against physical bounds that do not come from the BEM:
 
 * lower: the relaxed elastic pull-off from the same a0, on the quasi-static branch
-  (:func:`sweep.quasistatic.elastic_pull_off`); at the slowest rate the pull-off must equal
+  (:func:`sweep.engine.quasistatic.elastic_pull_off`); at the slowest rate the pull-off must equal
   it (to ``SLOW_RTOL``): the substrate relaxes faster than it is unloaded;
 * upper: 2/k, the pull-off of a crack whose work of adhesion is amplified by the full
   glassy ratio 1/k (JKR 1.5/k, DMT 2/k) -- or, for a large contact unloaded faster than it
@@ -16,7 +16,7 @@ judged against physical bounds that do not come from the BEM:
 
 A scene passes when it is ``ok`` with a finite pull-off inside the bounds, or ``failed``
 with a reason; never NaN, an ok result outside the bounds, or a run over its time budget
-without saying so. ``python -m sweep.extremes [--quick]`` prints the table.
+without saying so. ``python -m sweep.bench.extremes [--quick]`` prints the table.
 """
 from __future__ import annotations
 
@@ -59,14 +59,14 @@ def all_scenes() -> list[dict]:
 @lru_cache(maxsize=None)
 def relaxed_pull_off(mu: float, a0: float) -> float:
     """The relaxed elastic (quasi-static) pull-off from the contact radius a0."""
-    from .quasistatic import elastic_pull_off
+    from ..engine.quasistatic import elastic_pull_off
 
     return elastic_pull_off(mu, a_start=a0).pull_off
 
 
 def upper_bound(mu: float, k: float, a0: float) -> float:
     """max(2/k, pi sigma_0 (a0 + 2 l)^2): see the module docstring (units pi dg R)."""
-    from .problem import tip_zone
+    from ..engine.problem import tip_zone
 
     sigma0 = 16.0 * mu / (9.0 * math.sqrt(3.0) * math.pi ** (1.0 / 3.0))
     return max(2.0 / k, math.pi * sigma0 * (a0 + 2.0 * tip_zone(mu)) ** 2)
@@ -93,8 +93,8 @@ def run(scenes, numerics=None, on_row=None) -> list[dict]:
     (``on_row(row)`` is called as each is done)."""
     import time
 
-    from .models import simulate_scene
-    from .scene import Numerics, Scene
+    from ..engine.models import simulate_scene
+    from ..scene import Numerics, Scene
 
     numerics = numerics or Numerics.preset("balanced", time_budget_s=TIME_BUDGET_S)
     rows = []
@@ -126,7 +126,7 @@ def print_table(rows, out=print, header=True) -> None:
 def _main(argv=None) -> int:
     import argparse
 
-    p = argparse.ArgumentParser(prog="python -m sweep.extremes",
+    p = argparse.ArgumentParser(prog="python -m sweep.bench.extremes",
                                 description="stability at the extremes of the scene space")
     p.add_argument("--quick", action="store_true", help="the covering subset only")
     args = p.parse_args(argv)

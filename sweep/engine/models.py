@@ -3,17 +3,17 @@ r"""Models of one scene and the registry that maps a model name to its simulate 
 =======  ======================================================================================
 name     model
 =======  ======================================================================================
-bem      the boundary-element model (:func:`sweep.solver.simulate`): LJ interface, hereditary
+bem      the boundary-element model (:func:`sweep.engine.bem.simulate`): LJ interface, hereditary
          integral; the reference. On a graded mesh whose fixed crack band would need more
          than ``max_nodes`` nodes (mu above about 8, or large a0) it runs on a mesh refined
-         around the crack tip that follows it (:mod:`sweep.tip_following`,
+         around the crack tip that follows it (:mod:`sweep.engine.tip_following`,
          :func:`wants_tip_following`)
-crack    the crack-front model (:func:`sweep.crack_front.simulate_crack`): JKR contact whose
+crack    the crack-front model (:func:`sweep.engine.crack_front.simulate_crack`): JKR contact whose
          edge opens with the Persson-Brener Gamma(v) of the scene's spectrum
 pb       the paper's closed-form estimate (:func:`pb_estimate`): the crack speed at pull-off
          from the paper's fit vhat = 2.887 rhat_PB^1.171, Gamma_PB at that speed, and the
          load-control JKR pull-off with it, P = 1.5 Gamma_PB
-elastic  the quasi-static elastic branch (:func:`sweep.quasistatic.simulate_elastic`), no
+elastic  the quasi-static elastic branch (:func:`sweep.engine.quasistatic.simulate_elastic`), no
          hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100; "bem" and
          "auto" scenes that are elastic and quasi-static run it (:func:`wants_quasistatic`)
 auto     the cheapest model the scene allows (:func:`choose_model`): the BEM where the mesh that
@@ -28,9 +28,9 @@ from __future__ import annotations
 import math
 import time
 
-from . import units
-from .errors import check_choice, check_positive
-from .theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
+from .. import units
+from ..errors import check_choice, check_positive
+from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 
 __all__ = ["MODELS", "pb_estimate", "simulate_pb", "simulate_model", "simulate_scene",
            "choose_model", "bem_nodes_needed", "bem_node_budget", "wants_quasistatic",
@@ -81,7 +81,7 @@ def simulate_pb(scene, numerics=None):
     Only ``pull_off``, ``crack_speed``, ``vhat``, ``rhat_pb`` are set (no trajectory, no
     state at pull-off; the initial state does not enter the estimate).
     """
-    from .scene import Numerics, Result
+    from ..scene import Numerics, Result
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t0 = time.perf_counter()
@@ -98,8 +98,8 @@ def simulate_pb(scene, numerics=None):
 
 
 def _bem(scene, numerics=None):
-    from .scene import Numerics
-    from .solver import simulate
+    from ..scene import Numerics
+    from .bem import simulate
     from .tip_following import simulate_tip_following
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
@@ -109,7 +109,7 @@ def _bem(scene, numerics=None):
 
 
 def wants_tip_following(scene, numerics) -> bool:
-    """Whether a BEM scene runs on the tip-following mesh (:mod:`sweep.tip_following`):
+    """Whether a BEM scene runs on the tip-following mesh (:mod:`sweep.engine.tip_following`):
     a graded mesh sized from the band resolution (``nodes`` unset, not ``exact``) whose
     fixed crack band would need more than ``numerics.max_nodes`` nodes (large mu or a0)."""
     return (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact
@@ -133,14 +133,14 @@ def bem_nodes_needed(scene, numerics=None) -> int:
 
     Uniform mesh: its automatic (or given) domain over the spacing at which the process zone
     ``l0 = 1.693/mu^2`` spans ``numerics.zone_nodes`` spacings. Graded mesh: the nodes of
-    the mesh the solver would build (:func:`sweep.mesh.scene_mesh`, sized from the band
+    the mesh the solver would build (:func:`sweep.engine.mesh.scene_mesh`, sized from the band
     resolution).
     """
     import dataclasses
 
     from .mesh import scene_mesh
     from .problem import initial_estimates, tip_zone
-    from .scene import Numerics
+    from ..scene import Numerics
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     _, a_est, domain = initial_estimates(scene, numerics)
@@ -159,7 +159,7 @@ def bem_node_budget(numerics) -> int:
 
 def choose_model(scene, numerics=None) -> str:
     """The model "auto" picks: "bem" if its mesh fits the node budget, else "crack"."""
-    from .scene import Numerics
+    from ..scene import Numerics
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     return "bem" if bem_nodes_needed(scene, numerics) <= bem_node_budget(numerics) else "crack"
@@ -171,7 +171,7 @@ MODELS = {"bem": _bem, "crack": _crack, "pb": simulate_pb, "elastic": _elastic}
 
 def wants_quasistatic(scene, numerics) -> bool:
     """Whether a "bem" or "auto" scene is elastic and quasi-static, so that the equilibrium
-    branch (:mod:`sweep.quasistatic`) answers it without the hereditary machinery: k = 1,
+    branch (:mod:`sweep.engine.quasistatic`) answers it without the hereditary machinery: k = 1,
     started from a0, stopped at the pull-off, on the engine's own mesh (an explicit
     ``numerics.domain`` or ``exact`` asks for the hereditary BEM on that domain)."""
     return (scene.k == 1.0 and scene.a0 is not None and scene.stop == "pulloff"
@@ -181,7 +181,7 @@ def wants_quasistatic(scene, numerics) -> bool:
 def simulate_model(scene, model: str = "bem", numerics=None):
     """Run ``scene`` with the named model (one of :data:`MODELS` or "auto"); the result's
     ``model_used`` says which ran."""
-    from .scene import Numerics
+    from ..scene import Numerics
 
     check_choice("model", model, (*MODELS, "auto"))
     numerics = Numerics.preset("balanced") if numerics is None else numerics

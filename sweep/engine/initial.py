@@ -13,8 +13,8 @@ from collections import OrderedDict
 
 import numpy as np
 
-from kernels.interface import crossing_radius
-from kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton
+from ..kernels.interface import crossing_radius
+from ..kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton
 
 from .problem import jkr_radius
 
@@ -109,7 +109,7 @@ def relaxed_state(el: ElasticSolver, delta0=None, a0=None, mesh_key=None):
     """Relaxed elastic state at ``delta0`` or at the indentation giving contact radius ``a0``.
 
     ``mesh_key`` (hashable, determines the mesh and its influence matrix, e.g.
-    ``sweep.mesh.Mesh.key`` with the spacing) keeps the solution in a per-process cache of
+    ``sweep.engine.mesh.Mesh.key`` with the spacing) keeps the solution in a per-process cache of
     RELAXED_CACHE_SIZE states, returned (copied) to the next call with the same mesh, LJ
     law, tolerance and initial state; ``el`` then solves nothing (its Jacobian cache stays
     unfactorized). Returns (h, delta0) or raises RuntimeError with a reason.

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from kernels.interface import crossing_radius, lj_traction
-from kernels.solve import (STATUS_DOMAIN, STATUS_DONE, STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT,
+from ..kernels.interface import crossing_radius, lj_traction
+from ..kernels.solve import (STATUS_DOMAIN, STATUS_DONE, STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT,
                            invalidate, load, new_jacobian_cache, newton, stop_reached)
 
 #: Newton iterations per solve (as in the Prony kernel's driver)

@@ -1,12 +1,12 @@
 """Benchmarks, one subcommand per kind, each writing a JSON report::
 
-    python -m sweep.benchmarks scheduler --out results/bench/scheduler.json
+    python -m sweep.bench.benchmarks scheduler --out results/bench/scheduler.json
 
 ``scheduler``: parallel efficiency and per-scene overhead of the sweep engine. The grid is
 ``configs/smoke.yaml`` scaled up to ``--scenes`` scenes (its two n values times a finer
 log-spaced rate axis over the same range). In one process, on one machine:
 
-1. ``bare``: ``sweep.solver.simulate`` called in a plain loop (after ``warm_up``);
+1. ``bare``: ``sweep.engine.bem.simulate`` called in a plain loop (after ``warm_up``);
 2. ``j1``: ``run_sweep(jobs=1)`` (scheduler + store, in-process);
 3. ``j2``: ``run_sweep(jobs=2)`` with fresh loky workers (includes spawning them and their
    Numba cache load), then ``j2_warm`` with the reused workers;
@@ -38,7 +38,7 @@ import numpy as np
 from .tradeoff import (REFERENCE_OVERRIDES, REFERENCES, TRADEOFF_SCENES, VS_NUMPY_SCENES,
                        compute_reference, existing, write_tradeoff)
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _machine() -> dict:
@@ -49,7 +49,7 @@ def _machine() -> dict:
 
 def scaled_smoke(scenes: int = 40, base: str | Path | None = None):
     """configs/smoke.yaml with its rate axis refined so the grid has about ``scenes`` scenes."""
-    from .config import load_config, scale_grid
+    from ..campaign.config import load_config, scale_grid
 
     cfg = load_config(base or ROOT / "configs" / "smoke.yaml")
     g = cfg.grids[0]
@@ -79,9 +79,9 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
     ``j{jobs}`` always starts fresh worker processes, like a new ``sweep run`` does;
     ``j{jobs}_warm`` reuses the workers of the previous call.
     """
-    from . import solver
-    from .scheduler import run_sweep
-    from .store import load
+    from ..engine import bem as solver
+    from ..campaign.scheduler import run_sweep
+    from ..campaign.store import load
 
     cfg = scaled_smoke(scenes)
     tasks = cfg.tasks()
@@ -179,7 +179,7 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
 
 def bench_store(rows: int = 1000, trajectories: bool = False, steps: int = 2000) -> dict:
     """Cost of ResultStore.append per row and of one consolidation with ``rows`` rows."""
-    from .store import ResultStore
+    from ..campaign.store import ResultStore
 
     tmp = Path(tempfile.mkdtemp(prefix="bench-store-"))
     base = {"scene_id": "", "n": 0.8, "k": 0.1, "mu": 3.24, "rate": 1.0, "a0": 2.0,
@@ -213,7 +213,7 @@ class _KernelTimer:
     """Times the unloading kernel inside ``simulate`` (everything else is setup)."""
 
     def __enter__(self):
-        from . import solver
+        from ..engine import bem as solver
         self._solver = solver
         self._orig = solver.unload
         self.seconds = 0.0
@@ -255,7 +255,7 @@ def matvec_seconds(N: int, repeat: int = 2000) -> float:
 
 
 def _scene_run(scene, numerics, repeat: int) -> dict:
-    from .solver import simulate
+    from ..engine.bem import simulate
     best = None
     for _ in range(repeat):
         with _KernelTimer() as kt:
@@ -273,7 +273,7 @@ def _scene_run(scene, numerics, repeat: int) -> dict:
 def compile_seconds() -> dict:
     """Numba compile time: ``warm_up()`` in a fresh interpreter with an empty cache
     directory (cold), then again with the cache it left (cached)."""
-    code = ("import time; t=time.perf_counter(); from sweep.solver import warm_up; "
+    code = ("import time; t=time.perf_counter(); from sweep.engine.bem import warm_up; "
             "import_s=time.perf_counter()-t; w=warm_up(); print(import_s, w)")
     out = {}
     with tempfile.TemporaryDirectory() as cache:
@@ -291,8 +291,8 @@ def compile_seconds() -> dict:
 def bench_scene(repeat: int = 3, compile_: bool = True) -> dict:
     """Issue-3 numbers: per-preset wall time of the paper's scene, time per step over one
     dense matvec, Prony vs exact speed-up at equal steps, compile time."""
-    from .scene import PRESETS, Numerics, Scene
-    from .solver import warm_up
+    from ..scene import PRESETS, Numerics, Scene
+    from ..engine.bem import warm_up
     warm_up()
     scene = Scene(**PAPER_SCENE)
     report = {"kind": "scene", "machine": _machine(), "scene": PAPER_SCENE, "presets": {},
@@ -330,8 +330,8 @@ def bench_presets(repeat: int = 1) -> dict:
     """Speed/accuracy of the presets: error against the independent solver's values
     (shared/reference/independent_solutions.yaml) and cost, per case and preset."""
     import yaml
-    from .scene import PRESETS, Numerics, Scene
-    from .solver import warm_up
+    from ..scene import PRESETS, Numerics, Scene
+    from ..engine.bem import warm_up
     warm_up()
     ref = yaml.safe_load(REFERENCE_YAML.read_text())
     rows = []
@@ -360,7 +360,7 @@ def bench_convergence(mu: float = 6.0, nodes=(1000, 1500, 2000), domain: float =
     """Mesh convergence of the elastic pull-off at a large Tabor parameter (lattice trapping
     at coarse spacing), against the independent solver's value for that mu if it has one."""
     import yaml
-    from .scene import Numerics, Scene
+    from ..scene import Numerics, Scene
     ref = yaml.safe_load(REFERENCE_YAML.read_text()) if REFERENCE_YAML.exists() else {}
     ref_po = next((e["pull_off"] for e in ref.get("elastic", []) if e["mu"] == mu), None)
     rows = []
@@ -442,7 +442,7 @@ def step_cost(scene, numerics, repeat: int = 2) -> dict:
     Uses only the public API (``Result.wall_s``, ``Result.steps``): setup (mesh, Prony
     series, relaxed start) cancels in the difference.
     """
-    from .solver import simulate
+    from ..engine.bem import simulate
     full = min((simulate(scene, numerics) for _ in range(repeat)), key=lambda r: r.wall_s)
     cut_num = dataclasses.replace(numerics, max_steps=10)
     cut = min((simulate(scene, cut_num) for _ in range(repeat)), key=lambda r: r.wall_s)
@@ -470,9 +470,9 @@ def kernel_counters(scene, numerics) -> dict:
     crack-tip zone's Schur complement (``zone_refreshes``), factorizations of the contact
     (with the reason of the refactorizations) and the mean size of the interacting set
     |S|/N."""
-    from kernels import solve as ks
+    from ..kernels import solve as ks
 
-    from . import solver
+    from ..engine import bem as solver
     captured = {}
     orig = solver.unload
 
@@ -504,7 +504,7 @@ def compare_results(before, after) -> dict:
     in both, status changes, and over the scenes ``ok`` in both the relative differences
     |after / before - 1| of the pull-off and the crack speed (max and median), with the sums
     of the scenes' wall times."""
-    from .store import load
+    from ..campaign.store import load
 
     a = load(before).set_index("scene_id")
     b = load(after).set_index("scene_id")
@@ -529,10 +529,10 @@ def newton_diagnosis(scene, numerics, at_step: int = 300, ahead: int = 10) -> di
     as factorized at ``at_step`` (dense eigenvalues: the staleness of the Jacobian), and the
     cubic predictor's error |h_pred - h| / h0 (max over the nodes, where, and median) for
     each of the last steps (the distance Newton starts from)."""
-    from kernels.interface import lj_traction_and_stiffness
-    from kernels.jacobian import ZONE_IN, ZONE_OUT, crack_tip_index
+    from ..kernels.interface import lj_traction_and_stiffness
+    from ..kernels.jacobian import ZONE_IN, ZONE_OUT, crack_tip_index
 
-    from . import solver
+    from ..engine import bem as solver
     captured = {}
     orig = solver.unload
 
@@ -593,7 +593,7 @@ def newton_diagnosis(scene, numerics, at_step: int = 300, ahead: int = 10) -> di
 def bench_step_over_matvec(plan: BenchPlan) -> dict:
     """Time per step over the time of one dense N x N mat-vec at the mesh's N, with the
     kernel's counters (:func:`kernel_counters`)."""
-    from .scene import Numerics, Scene
+    from ..scene import Numerics, Scene
     scene = Scene(**plan.matvec_scene)
     out = {}
     for N in plan.matvec_nodes:
@@ -614,8 +614,8 @@ def bench_prony_speedup(plan: BenchPlan) -> dict:
     mesh, no second error-check solve). The
     speed-up is the ratio of wall time per step (whole runs, setup included).
     """
-    from .scene import Numerics, Scene
-    from .solver import simulate
+    from ..scene import Numerics, Scene
+    from ..engine.bem import simulate
     scene = Scene(**plan.prony_scene)
     base = existing({"mesh": "uniform", "pull_off_rtol": 0.0, **plan.prony_numerics})
     probe = simulate(scene, Numerics(**base, step=0.1))
@@ -637,7 +637,7 @@ def bench_prony_speedup(plan: BenchPlan) -> dict:
 
 def _listed(config, scenes, name: str):
     """A config with the numerics of ``config`` whose grid lists ``scenes`` one by one."""
-    from .config import AXES, config_from_dict
+    from ..campaign.config import AXES, config_from_dict
 
     grid = [{k: v for k, v in s.to_dict().items() if k in AXES and v is not None}
             for s in scenes]
@@ -662,7 +662,9 @@ def campaign_sample(config, size: int, seed: int = 0):
 
 def _clear_scene_caches() -> None:
     """Empty this process's per-scene caches (relaxed starts, Prony series, meshes)."""
-    from . import initial, mesh, problem
+    from ..engine import initial
+    from ..engine import mesh
+    from ..engine import problem
 
     initial._RELAXED.clear()
     problem.prony_series.cache_clear()
@@ -670,12 +672,13 @@ def _clear_scene_caches() -> None:
 
 
 class _fresh_disk_cache:
-    """Within: an empty on-disk cache (:mod:`sweep.diskcache`, a new temporary directory)
+    """Within: an empty on-disk cache (:mod:`sweep.engine.diskcache`, a new temporary directory)
     and empty in-memory scene caches, with loky workers started afresh so that they see it:
     what a first run on a new machine pays. Restores the previous cache directory."""
 
     def __enter__(self):
-        from . import diskcache, mesh
+        from ..engine import diskcache
+        from ..engine import mesh
         self._env = os.environ.get(diskcache.CACHE_ENV)
         self._unit = mesh._UNIT[0]
         os.environ[diskcache.CACHE_ENV] = tempfile.mkdtemp(prefix="bench-cache-")
@@ -685,7 +688,8 @@ class _fresh_disk_cache:
         return self
 
     def __exit__(self, *exc):
-        from . import diskcache, mesh
+        from ..engine import diskcache
+        from ..engine import mesh
         if self._env is None:
             os.environ.pop(diskcache.CACHE_ENV, None)
         else:
@@ -711,9 +715,9 @@ def bench_scale(plan: "BenchPlan") -> dict:
     """
     import pandas as pd
 
-    from .models import simulate_scene
-    from .scheduler import run_sweep, start_group
-    from .store import load
+    from ..engine.models import simulate_scene
+    from ..campaign.scheduler import run_sweep, start_group
+    from ..campaign.store import load
 
     cfg = load_config_path(plan.scale_config)
     sample = campaign_sample(cfg, plan.scale_sample, plan.scale_seed)
@@ -758,7 +762,7 @@ def bench_scale(plan: "BenchPlan") -> dict:
 
 def load_config_path(path: str):
     """A sweep config by path relative to the repository root (or absolute)."""
-    from .config import load_config
+    from ..campaign.config import load_config
 
     p = Path(path)
     return load_config(p if p.is_absolute() else ROOT / p)
@@ -772,10 +776,10 @@ def bench_campaign(plan: BenchPlan) -> dict:
     Both timed runs start from the same state: an on-disk cache filled by a first run of
     the sample (``wall_s.first_j1``, which fits every Prony series once) and empty
     in-memory caches (relaxed starts, meshes) in every process."""
-    from .config import config_from_dict
-    from .scheduler import run_sweep
-    from .solver import warm_up
-    from .store import load
+    from ..campaign.config import config_from_dict
+    from ..campaign.scheduler import run_sweep
+    from ..engine.bem import warm_up
+    from ..campaign.store import load
 
     cfg = load_config_path(plan.campaign)
     sub_cfg = campaign_subset(cfg, plan.campaign_stride)
@@ -863,10 +867,10 @@ def plain_time_at(engine_err: float, plain_rows: list[dict]) -> float | None:
 
 
 def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
-    """Engine vs the plain numpy solver (:mod:`sweep.plain_solver`) on the issue's scenes.
+    """Engine vs the plain numpy solver (:mod:`sweep.bench.plain_solver`) on the issue's scenes.
 
     Errors are relative pull-off errors against the stored converged reference of each scene
-    (see :mod:`sweep.tradeoff`). The engine's time is the best of ``repeat`` calls in this
+    (see :mod:`sweep.bench.tradeoff`). The engine's time is the best of ``repeat`` calls in this
     process (per-scene caches warm, as in a sweep); its first call is reported too. The plain
     solver climbs its ladder of (N, step) until it is more accurate than every engine
     configuration (or a run exceeds ``plain_time_limit_s``). ``ratio`` = plain time at equal
@@ -876,8 +880,8 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
     solver's time/error frontier (:func:`plain_time_at`), the estimate at equal accuracy.
     """
     from .plain_solver import plain_unload
-    from .scene import Numerics, Scene
-    from .solver import simulate
+    from ..scene import Numerics, Scene
+    from ..engine.bem import simulate
     from .tradeoff import load_references, reference_for, relative_error
 
     refs = load_references()
@@ -929,7 +933,7 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
 
 def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     """Every figure of ``results/bench.json`` (issue 9, item 7)."""
-    from .solver import warm_up
+    from ..engine.bem import warm_up
     plan = plan or BenchPlan()
     t0 = time.perf_counter()
     report = {"kind": "bench", "machine": {**_machine(), "loadavg_before": os.getloadavg()},
@@ -1087,7 +1091,7 @@ def all_cmd(tiny, out):
 @click.option("--out", default=None, help="JSON report path.")
 def scale_cmd(sample, jobs, config, out):
     """Estimated minutes for the 10,640-scene grid over the paper's ranges (a random sample)."""
-    from .solver import warm_up
+    from ..engine.bem import warm_up
 
     warm_up()
     _write(bench_scale(BenchPlan(scale_config=config, scale_sample=sample, jobs=jobs)), out)
@@ -1148,7 +1152,7 @@ def compare_cmd(before, after):
 def newton_diagnosis_cmd(n, k, mu, rate, delta0, preset, max_nodes, at_step, out):
     """Newton's cost on one scene: counters, the chord map's contraction and the predictor's
     error at the crack tip (default: the scale campaign's costliest kind of scene)."""
-    from .scene import Numerics, Scene
+    from ..scene import Numerics, Scene
     _write(newton_diagnosis(Scene(n=n, k=k, mu=mu, rate=rate, delta0=delta0),
                             Numerics.preset(preset, max_nodes=max_nodes), at_step), out)
 

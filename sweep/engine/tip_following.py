@@ -3,7 +3,7 @@
 At a large Tabor parameter the process zone l0 = 1.693/mu^2 (a_ref) is tiny (1.9e-3 at mu =
 30, 1.7e-4 at mu = 100) and a fixed graded mesh, fine over the whole band the tip sweeps
 (from a0 down to below the pull-off radius), needs 10^4-10^5 nodes. Here only a *window*
-around the crack tip is fine (spacing l0 / ``band_resolution``, :func:`sweep.mesh.graded_mesh`
+around the crack tip is fine (spacing l0 / ``band_resolution``, :func:`sweep.engine.mesh.graded_mesh`
 with the window as its band, element lengths growing by ``grading`` outside it), and the
 mesh is rebuilt when the tip leaves the window:
 
@@ -18,7 +18,7 @@ mesh is rebuilt when the tip leaves the window:
    modal state ``q`` as displacements (A (sigma - q_i), smooth, interpolated and mapped
    back through the new influence matrix), then the gap is re-equilibrated on the new
    mesh at frozen time; the records continue and the kernel resumes
-   (:func:`sweep.solver.unload_chunk`). Each re-meshing up to the pull-off must leave the
+   (:func:`sweep.engine.bem.unload_chunk`). Each re-meshing up to the pull-off must leave the
    load continuous (:func:`remesh_jump`), else the run ends failed with the reason.
 
 The cost is set by the window (a few hundred nodes, whatever a0) and by the number of time
@@ -38,15 +38,15 @@ import scipy.linalg
 from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
-from kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
+from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
                            STATUS_LEFT_BAND, STATUS_STEP_LIMIT, new_jacobian_cache, newton)
-from kernels.interface import lj_traction
+from ..kernels.interface import lj_traction
 
 from .initial import ElasticSolver, relaxed_state
-from . import units
+from .. import units
 from .problem import (Refused, initial_estimates, jkr_radius, material_of, prepare,
                       tip_zone)
-from .scene import Numerics, Result, Scene
+from ..scene import Numerics, Result, Scene
 
 #: room for the tip in its direction of motion, in process zones l0 (the tip moves this far,
 #: less TIP_MARGIN_ZONES, between two meshes)
@@ -275,13 +275,13 @@ def _reequilibrate(run, new, h, ceff, H):
 
 def branch_state(scene: Scene, band_resolution: float = 16.0, domain: float | None = None):
     """The relaxed elastic equilibrium at contact radius ``scene.a0`` on the quasi-static
-    branch (:class:`sweep.quasistatic.ElasticBranch`, which fixes the radius, not the
+    branch (:class:`sweep.engine.quasistatic.ElasticBranch`, which fixes the radius, not the
     indentation), on a mesh as fine as the window's (``band_resolution`` spacings per
     process zone, 8 zones each side) out to ``domain`` (the window mesh's, so that the gap
     is interpolated, never extrapolated): (nodes r, gap h, indentation delta), or None if
     it was not found.
 
-    Raises :class:`sweep.problem.Refused` where a0 lies below the displacement-controlled
+    Raises :class:`sweep.engine.problem.Refused` where a0 lies below the displacement-controlled
     fold of the branch (JKR: a = 0.5): the state exists but is unstable (the indentation
     decreases as the radius grows), so no relaxed state can be held there.
     """
@@ -315,10 +315,10 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
     (warm-started solves; the tip stays in the fine window): to a0 or, where the tip is
     pinned between nodes (a(delta) a staircase), within two fine spacings
     (``Result.a0_result`` says where), else RuntimeError with the reason. A direct Newton
-    solve from the JKR gap, as :func:`sweep.initial.relaxed_state` does, can converge to a
+    solve from the JKR gap, as :func:`sweep.engine.initial.relaxed_state` does, can converge to a
     state whose tip sits on the coarse mesh outside the window at large mu, and its
     continuation costs a dense factorization per solve. From delta0:
-    :func:`sweep.initial.relaxed_state`.
+    :func:`sweep.engine.initial.relaxed_state`.
     """
     def solve(d_new, guess):
         # Newton to the numerics' tolerance; where it stalls (large mu: the LJ stiffness
@@ -432,17 +432,17 @@ def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
     numerics : Numerics, optional
         Default ``Numerics.preset("balanced")``; the fine spacing is l0 / band_resolution
         (or, with ``nodes`` set, the mesh of that many nodes), the rest as for
-        :func:`sweep.solver.simulate` (steps, tolerances, time budget, error indicator).
+        :func:`sweep.engine.bem.simulate` (steps, tolerances, time budget, error indicator).
     ahead, behind : float
         The window, in process zones l0 (see :func:`tip_window`).
 
     Returns
     -------
     Result
-        As :func:`sweep.solver.simulate`; ``nodes_used`` is the largest mesh of the run,
+        As :func:`sweep.engine.bem.simulate`; ``nodes_used`` is the largest mesh of the run,
         ``reason`` of an ok result says how many meshes it took.
     """
-    from .solver import CHECK_FRACTION, _check_resolution, coarser, resolution_error
+    from .bem import CHECK_FRACTION, _check_resolution, coarser, resolution_error
 
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t_start = time.perf_counter()
@@ -457,7 +457,7 @@ def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
 
 
 def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
-    from .solver import (CHUNK_STEPS, STATUS_TIME_BUDGET, UnloadingState, _finish,
+    from .bem import (CHUNK_STEPS, STATUS_TIME_BUDGET, UnloadingState, _finish,
                          unload_chunk)
 
     if numerics.mesh != "graded" or numerics.exact:
@@ -565,7 +565,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     return res
 
 
-#: the convergence study (``python -m sweep.tip_following``): a viscoelastic scene unloaded
+#: the convergence study (``python -m sweep.engine.tip_following``): a viscoelastic scene unloaded
 #: from a0 = 1.2 (n = 0.8, k = 0.5, rate 1), fine spacing l0/band_resolution, window
 #: (ahead, behind) in l0
 STUDY_SCENE = dict(n=0.8, k=0.5, a0=1.2, rate=1.0)
@@ -639,7 +639,7 @@ def remesh_jumps(scene: Scene, numerics: Numerics | None = None, form: str = "au
 def _main(argv=None) -> None:
     import argparse
 
-    p = argparse.ArgumentParser(prog="python -m sweep.tip_following",
+    p = argparse.ArgumentParser(prog="python -m sweep.engine.tip_following",
                                 description="convergence of the tip-following BEM")
     p.add_argument("--mu", type=float, nargs="+", default=[30.0, 100.0])
     p.add_argument("--resolutions", type=float, nargs="+", default=list(STUDY_RESOLUTIONS))

@@ -1,6 +1,6 @@
 """results/REPORT.md: the reproduction of the paper, generated from this project's output files.
 
-:func:`build_report` reads the ``fit.json``/``*.json`` files that ``python -m sweep.reproduce``
+:func:`build_report` reads the ``fit.json``/``*.json`` files that ``python -m sweep.paper.reproduce``
 wrote under a results directory (and the attributes of the HDF5 files they name) and returns
 Markdown: every fit beside the paper's value, the figures, scene counts, failures, wall times
 and the commits. The paper's values (``paper``, from ``tests/data/paper_values.yaml``) fill

@@ -1,6 +1,6 @@
 """Where the models agree: BEM vs crack-front model vs the PB estimate on the same scenes.
 
-``python -m sweep.agreement --out results/agreement/agreement.json`` (``make agreement``):
+``python -m sweep.bench.agreement --out results/agreement/agreement.json`` (``make agreement``):
 
 * mu = 3.24 (the paper's), n = 0.8, k = 0.1, a0 in {1, 2, 3, 4, 6, 8}, rates {1, 10^2.5, 1e4}:
   finite-size effects of the crack-front model at small a0 and its relaxed-bulk assumption
@@ -23,10 +23,10 @@ import sys
 import time
 from pathlib import Path
 
-from .crack_front import simulate_crack
-from .models import simulate_pb
-from .scene import Numerics, Scene
-from .solver import simulate
+from ..engine.crack_front import simulate_crack
+from ..engine.models import simulate_pb
+from ..scene import Numerics, Scene
+from ..engine.bem import simulate
 
 A0S = (1.0, 2.0, 3.0, 4.0, 6.0, 8.0)
 RATES = (1.0, 10**2.5, 1e4)
@@ -66,7 +66,7 @@ def run(a0s=A0S, rates=RATES, mus=MUS) -> dict:
     for mu in mus:
         mu_rows.append(_row(Scene(n=0.8, k=0.1, mu=mu, a0=3.0, rate=10**2.5)))
         print(_fmt(mu_rows[-1]), flush=True)
-    from .store import provenance
+    from ..campaign.store import provenance
 
     return {"a0_scan": rows, "mu_scan": mu_rows, "wall_s": time.perf_counter() - t0,
             "git_commit": provenance()["git_commit"]}
@@ -99,9 +99,9 @@ def merged(res: dict, extra=()) -> dict:
 
 def _reach(res: dict) -> str:
     """Why the mu scan stops where it does: the highest mu measured, its BEM cost, and the
-    nodes the BEM's range end (sweep.problem.BEM_MU_RANGE) would need with today's mesh."""
-    from .models import bem_node_budget, bem_nodes_needed
-    from .problem import BEM_MU_RANGE
+    nodes the BEM's range end (sweep.engine.problem.BEM_MU_RANGE) would need with today's mesh."""
+    from ..engine.models import bem_node_budget, bem_nodes_needed
+    from ..engine.problem import BEM_MU_RANGE
 
     top = max(res["mu_scan"], key=lambda r: r["mu"], default=None)
     if top is None:

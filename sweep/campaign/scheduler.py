@@ -2,7 +2,7 @@
 
 :func:`run_sweep` is the Python entry point behind ``sweep run``::
 
-    from sweep import run_sweep
+    from .. import run_sweep
     report = run_sweep("configs/smoke.yaml", jobs=2)          # joblib/loky on this machine
     report = run_sweep(cfg, backend="dask", scheduler="tcp://head:8786")   # a cluster
 
@@ -12,7 +12,7 @@ relaxed start, so one worker solves it once; chunks are small (a quarter of a wo
 of the estimated cost at most) and dispatched the most expensive first
 (longest-processing-time first, so that no large chunk starts last and leaves one core idle
 at the end of the grid). Results stream back to the parent as each chunk finishes and the
-parent, the single writer, appends them to the crash-safe store (:mod:`sweep.store`).
+parent, the single writer, appends them to the crash-safe store (:mod:`sweep.campaign.store`).
 Backends:
 
 * ``loky`` (default): ``jobs`` worker processes on this machine (default: all cores), each
@@ -22,7 +22,7 @@ Backends:
   ``scheduler`` (``tcp://host:8786``); without an address a ``LocalCluster`` with ``jobs``
   single-threaded worker processes is started for the run.
 
-The Numba cache is warmed in the parent (``sweep.solver.warm_up()``, which compiles and
+The Numba cache is warmed in the parent (``sweep.engine.bem.warm_up()``, which compiles and
 writes the on-disk cache) before the grid starts, and once more in every worker process on
 its first task (a cache load). Resume: scenes whose id is already in the results file (or
 its journal) are skipped, so running the same command again completes an interrupted sweep.
@@ -44,10 +44,10 @@ import click
 import numpy as np
 
 from .config import SweepConfig, as_config
-from .errors import InputError, check_int, check_range
-from .scene import Result
+from ..errors import InputError, check_int, check_range
+from ..scene import Result
 from .store import ResultStore, StoreBusyError, plain_row
-from .threads import THREAD_VARS, limit_env, limit_loaded_pools
+from ..threads import THREAD_VARS, limit_env, limit_loaded_pools
 
 BACKENDS = ("loky", "dask")
 PROGRESS_MODES = ("auto", "bar", "log", "none")
@@ -97,7 +97,7 @@ def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
         limit_env(THREAD_VARS)
         limit_loaded_pools()
     if warm:
-        from . import solver
+        from ..engine import bem as solver
 
         solver.warm_up()
     _WORKER_READY = True
@@ -119,7 +119,7 @@ def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | 
     if in_worker:
         _prepare_worker(warm=simulate is None)
     if simulate is None:
-        from .models import simulate_scene as simulate   # dispatches on scene.model
+        from ..engine.models import simulate_scene as simulate   # dispatches on scene.model
     t0 = time.perf_counter()
     c0 = time.process_time()
     try:
@@ -242,7 +242,7 @@ def estimated_cost(scene, numerics) -> float:
     scene (no mesh is built); a scene it cannot size gets cost 1.
     """
     try:
-        from .problem import initial_estimates, tip_zone
+        from ..engine.problem import initial_estimates, tip_zone
 
         _, a_est, _ = initial_estimates(scene, numerics)
         size = max(a_est, 0.0) / tip_zone(scene.mu)
@@ -272,7 +272,7 @@ CHUNK_SCENES = 24
 
 
 def start_group(scene) -> tuple:
-    """Scenes that share a relaxed start (the per-process cache of :mod:`sweep.initial`):
+    """Scenes that share a relaxed start (the per-process cache of :mod:`sweep.engine.initial`):
     same material ratio k, Tabor parameter and initial state; n and the rate do not enter."""
     return tuple(getattr(scene, name, None) for name in ("model", "k", "mu", "a0", "delta0"))
 
@@ -383,10 +383,10 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
         "auto": an updating line on a TTY, one line per scene otherwise. A callable gets a
         dict (done, total, failed, eta, row) after each scene.
     simulate : callable, optional
-        Replacement for :func:`sweep.solver.simulate` (module-level, so that it pickles to
+        Replacement for :func:`sweep.engine.bem.simulate` (module-level, so that it pickles to
         workers); for tests and benchmarks.
     consolidate_every : float
-        Seconds between consolidations of the results file (see :mod:`sweep.store`).
+        Seconds between consolidations of the results file (see :mod:`sweep.campaign.store`).
     connect_timeout : float
         Seconds to wait for a dask scheduler.
 
@@ -515,7 +515,7 @@ def _close_dask(client, cluster) -> None:
 def _warm_parent() -> None:
     """Compile (or load) the Numba kernels once, in the parent, before the workers start."""
     try:
-        from . import solver
+        from ..engine import bem as solver
     except ImportError as exc:
         raise SweepRuntimeError(f"cannot import the solver ({exc})") from None
     solver.warm_up()

@@ -8,7 +8,7 @@ Two kinds (``Numerics.mesh``), nodes in a_ref units with r_0 = 0:
   down to below the pull-off radius), spacings growing geometrically by ``grading`` from
   the band inward to r = 0 (deep inside the compressed contact) and outward to the domain
   edge (the far Lennard-Jones tail). The fine spacing is the tip zone (the process zone
-  l0 = 1.693/mu^2, or sqrt(h0) on the DMT side: :func:`sweep.problem.tip_zone`) divided
+  l0 = 1.693/mu^2, or sqrt(h0) on the DMT side: :func:`sweep.engine.problem.tip_zone`) divided
   by ``band_resolution``, or the one that gives exactly ``nodes``
   nodes when a node count is requested.
 
@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-import kernels.influence
-from kernels.influence import (assemble_nodes, combine_lattice_hats, grow_unit,
+from .. import kernels
+from ..kernels.influence import (assemble_nodes, combine_lattice_hats, grow_unit,
                                load_weights_nodes)
 
 from . import diskcache
@@ -216,7 +216,7 @@ def unit_influence(N: int) -> np.ndarray:
 
     Its entries do not depend on the matrix size (the last node has a full hat), so one
     matrix, grown in blocks of UNIT_BLOCK nodes (only the new rows and columns are
-    assembled), serves every mesh of the process. It is kept on disk too (:mod:`sweep.diskcache`,
+    assembled), serves every mesh of the process. It is kept on disk too (:mod:`sweep.engine.diskcache`,
     memory-mapped, so that the workers of a sweep share one copy and a new process does not
     assemble it again); the file name carries a hash of kernels/influence.py.
     """

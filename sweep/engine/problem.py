@@ -5,7 +5,7 @@ solve needs before it starts -- the Lennard-Jones constants (h0, c), the process
 the estimated initial state, the domain, the mesh with its influence matrix and load
 weights, the Prony time window and series -- so that data flows one way: scene ->
 problem -> kernels -> result. The per-process caches (Prony series, influence matrices)
-live here and in :mod:`sweep.mesh`.
+live here and in :mod:`sweep.engine.mesh`.
 """
 from __future__ import annotations
 
@@ -16,11 +16,12 @@ from pathlib import Path
 
 import numpy as np
 
-from . import diskcache, units
-from .materials.prony_series import PronySeries
+from . import diskcache
+from .. import units
+from ..materials.prony_series import PronySeries
 from .mesh import Mesh, scene_mesh
-from .scene import Numerics, Scene
-from .theory import jkr_contact_radius
+from ..scene import Numerics, Scene
+from ..theory import jkr_contact_radius
 
 #: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
 WINDOW_SAFETY = 10.0
@@ -39,7 +40,7 @@ TIP_GAP = 3.0 ** (1.0 / 6.0)
 
 #: Tabor parameters of the hereditary BEM: the whole range of Scene. Validated: above about 8
 #: the fixed crack band exceeds max_nodes and the tip-following mesh
-#: (:mod:`sweep.tip_following`) takes over (pull-off converged to 1 % at mu = 30 and 100);
+#: (:mod:`sweep.engine.tip_following`) takes over (pull-off converged to 1 % at mu = 30 and 100);
 #: below 1.83 the mesh is sized from sqrt(h0) (:func:`tip_zone`) and the domain from the LJ
 #: tail (elastic pull-off equal to the quasi-static branch's to 1e-3 down to mu = 0.01)
 BEM_MU_RANGE = (0.01, 100.0)
@@ -75,7 +76,7 @@ def jkr_radius(delta: float) -> float:
 
 def material(kind: str, n: float, k: float):
     """The material object (units E0 = 1, tau0 = 1): "mpl" or "sls"."""
-    from .materials import SLS, MPLRetardation
+    from ..materials import SLS, MPLRetardation
     if kind == "sls":
         return SLS(1.0, 1.0 / k, 1.0)
     return MPLRetardation(1.0, 1.0 / k, n, 1.0)
@@ -117,7 +118,7 @@ def prony_series(kind: str, n: float, k: float, t_min: float, t_max: float, rtol
     scene's unloading; the scenes of a sweep repeat the same (material, n, k) and, through
     the snapped :func:`time_window`, the same window (156 windows for the 936 scenes of
     configs/threshold.yaml). Each fit is kept in memory and on disk
-    (:mod:`sweep.diskcache`, keyed by its arguments and a hash of sweep/materials), so a
+    (:mod:`sweep.engine.diskcache`, keyed by its arguments and a hash of sweep/materials), so a
     worker or a later sweep reads it instead of fitting it again.
     """
     key = (kind, float(n), float(k), float(t_min), float(t_max), float(rtol))
@@ -150,7 +151,7 @@ _PRONY_FIELDS = {"kind", "key", "weights", "times", "max_rel_error", "rtol", "co
 def _materials_tag() -> str:
     """Hash of the material and fitting code (sweep/materials/*.py): a cached series is
     used only with the code that fitted it."""
-    from . import materials
+    from .. import materials
     folder = Path(materials.__file__).parent
     return diskcache.source_tag(*sorted(str(p) for p in folder.glob("*.py")))
 
@@ -219,7 +220,7 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
     """Derive a scene's numbers once. Raises :class:`Refused` when the mesh cannot do.
 
     ``band`` overrides the crack band of a graded mesh (a_ref radii, see
-    :func:`sweep.mesh.crack_band`).
+    :func:`sweep.engine.mesh.crack_band`).
     """
     lo, hi = BEM_MU_RANGE
     if not lo <= scene.mu <= hi:
@@ -244,7 +245,7 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused(f"mesh too large: the crack band needs {mesh.nodes} nodes at "
                       f"band_resolution {numerics.band_resolution:g} (> max_nodes = "
                       f"{numerics.max_nodes}); raise max_nodes or lower band_resolution, or run it "
-                      f"on the tip-following mesh (sweep.tip_following; model bem does so)")
+                      f"on the tip-following mesh (sweep.engine.tip_following; model bem does so)")
     weights = times = np.zeros(0)
     error = 0.0
     if scene.k < 1.0 and not numerics.exact:

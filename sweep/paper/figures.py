@@ -1,6 +1,6 @@
 r"""The paper's figures, redrawn from this project's runs and theory (matplotlib, ``plot`` extra).
 
-Each function takes tables/dicts made by :mod:`sweep.analysis` (or a runs table of
+Each function takes tables/dicts made by :mod:`sweep.analysis.fits` (or a runs table of
 :func:`sweep.load`) and writes one PNG; none computes a fit itself. Symbols follow the paper:
 ``P_po`` (pull-off, units pi dg R), ``a0`` (initial contact radius, a_ref, the max-tension
 radius), ``r-hat`` (rate r tau0/h0), ``r-hat_PB`` (r tau0/d_ref), ``v-hat`` (v tau0/l0),
@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
-from .plots import _pyplot
+from ..analysis.plots import _pyplot
 
 __all__ = ["threshold_figure", "vr_figure", "pb_vs_bem_figure", "fig3_figure",
            "aconv_figure", "mplplot_figure", "pb_bem_figure", "b1_figure"]
@@ -70,7 +70,7 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
     solid above, open circle at ``a0t``); (b) ``P_po(a0t)`` vs ``a0t`` with the fit, the
     paper's line and the saturation ``1.5/k`` (inset ``a0t`` vs rate); (c) ``P_po(a0)`` of
     ``n = overshoot_n`` at every rate (overshoot and the first-crossing rule).
-    ``fit`` is :func:`sweep.analysis.threshold_analysis` output; ``runs`` the runs table.
+    ``fit`` is :func:`sweep.analysis.fits.threshold_analysis` output; ``runs`` the runs table.
     """
     plt = _pyplot()
     ok = runs[runs["status"] == "ok"].sort_values("a0")
@@ -175,7 +175,7 @@ def _vr_scatter(ax, d, xcol, ycol):
 
 def vr_figure(points: pd.DataFrame, fit: dict, out, paper=(2.887, 1.171)) -> Path:
     """The inset of the paper's Fig. r_v: ``v-hat`` vs ``r-hat_PB`` (log-log), our two fits
-    and the paper's. ``points``: :func:`sweep.analysis.paper_variables` of the finished runs."""
+    and the paper's. ``points``: :func:`sweep.analysis.fits.paper_variables` of the finished runs."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 6))
     d = points[(points["vhat"] > 0)]
@@ -200,7 +200,7 @@ def pb_vs_bem_figure(points: pd.DataFrame, comp: dict, out) -> Path:
     """The paper's Fig. r_v main panel and the direct check: ``Gamma_eff`` of the BEM against
     PB at the crack speed predicted from the rate by the v-r fit (left) and at the measured
     crack speed (right), with the 1:1 and +-15 % lines. ``points``: the first value of
-    :func:`sweep.analysis.pb_comparison`, ``comp`` its second."""
+    :func:`sweep.analysis.fits.pb_comparison`, ``comp`` its second."""
     plt = _pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(13, 5.8))
     for ax, col, way, title in (
@@ -231,7 +231,7 @@ def fig3_figure(runs: pd.DataFrame, trajectories: dict, out) -> Path:
     """The paper's Fig. 3: ``P(a)`` during unloading; panels (a) rates (n = 0.8, a0 = 3.61),
     (b) n (rate 10^2.5), (c) a0 (n = 1.6, rate 10^2.5); the JKR curve for reference.
     ``trajectories`` maps scene_id to the dict of :func:`sweep.load_trajectory`."""
-    from .theory import jkr_load
+    from ..theory import jkr_load
 
     plt = _pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(16, 5))
@@ -289,7 +289,7 @@ def mplplot_figure(out, n_values=(0.2, 0.4, 0.6), k=0.1) -> Path:
     """The paper's Fig. MPLplot: (a) relaxation ``R(t)/E0`` of the MPL relaxation model
     (eq. Rt3), (b) creep ``C(t)/C0`` of the MPL retardation model (eq. Ctgen), against the
     SLS (dashed blue)."""
-    from .materials import SLS, MPLRelaxation, MPLRetardation
+    from ..materials import SLS, MPLRelaxation, MPLRetardation
 
     plt = _pyplot()
     t = np.logspace(-4, 6, 300)
@@ -320,7 +320,7 @@ def pb_bem_figure(curves: dict, laws: dict, points: pd.DataFrame, out, k=0.1) ->
     """The paper's Fig. PB_BEM: PB ``Gamma_eff(v-hat)`` lines (MPL n values and the SLS), the
     BEM markers (k = ``k``), the intermediate power laws ``beta v^m`` (dashed), and ``beta``,
     ``m`` vs n in an inset. ``curves`` maps a label (n or "sls") to (vhat, gamma);
-    ``laws`` maps n to :func:`sweep.analysis.pb_power_law` output."""
+    ``laws`` maps n to :func:`sweep.analysis.fits.pb_power_law` output."""
     plt = _pyplot()
     fig, (ax, side) = plt.subplots(1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [2.3, 1]})
     for key, (v, g) in curves.items():
@@ -358,7 +358,7 @@ def b1_figure(curves: dict, regimes: dict, out, k: float, paper_q1=(-0.0125, 3.1
     """Appendix B, Fig. B1: ``Gamma_eff - 1`` vs ``v-hat`` with the two power laws, ``q1`` vs
     n against the paper's ``q1 = -0.0125 + 3.136 n`` and ``q2``, ``m2`` vs n.
     ``curves`` maps n to (vhat, gamma); ``regimes`` maps n to
-    :func:`sweep.analysis.pb_regimes` output."""
+    :func:`sweep.analysis.fits.pb_regimes` output."""
     plt = _pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(13, 5.2))
     ax = axes[0]
