@@ -53,7 +53,7 @@ test-slow: $(STAMP)
 
 # The kernels run as plain Python (NUMBA_DISABLE_JIT=1) so that coverage sees their lines:
 # the kernel-by-kernel tests and the engine against tests/naive.py on small meshes (~30 s).
-KERNEL_TESTS := tests/test_history.py tests/test_fast_vs_naive.py tests/test_influence.py
+KERNEL_TESTS := tests/kernels/test_history.py tests/engine/test_fast_vs_naive.py tests/kernels/test_influence.py
 coverage-kernels: $(STAMP)
 	NUMBA_DISABLE_JIT=1 $(BIN)/python -m pytest -q -p no:cacheprovider --cov=kernels \
 	  --cov-report=term-missing $(KERNEL_TESTS) -k "not uniform_pressure and not hertz"

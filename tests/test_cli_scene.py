@@ -57,7 +57,7 @@ def test_scene_bad_input_one_line_exit_2(args, name, capsys):
 def test_failed_scene_exits_1(capsys):
     # mu = 10, a0 = 10 on a graded mesh of 300 nodes: the process zone spans half a node
     # spacing; refused with the advice, status failed (without --nodes the scene runs on
-    # the tip-following mesh, tests/test_tip_following.py)
+    # the tip-following mesh, tests/engine/test_tip_following.py)
     assert main(["scene", "--n", "1", "--mu", "10", "--a0", "10", "--rate", "1",
                  "--preset", "fast", "--nodes", "300", "--json"]) == 1
     out = json.loads(capsys.readouterr().out)

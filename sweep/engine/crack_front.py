@@ -38,7 +38,7 @@ control as under load control, provided ``a0 > 1.040``; ``-5/6`` is the load at 
 sphere jumps off. For a constant ``Gamma = c dg`` reached after pinning (``Gamma(0) = c``) the
 closed form is ``1.5 c`` for ``a0 >= 1.040 c^(1/3)`` and
 ``2 sqrt(2c) a0^(3/2) - 4/3 a0^3`` (the load at depinning) for ``a0/c^(1/3)`` in
-``[1/2, 1.040]``: tested in ``tests/test_crack_front.py``.
+``[1/2, 1.040]``: tested in ``tests/engine/test_crack_front.py``.
 
 Rate laws (:class:`GentSchultzLaw`, :class:`PerssonBrenerLaw`) map ``v`` to ``Gamma`` and
 back; :func:`unload` runs one unloading; :func:`simulate_crack` runs a :class:`sweep.Scene`

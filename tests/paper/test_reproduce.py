@@ -5,7 +5,7 @@ import json
 import pytest
 
 from sweep.paper.reproduce import main
-from tests.test_analysis import synthetic_threshold_runs, synthetic_vr_runs, write_results
+from tests.analysis.test_fits import synthetic_threshold_runs, synthetic_vr_runs, write_results
 
 pytest.importorskip("matplotlib")
 

@@ -12,7 +12,7 @@ from sweep.campaign.config import AXIS_DEFAULTS, config_from_dict, load_config, 
 from sweep.errors import InputError
 from sweep.scene import Numerics, Scene, scene_id
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 CONFIGS = ROOT / "configs"
 
 

@@ -205,7 +205,7 @@ def test_shipped_pdms_config_runs_and_matches_make_pdms(tmp_path):
     from sweep.paper import pdms
     from sweep.campaign.si import si_table
 
-    cfg = Path(__file__).resolve().parents[1] / "configs" / "pdms.yaml"
+    cfg = Path(__file__).resolve().parents[2] / "configs" / "pdms.yaml"
     out = tmp_path / "p.h5"
     assert main(["run", str(cfg), "--out", str(out), "-j", "1", "--progress", "none"]) == 0
     df = si_table(out)

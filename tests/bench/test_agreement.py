@@ -5,7 +5,7 @@ from pathlib import Path
 
 from sweep.bench.agreement import main, merged, summary
 
-DIR = Path(__file__).resolve().parents[1] / "results" / "agreement"
+DIR = Path(__file__).resolve().parents[2] / "results" / "agreement"
 
 
 def test_high_mu_rows_merge_into_the_mu_scan():
