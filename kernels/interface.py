@@ -10,6 +10,12 @@ from __future__ import annotations
 
 from numba import njit
 
+#: the gap at the crack tip over h0: the traction is most tensile at h_m = 3^(1/6) h0, and the
+#: contact radius ``a`` is where the gap equals it (docs/design.md section 2). The one place
+#: this number is written; everything else reads it from here (or from
+#: ``sweep.engine.problem.Scales.tip_gap``)
+TIP_GAP = 3.0 ** (1.0 / 6.0)
+
 
 @njit(cache=True)
 def lj_traction(h, h0, c, out):

@@ -15,7 +15,8 @@ _threads.limit_env(_threads.BLAS_VARS)
 
 from .errors import InputError  # noqa: E402
 from .scene import PRESETS, Numerics, Result, Scene, scene_id  # noqa: E402
-from .engine.bem import simulate, warm_up  # noqa: E402
+from .engine.models import simulate  # noqa: E402  (the one entry for one scene)
+from .engine.bem import warm_up  # noqa: E402
 from .campaign.store import load, load_trajectory  # noqa: E402  (results files of sweeps)
 from .campaign.scheduler import run_sweep  # noqa: E402  (the Python entry point of `sweep run`)
 

@@ -25,25 +25,18 @@ import time
 
 import numpy as np
 
-from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_DOMAIN, STATUS_LEFT_BAND,
-                           STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT, invalidate, stop_reached,
-                           unload)
-
-from .. import units
+from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP_LIMIT,
+                             invalidate, unload)
+from ..scene import Numerics, Result, Scene
 from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
-from .postprocess import crack_speed_at, refine_minimum
-from .problem import Problem, Refused, lj_constants, material_of, prepare  # noqa: F401 (re-exported)
-from ..scene import Numerics, Result, Scene
+from .postprocess import STATUS_TIME_BUDGET, finish
+from .problem import Problem, Refused, derive, material_of, prepare
+from .resolution import estimate_error
 
 #: Newton iterations per solve: a good step converges in 2-5 (quadratic predictor); a solve
 #: that needs more is better retried with a smaller step or taken for a fold
 MAX_NEWTON_ITER = 12
-#: the resolution error model, K (spacing/l0)^2 (see :func:`resolution_error`) ...
-RESOLUTION_ERROR_K = 0.3
-#: ... decides alone while below this fraction of numerics.pull_off_rtol; above it the
-#: scene is solved again at half the resolution and the pull-off change decides
-CHECK_FRACTION = 0.25
 #: the crack tip must recede by this many (fine) node spacings after the load minimum
 #: before a run stops (a lattice dip of the load cannot end it; kernels.solve.stop_reached)
 STOP_TRAVEL_SPACINGS = 3.0
@@ -68,7 +61,7 @@ def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
     -------
     Result
         Pull-off force, state and crack speed at pull-off, counters, trajectory, and the
-        error estimate (see :func:`resolution_error` and :func:`_check_resolution`).
+        error estimate (:mod:`sweep.engine.resolution`).
         ``status`` is "failed" (with ``reason``) if the run could not be completed or its
         error estimate exceeds ``numerics.pull_off_rtol`` (reason "unresolved: ...").
     """
@@ -81,22 +74,13 @@ def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
     t_start = time.perf_counter()
     deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
     res = _attempt(scene, numerics, deadline)
-    if res.ok and numerics.pull_off_rtol > 0 and not numerics.exact:
-        res.error_estimate = resolution_error(res.spacing, units.l0_hat(scene.mu))
-        if res.error_estimate > CHECK_FRACTION * numerics.pull_off_rtol:
-            _check_resolution(res, _attempt(scene, coarser(numerics), deadline))
+    if not numerics.exact:
+        # the resolution error against the process zone l0 (the mesh is sized from the tip
+        # zone; the two differ below mu = 1.83, where this estimate is the smaller one)
+        estimate_error(res, derive(scene, numerics).process_zone,
+                       lambda coarse: _attempt(scene, coarse, deadline))
     res.wall_s = time.perf_counter() - t_start
     return res
-
-
-def resolution_error(spacing: float, l0: float) -> float:
-    """Pull-off error expected from the crack-band resolution: RESOLUTION_ERROR_K (spacing/l0)^2.
-
-    The bound of the measured convergence (README, "Speed and accuracy"): on the reference
-    scenes A, D, F the pull-off error times (l0/spacing)^2 stays below 0.22 from 6 to 40
-    spacings per l0.
-    """
-    return RESOLUTION_ERROR_K * (spacing / l0) ** 2
 
 
 def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Result:
@@ -118,43 +102,16 @@ def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Re
         if left is None:
             return res
         lo, hi = pb.mesh.band
-        width = max(hi - lo, 10 * pb.l0)
+        width = max(hi - lo, 10 * pb.tip_zone)
         band = (max(lo - width, 0.0), hi) if left == "inner" else (lo, hi + width)
     return res
 
 
-def coarser(numerics: Numerics) -> Numerics:
-    """The numerics of the error indicator's cheaper solve: half the mesh resolution
-    (half the band resolution, or half the nodes), no coarse-mesh refusal."""
-    if numerics.nodes is not None:
-        return dataclasses.replace(numerics, nodes=max(numerics.nodes // 2, 20), zone_nodes=0.0)
-    return dataclasses.replace(numerics, band_resolution=max(numerics.band_resolution / 2, 2.0),
-                               zone_nodes=0.0)
-
-
-def _check_resolution(res: Result, coarse: Result) -> None:
-    """Set the error estimate of ``res`` from the half-resolution solve; not ``ok`` when
-    it exceeds the tolerance (or the cheaper solve failed)."""
-    tol = res.numerics.pull_off_rtol
-    if not coarse.ok:
-        res.error_estimate = math.inf
-        res.status = "failed"
-        res.reason = (f"unresolved: the check on a mesh of half the resolution failed "
-                      f"({coarse.reason}); refine the mesh (band_resolution or nodes)")
-        return
-    res.error_estimate = abs(res.pull_off - coarse.pull_off) / res.pull_off
-    if res.error_estimate > tol:
-        res.status = "failed"
-        res.reason = (f"unresolved: the pull-off moves by {res.error_estimate:.2g} (> pull_off_rtol "
-                      f"= {tol:g}) on a mesh of half the resolution ({coarse.pull_off:.5g} vs "
-                      f"{res.pull_off:.5g}); refine the mesh (band_resolution or nodes)")
-
-
+#: what to change when the graded mesh finds no equilibrium before the pull-off
+ADVICE_GRADED = "increase nodes or reduce domain"
 #: the unloading kernel runs in chunks of this many steps; the wall-time budget is checked
 #: between chunks (a resumed chunk restarts the step predictor: a few Newton iterations)
 CHUNK_STEPS = 2000
-#: status of a run stopped by ``Numerics.time_budget_s`` (beside the kernel's STATUS_*)
-STATUS_TIME_BUDGET = -1
 
 
 @dataclasses.dataclass
@@ -237,9 +194,9 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
     min_travel = STOP_TRAVEL_SPACINGS * dr
     if numerics.exact:
         out = [np.empty(numerics.max_steps + 1) for _ in range(5)]
-        status, n = unload_exact(pb.A, r, pb.wP, h_init, delta0, scene, numerics, pb.h0, pb.c,
-                                 material_of(scene) if scene.k < 1.0 else None, pb.stop_mode,
-                                 min_travel, out, stats)
+        status, n = unload_exact(pb, h_init, delta0,
+                                 material_of(scene) if scene.k < 1.0 else None, min_travel, out,
+                                 stats)
     else:
         run = UnloadingState.start(pb, h_init, delta0, el.cache, stats)
         while True:
@@ -259,43 +216,8 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
         res.reason = (f"the crack tip left the fine band {pb.mesh.band[0]:.3g}..{pb.mesh.band[1]:.3g}"
                       f" of the graded mesh (a = {a[-1]:.4g})")
         return "inner" if a[-1] < pb.tip_range[0] else "outer"
-    _finish(res, scene, status, t, delta, P, a, a_inner, dr)
+    finish(res, status, res.trajectory, dr, min_travel, pb.scales, advice=ADVICE_GRADED)
     return None
-
-
-def _finish(res, scene, status, t, delta, P, a, a_inner, dr):
-    i, t_star, P_star = refine_minimum(t, P)
-    passed = stop_reached(P, a, len(P), i, 0, STOP_TRAVEL_SPACINGS * dr)
-    if status == STATUS_TIME_BUDGET:
-        res.reason = (f"time budget: {res.numerics.time_budget_s:g} s spent after {len(t) - 1} "
-                      f"steps (a = {a[-1]:.4g}, pull-off not reached); give it more "
-                      f"(numerics time_budget_s) or cheaper numerics (preset fast, fewer nodes)")
-        return
-    if status == STATUS_DOMAIN:
-        res.reason = "contact reached the mesh edge: increase numerics.domain"
-        return
-    if status == STATUS_STEP_LIMIT and not passed:
-        res.reason = f"step limit ({res.numerics.max_steps}) reached before pull-off"
-        return
-    if status == STATUS_NEWTON_FAILED and not passed:
-        res.reason = (f"no equilibrium found at the minimum step before pull-off (delta="
-                      f"{delta[-1]:.6g}, a={a[-1]:.4g}): the discrete path folds where the "
-                      f"crack tip is under-resolved; increase nodes or reduce domain")
-        return
-    if P_star >= 0:
-        res.reason = "no tensile load reached"
-        return
-    res.status = "ok"
-    if status == STATUS_NEWTON_FAILED:
-        res.reason = "stopped at the jump-off instability after pull-off"
-    res.pull_off = -P_star
-    res.t_pulloff = t_star
-    res.delta_pulloff = float(np.interp(t_star, t, delta))
-    res.a_pulloff = float(np.interp(t_star, t, a))
-    res.a_inner_pulloff = float(np.interp(t_star, t, a_inner))
-    res.crack_speed = float(crack_speed_at(t, a, t_star, dr))
-    res.vhat = res.crack_speed / units.l0_hat(scene.mu)
-    res.rhat_pb = units.rhat_pb(scene.rate, scene.mu)
 
 
 def warm_up() -> float:

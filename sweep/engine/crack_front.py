@@ -57,6 +57,7 @@ from scipy.interpolate import PchipInterpolator
 
 from .. import units
 from ..errors import InputError, check_choice, check_positive, check_range
+from ..scene import Numerics, Result
 from ..theory import (A_PULL_OFF_FORCE, jkr_contact_radius, jkr_indentation, pb_gamma_eff,
                      pb_gamma_eff_spectrum)
 
@@ -399,8 +400,6 @@ def simulate_crack(scene, numerics=None):
     at the JKR state of that radius (the BEM's ``a0`` is the LJ max-tension radius, which tends
     to it as mu grows).
     """
-    from ..scene import Numerics, Result
-
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t_start = time.perf_counter()
     res = Result(scene=scene, numerics=numerics)

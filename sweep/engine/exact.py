@@ -16,16 +16,25 @@ from ..kernels.solve import (STATUS_DOMAIN, STATUS_DONE, STATUS_NEWTON_FAILED, S
 MAX_NEWTON_ITER = 12
 
 
-def unload_exact(A, r, wP, h_init, delta0, scene, numerics, h0, c, material, stop_mode,
-                  min_travel, out, stats):
+def unload_exact(pb, h_init, delta0, material, min_travel, out, stats):
     """Unloading with the exact hereditary integral (closed-form integrated compliance).
 
     Fixed indentation step ``numerics.step`` h0 (halved on a Newton failure); no Prony.
     Cost O(steps^2 N): for validation on small problems.
+
+    Parameters
+    ----------
+    pb : sweep.engine.problem.Problem
+        The prepared problem (mesh, influence matrix, LJ constants, loading speed).
+    h_init, delta0 : the relaxed gap (d_ref) and its indentation.
+    material : the material object (``integrated_compliance``), None when elastic.
+    min_travel : crack-tip recession after the load minimum required to stop (a_ref).
+    out : the five record arrays (t, delta, P, a, a_inner); ``stats`` the solver counters.
     """
+    A, r, wP, scene, numerics = pb.A, pb.mesh.r, pb.wP, pb.scene, pb.numerics
+    h0, c, hm, stop_mode = pb.h0, pb.c, pb.hm, pb.stop_mode
     t_out, d_out, P_out, a_out, ai_out = out
     N = h_init.size
-    hm = 3.0 ** (1.0 / 6.0) * h0
     psi = (lambda T: np.asarray(T, dtype=float)) if scene.k == 1.0 else material.integrated_compliance
     sigma0 = np.empty(N)
     lj_traction(h_init, h0, c, sigma0)
@@ -45,7 +54,7 @@ def unload_exact(A, r, wP, h_init, delta0, scene, numerics, h0, c, material, sto
     while True:
         if n > numerics.max_steps:
             return STATUS_STEP_LIMIT, n
-        dt = dd / (scene.rate * h0)
+        dt = dd / pb.scales.loading_speed
         t_new = t + dt
         ceff = float(psi(dt)) / dt
         hist = sigma0.copy()

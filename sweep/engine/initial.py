@@ -13,7 +13,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..kernels.interface import crossing_radius
+from ..kernels.interface import TIP_GAP, crossing_radius
 from ..kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton
 
 from .problem import jkr_radius
@@ -61,7 +61,7 @@ class ElasticSolver:
             invalidate(self.cache)   # refactorize next time
         return ok, h
 
-    def radius(self, h, level_factor=3.0 ** (1.0 / 6.0)):
+    def radius(self, h, level_factor=TIP_GAP):
         return crossing_radius(h, self.r, level_factor * self.h0)
 
 

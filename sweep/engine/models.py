@@ -25,16 +25,24 @@ the store and the analysis do not care which ran.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
 from .. import units
 from ..errors import check_choice, check_positive
+from ..scene import Numerics, Result, Scene
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
+from . import bem
+from .crack_front import simulate_crack
+from .mesh import scene_mesh
+from .problem import derive
+from .quasistatic import simulate_elastic
+from .tip_following import simulate_tip_following
 
-__all__ = ["MODELS", "pb_estimate", "simulate_pb", "simulate_model", "simulate_scene",
-           "choose_model", "bem_nodes_needed", "bem_node_budget", "wants_quasistatic",
-           "wants_tip_following"]
+__all__ = ["MODELS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
+           "simulate_scene", "choose_model", "bem_nodes_needed", "bem_node_budget",
+           "wants_quasistatic", "wants_tip_following"]
 
 
 def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171) -> dict:
@@ -81,8 +89,6 @@ def simulate_pb(scene, numerics=None):
     Only ``pull_off``, ``crack_speed``, ``vhat``, ``rhat_pb`` are set (no trajectory, no
     state at pull-off; the initial state does not enter the estimate).
     """
-    from ..scene import Numerics, Result
-
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t0 = time.perf_counter()
     res = Result(scene=scene, numerics=numerics)
@@ -98,14 +104,10 @@ def simulate_pb(scene, numerics=None):
 
 
 def _bem(scene, numerics=None):
-    from ..scene import Numerics
-    from .bem import simulate
-    from .tip_following import simulate_tip_following
-
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     if wants_tip_following(scene, numerics):
         return simulate_tip_following(scene, numerics)
-    return simulate(scene, numerics)
+    return bem.simulate(scene, numerics)
 
 
 def wants_tip_following(scene, numerics) -> bool:
@@ -116,18 +118,6 @@ def wants_tip_following(scene, numerics) -> bool:
             and bem_nodes_needed(scene, numerics) > numerics.max_nodes)
 
 
-def _elastic(scene, numerics=None):
-    from .quasistatic import simulate_elastic
-
-    return simulate_elastic(scene, numerics)
-
-
-def _crack(scene, numerics=None):
-    from .crack_front import simulate_crack
-
-    return simulate_crack(scene, numerics)
-
-
 def bem_nodes_needed(scene, numerics=None) -> int:
     """Nodes the BEM needs for ``scene``.
 
@@ -136,19 +126,12 @@ def bem_nodes_needed(scene, numerics=None) -> int:
     the mesh the solver would build (:func:`sweep.engine.mesh.scene_mesh`, sized from the band
     resolution).
     """
-    import dataclasses
-
-    from .mesh import scene_mesh
-    from .problem import initial_estimates, tip_zone
-    from ..scene import Numerics
-
     numerics = Numerics.preset("balanced") if numerics is None else numerics
-    _, a_est, domain = initial_estimates(scene, numerics)
-    l0 = tip_zone(scene.mu)
+    s = derive(scene, numerics)
     if numerics.mesh == "uniform":
-        return int(math.ceil(domain * numerics.zone_nodes / l0)) + 1
-    mesh = scene_mesh(dataclasses.replace(numerics, nodes=None), l0, a_est, domain,
-                      pull_off_only=scene.stop == "pulloff")
+        return int(math.ceil(s.domain * numerics.zone_nodes / s.tip_zone)) + 1
+    mesh = scene_mesh(dataclasses.replace(numerics, nodes=None), s.tip_zone, s.a0_estimate,
+                      s.domain, pull_off_only=scene.stop == "pulloff")
     return mesh.nodes
 
 
@@ -159,14 +142,12 @@ def bem_node_budget(numerics) -> int:
 
 def choose_model(scene, numerics=None) -> str:
     """The model "auto" picks: "bem" if its mesh fits the node budget, else "crack"."""
-    from ..scene import Numerics
-
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     return "bem" if bem_nodes_needed(scene, numerics) <= bem_node_budget(numerics) else "crack"
 
 
 #: model name -> simulate(scene, numerics=None) -> Result
-MODELS = {"bem": _bem, "crack": _crack, "pb": simulate_pb, "elastic": _elastic}
+MODELS = {"bem": _bem, "crack": simulate_crack, "pb": simulate_pb, "elastic": simulate_elastic}
 
 
 def wants_quasistatic(scene, numerics) -> bool:
@@ -181,8 +162,6 @@ def wants_quasistatic(scene, numerics) -> bool:
 def simulate_model(scene, model: str = "bem", numerics=None):
     """Run ``scene`` with the named model (one of :data:`MODELS` or "auto"); the result's
     ``model_used`` says which ran."""
-    from ..scene import Numerics
-
     check_choice("model", model, (*MODELS, "auto"))
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     if model in ("bem", "auto") and wants_quasistatic(scene, numerics):
@@ -194,6 +173,35 @@ def simulate_model(scene, model: str = "bem", numerics=None):
     return res
 
 
-def simulate_scene(scene, numerics=None):
-    """Run ``scene`` with the model it asks for (``scene.model``); what sweeps call."""
+def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
+    """Simulate one scene with the model it asks for: the one entry for one scene.
+
+    ``sweep.simulate``, ``sweep scene`` and every scene of ``sweep run`` go through here, so
+    the three can never disagree. ``scene.model`` picks the model (:data:`MODELS`, or
+    "auto"); a "bem" scene runs on the graded mesh, on the tip-following mesh where the
+    graded mesh's crack band would exceed ``numerics.max_nodes``, or on the quasi-static
+    elastic branch when it is elastic and quasi-static (:func:`simulate_model`).
+
+    Parameters
+    ----------
+    scene : Scene
+        Physics: material (n, k), Tabor parameter, initial state, unloading rate, model
+        (docs/design.md section 2 units).
+    numerics : Numerics, optional
+        Discretization and tolerances; default ``Numerics.preset("balanced")``.
+
+    Returns
+    -------
+    Result
+        ``model_used`` says which model ran; a numerical failure is ``status="failed"``
+        with a reason, never an exception.
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError("scene must be a sweep.Scene")
+    if numerics is not None and not isinstance(numerics, Numerics):
+        raise TypeError("numerics must be a sweep.Numerics")
     return simulate_model(scene, scene.model, numerics)
+
+
+#: the name sweeps used before :func:`simulate` was the package's front door
+simulate_scene = simulate

@@ -1,9 +1,15 @@
-"""Curve fits on a computed unloading: the refined load minimum and the crack speed there."""
+"""A computed unloading turned into a result: the refined load minimum, the state and the
+crack speed there (:func:`finish`, shared by every BEM mesh)."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
+
+from ..kernels.solve import STATUS_DOMAIN, STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT, stop_reached
+
+#: status of a run stopped by ``Numerics.time_budget_s`` (beside the kernel's STATUS_*)
+STATUS_TIME_BUDGET = -1
 
 
 #: a parabola refinement lowering the sampled minimum by more than this fraction must
@@ -61,3 +67,56 @@ def crack_speed_at(t, a, t_star, spacing, window_nodes=3.0, min_points=5):
     scale = max(np.max(np.abs(tt)), 1e-300)
     coef = np.polyfit(tt / scale, a[sel], 2)
     return -coef[1] / scale
+
+
+def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float, scales,
+           advice: str) -> None:
+    """Fill ``res`` from a finished unloading, in place: ``ok`` with the pull-off, the state
+    and crack speed at the pull-off instant, or a failure with its reason.
+
+    Parameters
+    ----------
+    res : sweep.Result
+    status : the kernel's status (or STATUS_TIME_BUDGET).
+    trajectory : arrays ``t, delta, P, a, a_inner`` of the run (tau0, d_ref, pi dg R, a_ref).
+    spacing : the fine node spacing (a_ref), the scale of the crack-speed fit.
+    min_travel : crack-tip recession after the load minimum that counts as past the
+        pull-off (a_ref, :func:`sweep.kernels.solve.stop_reached`).
+    scales : the scene's :class:`sweep.engine.problem.Scales` (process zone for ``vhat``,
+        loading speed for ``rhat_pb``).
+    advice : what to change when no equilibrium was found before the pull-off (it depends
+        on the mesh that ran).
+    """
+    t, delta, P, a, a_inner = (trajectory[k] for k in ("t", "delta", "P", "a", "a_inner"))
+    i, t_star, P_star = refine_minimum(t, P)
+    passed = stop_reached(P, a, len(P), i, 0, min_travel)
+    if status == STATUS_TIME_BUDGET:
+        res.reason = (f"time budget: {res.numerics.time_budget_s:g} s spent after {len(t) - 1} "
+                      f"steps (a = {a[-1]:.4g}, pull-off not reached); give it more "
+                      f"(numerics time_budget_s) or cheaper numerics (preset fast, fewer nodes)")
+        return
+    if status == STATUS_DOMAIN:
+        res.reason = "contact reached the mesh edge: increase numerics.domain"
+        return
+    if status == STATUS_STEP_LIMIT and not passed:
+        res.reason = f"step limit ({res.numerics.max_steps}) reached before pull-off"
+        return
+    if status == STATUS_NEWTON_FAILED and not passed:
+        res.reason = (f"no equilibrium found at the minimum step before pull-off (delta="
+                      f"{delta[-1]:.6g}, a={a[-1]:.4g}): the discrete path folds where the "
+                      f"crack tip is under-resolved; {advice}")
+        return
+    if P_star >= 0:
+        res.reason = "no tensile load reached"
+        return
+    res.status = "ok"
+    if status == STATUS_NEWTON_FAILED:
+        res.reason = "stopped at the jump-off instability after pull-off"
+    res.pull_off = -P_star
+    res.t_pulloff = t_star
+    res.delta_pulloff = float(np.interp(t_star, t, delta))
+    res.a_pulloff = float(np.interp(t_star, t, a))
+    res.a_inner_pulloff = float(np.interp(t_star, t, a_inner))
+    res.crack_speed = float(crack_speed_at(t, a, t_star, spacing))
+    res.vhat = res.crack_speed / scales.process_zone
+    res.rhat_pb = scales.loading_speed

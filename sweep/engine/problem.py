@@ -16,12 +16,14 @@ from pathlib import Path
 
 import numpy as np
 
-from . import diskcache
-from .. import units
+from .. import materials, units
+from ..kernels.interface import TIP_GAP
+from ..materials import SLS, MPLRetardation
 from ..materials.prony_series import PronySeries
-from .mesh import Mesh, scene_mesh
 from ..scene import Numerics, Scene
 from ..theory import jkr_contact_radius
+from . import diskcache
+from .mesh import Mesh, scene_mesh
 
 #: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
 WINDOW_SAFETY = 10.0
@@ -34,8 +36,6 @@ WINDOW_GRID = 0.5
 WINDOW_T_MAX = 1e4
 #: the crack tip stays this many process zones inside the fine band of a graded mesh
 TIP_MARGIN_ZONES = 2.0
-#: max-tension gap over h0: the crack tip (contact radius a) is where the gap is 3^(1/6) h0
-TIP_GAP = 3.0 ** (1.0 / 6.0)
 
 
 #: Tabor parameters of the hereditary BEM: the whole range of Scene. Validated: above about 8
@@ -52,7 +52,9 @@ class Refused(Exception):
 
 def tip_zone(mu: float) -> float:
     """Length (a_ref) over which the interface traction varies at the crack tip: the unit
-    of the fine spacing (l0/band_resolution) and of the band margins of a graded mesh.
+    of the fine spacing (tip_zone/band_resolution) and of the band margins of a graded mesh.
+    Not to be confused with the process zone l0 (:func:`sweep.units.l0_hat`), the unit of
+    ``vhat``: the two are equal for mu >= 1.83.
 
     The process zone l0 = 1.693/mu^2 on the JKR side. On the DMT side l0 outgrows the
     contact itself (l0 = 17000 at mu = 0.01) and the sphere hardly deforms: the gap near
@@ -76,7 +78,6 @@ def jkr_radius(delta: float) -> float:
 
 def material(kind: str, n: float, k: float):
     """The material object (units E0 = 1, tau0 = 1): "mpl" or "sls"."""
-    from ..materials import SLS, MPLRetardation
     if kind == "sls":
         return SLS(1.0, 1.0 / k, 1.0)
     return MPLRetardation(1.0, 1.0 / k, n, 1.0)
@@ -87,24 +88,25 @@ def material_of(scene: Scene):
     return material(scene.material, scene.n, scene.k)
 
 
-def auto_domain(scene: Scene, numerics: Numerics, delta0_estimate: float) -> float:
-    """Mesh radius: the rigid gap r^2/2 - delta0 reaches ``tail_gap`` h0 at the edge."""
-    h0 = units.h0_hat(scene.mu)
-    r_tail = math.sqrt(2.0 * (max(delta0_estimate, 0.0) + numerics.tail_gap * h0))
-    a_est = jkr_radius(delta0_estimate) if scene.a0 is None else scene.a0
-    return max(r_tail, 1.3 * a_est + 0.5)
+def auto_domain(h0: float, tail_gap: float, delta0_estimate: float, a0_estimate: float) -> float:
+    """Mesh radius (a_ref): the rigid gap r^2/2 - delta0 reaches ``tail_gap`` h0 at the edge,
+    and at least 1.3 a0 + 0.5 (``a0_estimate``: the given a0, or JKR at ``delta0_estimate``;
+    the JKR radius is 0 where JKR has no contact)."""
+    r_tail = math.sqrt(2.0 * (max(delta0_estimate, 0.0) + tail_gap * h0))
+    return max(r_tail, 1.3 * a0_estimate + 0.5)
 
 
-def time_window(scene: Scene, numerics: Numerics, delta0: float) -> tuple[float, float]:
-    """Prony window [t_min, t_max] in tau0 for this scene's unloading.
+def time_window(rate: float, scales: Scales, min_step: float) -> tuple[float, float]:
+    """Prony window [t_min, t_max] in tau0 for a scene's unloading at ``rate`` (r-hat) from
+    ``scales.delta0_estimate``, with indentation steps down to ``min_step`` h0.
 
     The window is widened outward to the grid of WINDOW_GRID decades, so that the scenes
     of a sweep share a few windows (and their cached Prony series, :func:`prony_series`).
     """
-    h0 = units.h0_hat(scene.mu)
-    t_min = numerics.min_step / scene.rate        # the smallest step the run may take
+    delta0 = scales.delta0_estimate
+    t_min = min_step / rate        # the smallest step the run may take
     travel = max(delta0, 0.0) + 3.0 + 2.0 * math.sqrt(max(delta0, 1.0))
-    t_max = max(min(WINDOW_SAFETY * travel / (scene.rate * h0), WINDOW_T_MAX), 10 * t_min)
+    t_max = max(min(WINDOW_SAFETY * travel / scales.loading_speed, WINDOW_T_MAX), 10 * t_min)
     lo = math.floor(math.log10(t_min) / WINDOW_GRID) * WINDOW_GRID
     hi = math.ceil(math.log10(t_max) / WINDOW_GRID) * WINDOW_GRID
     return 10.0 ** lo, 10.0 ** hi
@@ -151,23 +153,20 @@ _PRONY_FIELDS = {"kind", "key", "weights", "times", "max_rel_error", "rtol", "co
 def _materials_tag() -> str:
     """Hash of the material and fitting code (sweep/materials/*.py): a cached series is
     used only with the code that fitted it."""
-    from .. import materials
     folder = Path(materials.__file__).parent
     return diskcache.source_tag(*sorted(str(p) for p in folder.glob("*.py")))
 
 
 @dataclass(frozen=True)
 class Problem:
-    """Everything a solve of one scene needs, derived once (docs/design.md section 2 units).
+    """Everything a BEM solve of one scene needs, derived once (docs/design.md section 2 units).
 
     Attributes
     ----------
     scene, numerics : the inputs.
-    h0, c : LJ range (d_ref) and prefactor; ``hm = 3^(1/6) h0`` the max-tension gap.
-    l0 : the tip zone (a_ref, :func:`tip_zone`): the process zone 1.693/mu^2, or sqrt(h0)
-        on the DMT side (mu < 1.83).
-    delta0_estimate, a0_estimate : the initial state before it is solved (delta0 given, or
-        JKR from a0), which sizes the domain, the crack band and the time window.
+    scales : the scene's :class:`Scales` (h0, the tip gap, the process and tip zones, the
+        loading speed, the initial estimates); ``h0``, ``c``, ``hm`` (the tip gap) and
+        ``tip_zone`` read from it.
     mesh : the mesh (``mesh.r`` node radii, ``mesh.spacing`` the fine spacing).
     A, wP : influence matrix and load weights of the mesh (read-only, cached).
     prony_weights, prony_times : Prony modes of Chat (empty when elastic or exact).
@@ -176,12 +175,7 @@ class Problem:
 
     scene: Scene
     numerics: Numerics
-    h0: float
-    c: float
-    hm: float
-    l0: float
-    delta0_estimate: float
-    a0_estimate: float
+    scales: Scales
     mesh: Mesh
     A: np.ndarray
     wP: np.ndarray
@@ -190,12 +184,32 @@ class Problem:
     prony_error: float
 
     @property
+    def h0(self) -> float:
+        """LJ range (d_ref)."""
+        return self.scales.h0
+
+    @property
+    def c(self) -> float:
+        """LJ prefactor."""
+        return self.scales.c
+
+    @property
+    def hm(self) -> float:
+        """The gap at the crack tip, 3^(1/6) h0 (d_ref)."""
+        return self.scales.tip_gap
+
+    @property
+    def tip_zone(self) -> float:
+        """The mesh's resolution unit (a_ref), :attr:`Scales.tip_zone`."""
+        return self.scales.tip_zone
+
+    @property
     def tip_range(self) -> tuple[float, float]:
         """Radii the crack tip must stay within: the fine band less TIP_MARGIN_ZONES l0 at
         each end that has a coarse region beyond it."""
         lo, hi = self.mesh.band
-        lo = lo + TIP_MARGIN_ZONES * self.l0 if lo > 0 else -1.0
-        hi = hi - TIP_MARGIN_ZONES * self.l0 if hi < self.mesh.domain else math.inf
+        lo = lo + TIP_MARGIN_ZONES * self.tip_zone if lo > 0 else -1.0
+        hi = hi - TIP_MARGIN_ZONES * self.tip_zone if hi < self.mesh.domain else math.inf
         return lo, hi
 
     @property
@@ -204,16 +218,64 @@ class Problem:
         return 0 if self.scene.stop == "pulloff" else 1
 
 
-def initial_estimates(scene: Scene, numerics: Numerics) -> tuple[float, float, float]:
-    """(indentation, contact radius, mesh radius) a scene's mesh is sized from: the JKR
-    estimates of the initial state (d_ref, a_ref, a_ref) and the automatic (or given) domain."""
+@dataclass(frozen=True)
+class Scales:
+    """The numbers every model of a scene derives from (scene, numerics): derived once, by
+    :func:`derive`, and read from here by the meshes, the solvers, the resolution checks and
+    the result (docs/design.md section 2 units).
+
+    Attributes
+    ----------
+    h0 : LJ range (d_ref), ``1/(pi^(2/3) mu)``.
+    c : LJ prefactor, ``sigma = -c [(h0/h)^3 - (h0/h)^9]``.
+    tip_gap : the gap at the crack tip, ``3^(1/6) h0`` (d_ref): where the traction is most
+        tensile; the contact radius ``a`` is where the gap equals it.
+    process_zone : the Persson-Brener process zone ``l0 = 1.693/mu^2`` (a_ref), the unit of
+        ``vhat`` (:func:`sweep.units.l0_hat`).
+    tip_zone : the length over which the traction varies at the tip (a_ref,
+        :func:`tip_zone`), the unit of the meshes' fine spacing; equal to ``process_zone``
+        for mu >= 1.83, ``sqrt(h0)`` below.
+    loading_speed : ``rate h0`` (d_ref/tau0): d delta/dt = -loading_speed; also the paper's
+        ``rhat_PB`` (:func:`sweep.units.rhat_pb`).
+    delta0_estimate, a0_estimate : the initial state before it is solved (delta0 given, or
+        JKR from a0), d_ref and a_ref; they size the domain, the crack band and the time window.
+    domain : mesh radius (a_ref): ``numerics.domain`` or :func:`auto_domain`.
+    """
+
+    h0: float
+    c: float
+    tip_gap: float
+    process_zone: float
+    tip_zone: float
+    loading_speed: float
+    delta0_estimate: float
+    a0_estimate: float
+    domain: float
+
+
+@lru_cache(maxsize=1024)
+def derive(scene: Scene, numerics: Numerics) -> Scales:
+    """The :class:`Scales` of a scene under its numerics (cached per process: the model
+    dispatch, the mesh and the solver of one scene read the same object)."""
+    h0, c = lj_constants(scene.mu)
     if scene.delta0 is not None:
         d_est = scene.delta0
     else:
         d_est = scene.a0**2 - math.sqrt(2 * scene.a0)
     a_est = scene.a0 if scene.a0 is not None else max(jkr_radius(d_est), 0.0)
-    domain = numerics.domain if numerics.domain is not None else auto_domain(scene, numerics, d_est)
-    return d_est, a_est, domain
+    domain = (numerics.domain if numerics.domain is not None
+              else auto_domain(h0, numerics.tail_gap, d_est, a_est))
+    return Scales(h0=h0, c=c, tip_gap=TIP_GAP * h0, process_zone=units.l0_hat(scene.mu),
+                  tip_zone=tip_zone(scene.mu), loading_speed=scene.rate * h0,
+                  delta0_estimate=float(d_est), a0_estimate=float(a_est), domain=float(domain))
+
+
+def initial_estimates(scene: Scene, numerics: Numerics) -> tuple[float, float, float]:
+    """(indentation, contact radius, mesh radius) a scene's mesh is sized from: the JKR
+    estimates of the initial state (d_ref, a_ref, a_ref) and the automatic (or given) domain
+    (the :class:`Scales` of :func:`derive`)."""
+    s = derive(scene, numerics)
+    return s.delta0_estimate, s.a0_estimate, s.domain
 
 
 def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Problem:
@@ -227,19 +289,18 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
                       f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
                       f"elastic or auto, large contacts the crack-front model (model crack)")
-    h0, c = lj_constants(scene.mu)
-    l0 = tip_zone(scene.mu)
-    d_est, a_est, domain = initial_estimates(scene, numerics)
-    mesh = scene_mesh(numerics, l0, a_est, domain, pull_off_only=scene.stop == "pulloff",
-                      band=band)
-    zone = l0 / mesh.spacing
+    s = derive(scene, numerics)
+    zone_length, domain = s.tip_zone, s.domain
+    mesh = scene_mesh(numerics, zone_length, s.a0_estimate, domain,
+                      pull_off_only=scene.stop == "pulloff", band=band)
+    zone = zone_length / mesh.spacing
     if zone < numerics.zone_nodes:
         if mesh.kind == "uniform":
-            need = int(math.ceil(numerics.zone_nodes * domain / l0)) + 1
+            need = int(math.ceil(numerics.zone_nodes * domain / zone_length)) + 1
             advice = f"use nodes >= {need} for domain {domain:.3g}"
         else:
             advice = "use more nodes (or leave nodes unset to size the mesh from band_resolution)"
-        raise Refused(f"mesh too coarse: the tip zone l0 = {l0:.3g} a_ref spans {zone:.2g} "
+        raise Refused(f"mesh too coarse: the tip zone {zone_length:.3g} a_ref spans {zone:.2g} "
                       f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
     if mesh.nodes > numerics.max_nodes:
         raise Refused(f"mesh too large: the crack band needs {mesh.nodes} nodes at "
@@ -249,13 +310,11 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
     weights = times = np.zeros(0)
     error = 0.0
     if scene.k < 1.0 and not numerics.exact:
-        t_min, t_max = time_window(scene, numerics, d_est)
+        t_min, t_max = time_window(scene.rate, s, numerics.min_step)
         n = scene.n if scene.material == "mpl" else 0.0
         prony = prony_series(scene.material, n, scene.k, t_min, t_max, numerics.prony_rtol)
         weights = np.ascontiguousarray(prony.weights, dtype=float)
         times = np.ascontiguousarray(prony.times, dtype=float)
         error = float(prony.max_rel_error)
-    return Problem(scene=scene, numerics=numerics, h0=h0, c=c, hm=TIP_GAP * h0, l0=l0,
-                   delta0_estimate=float(d_est), a0_estimate=float(a_est), mesh=mesh,
-                   A=mesh.influence, wP=mesh.load_weights, prony_weights=weights,
+    return Problem(scene=scene, numerics=numerics, scales=s, mesh=mesh, A=mesh.influence, wP=mesh.load_weights, prony_weights=weights,
                    prony_times=times, prony_error=error)

@@ -48,15 +48,15 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..kernels.influence import assemble_nodes, load_weights_nodes
-from ..kernels.interface import lj_traction_and_stiffness
+from ..kernels.interface import TIP_GAP, lj_traction_and_stiffness
 
 from .. import units
 from ..errors import check_range
+from ..scene import Numerics, Result
+from ..theory import jkr_indentation, maugis_dugdale_pull_off, maugis_lambda
 from .initial import jkr_gap_guess
-from ..theory import jkr_indentation
+from .problem import derive
 
-#: gap at the crack tip (max LJ tension) per h0
-TIP_GAP = 3.0 ** (1.0 / 6.0)
 #: Persson-Brener process zone l0 * mu^2 in a_ref (docs/design.md section 2)
 PROCESS_ZONE = 243.0 / (256.0 * math.pi * (math.pi / 9.0) ** 2) / math.pi ** (1.0 / 3.0)
 #: contact radius at the JKR (force-controlled) pull-off, a_ref
@@ -352,8 +352,6 @@ def pull_off_table(mus=TABLE_MU, **options) -> list[dict]:
     Rows: mu, pull_off, a, delta, nodes, seconds, converged, md_pull_off (the MD value at
     the equivalent lambda, :func:`sweep.theory.maugis_dugdale_pull_off`).
     """
-    from ..theory import maugis_dugdale_pull_off, maugis_lambda
-
     rows = []
     for mu in mus:
         r = elastic_pull_off(mu, **options)
@@ -384,8 +382,6 @@ def simulate_elastic(scene, numerics=None):
     ``steps`` = equilibrium solves, ``factorizations`` = Newton iterations (one dense solve
     each). A numerical failure gives ``status="failed"`` with the reason, never raises.
     """
-    from ..scene import Numerics, Result
-
     if numerics is None:
         numerics = Numerics.preset("balanced")
     t0 = time.perf_counter()
@@ -403,19 +399,19 @@ def simulate_elastic(scene, numerics=None):
     if not po.converged:
         res.reason = po.reason
         return res
-    h0 = units.h0_hat(scene.mu)
+    scales = derive(scene, res.numerics)
     radii, loads, deltas = po.branch
     stop = int(np.argmin(deltas)) + 1          # the displacement-controlled fold
     keep = radii[:stop] >= po.a
     d0 = float(deltas[0])
-    speed = scene.rate * h0
+    speed = scales.loading_speed
     res.status = "ok"
     res.reason = po.reason
     res.pull_off, res.a_pulloff, res.delta_pulloff = po.pull_off, po.a, po.delta
     res.t_pulloff = (d0 - po.delta) / speed
     res.crack_speed = speed / po.ddelta_da
-    res.vhat = res.crack_speed / units.l0_hat(scene.mu)
-    res.rhat_pb = units.rhat_pb(scene.rate, scene.mu)
+    res.vhat = res.crack_speed / scales.process_zone
+    res.rhat_pb = scales.loading_speed
     res.a0_result, res.delta0_result = float(radii[0]), d0
     res.spacing, res.domain_used = po.spacing, po.domain
     res.prony_terms, res.prony_error = 0, 0.0

@@ -42,16 +42,19 @@ from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER
                            STATUS_LEFT_BAND, STATUS_STEP_LIMIT, new_jacobian_cache, newton)
 from ..kernels.interface import lj_traction
 
-from .initial import ElasticSolver, relaxed_state
-from .. import units
-from .problem import (Refused, initial_estimates, jkr_radius, material_of, prepare,
-                      tip_zone)
 from ..scene import Numerics, Result, Scene
+from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, unload_chunk
+from .initial import ElasticSolver, relaxed_state
+from .postprocess import STATUS_TIME_BUDGET, finish
+from .problem import Refused, derive, jkr_radius, material_of, prepare
+from .quasistatic import ElasticBranch
+from .resolution import estimate_error
 
-#: room for the tip in its direction of motion, in process zones l0 (the tip moves this far,
+#: room for the tip in its direction of motion, in tip zones (Scales.tip_zone: the process
+#: zone l0 at mu >= 1.83; the tip moves this far,
 #: less TIP_MARGIN_ZONES, between two meshes)
 WINDOW_AHEAD_ZONES = 16.0
-#: fine region behind the tip (the cohesive zone, a few l0, and the recent wake), l0
+#: fine region behind the tip (the cohesive zone, a few l0, and the recent wake), tip zones
 WINDOW_BEHIND_ZONES = 8.0
 #: Newton tolerance (units of h0) of a first relaxed solve where the numerics' one stalls
 LOOSE_TOL = 1e-4
@@ -75,6 +78,9 @@ REMESH_JUMP_STEPS = 5.0
 REMESH_JUMP_RTOL = 1e-3
 #: Newton iterations of the re-equilibration after a state transfer (:func:`transfer`)
 REEQUILIBRATE_ITER = 30
+#: what to change when the tip-following mesh finds no equilibrium before the pull-off
+ADVICE_TIP_FOLLOWING = ("raise band_resolution (the fine spacing is the tip zone / "
+                        "band_resolution) or use the crack-front model (model crack)")
 
 
 def remesh_jump(P: np.ndarray, m: int, rtol: float = REMESH_JUMP_RTOL) -> float | None:
@@ -108,10 +114,11 @@ def _continuity(run, remeshed_at: list, rtol: float) -> str:
     return ""
 
 
-def indentation_travel(scene: Scene, delta0: float) -> float:
+def indentation_travel(scene: Scene, delta0: float, loading_speed: float) -> float:
     """Least indentation travel (d_ref) of an unloading from ``delta0`` to the pull-off:
     D = Cbar(D / (rate h0)) max(delta0, 0), with Cbar(t) = (1/t) int_0^t Chat the mean
-    compliance of a ramp of duration t (tau0).
+    compliance of a ramp of duration t (tau0); ``loading_speed`` = rate h0 (d_ref/tau0,
+    :attr:`sweep.engine.problem.Scales.loading_speed`).
 
     Relaxed (slow) the indentation falls from delta0 to the relaxed pull-off, below 0 (JKR:
     -0.51 at mu = 10); faster, the substrate answers a load change with less compliance, at
@@ -122,11 +129,10 @@ def indentation_travel(scene: Scene, delta0: float) -> float:
     full = max(delta0, 0.0)
     if full == 0.0 or scene.k >= 1.0:
         return full
-    h0 = units.h0_hat(scene.mu)
     mat = material_of(scene)
 
     def excess(D):
-        t = D / (scene.rate * h0)
+        t = D / loading_speed
         return D - float(mat.integrated_compliance(t)) / t * full
 
     return full if excess(full) <= 0.0 else float(brentq(excess, 1e-12 * full, full))
@@ -159,25 +165,26 @@ def estimate_steps(scene: Scene, numerics: Numerics, delta: float, a: float,
     :func:`indentation_travel`, and the crack tip at least to the relaxed JKR radius there
     (a frozen contact keeps its radius, a relaxed one follows JKR), at most ``da_max``
     fine spacings per step."""
-    D = indentation_travel(scene, delta_start)
+    scales = derive(scene, numerics)
+    D = indentation_travel(scene, delta_start, scales.loading_speed)
     a_end = min(jkr_radius(delta_start - D), a_start)
     tip = max(a - a_end, 0.0)
-    da = numerics.da_max * tip_zone(scene.mu) / numerics.band_resolution
+    da = numerics.da_max * scales.tip_zone / numerics.band_resolution
     rest = max(delta - (delta_start - D), 0.0)
     tip_steps, travel_steps = int(math.ceil(tip / da)), int(math.ceil(rest / step))
     return StepEstimate(steps=max(tip_steps, travel_steps), tip_travel=tip, tip_step=da,
                         tip_steps=tip_steps, travel=rest, step=step, travel_steps=travel_steps)
 
 
-def tip_window(tip: float, l0: float, ahead: float = WINDOW_AHEAD_ZONES,
+def tip_window(tip: float, zone: float, ahead: float = WINDOW_AHEAD_ZONES,
                behind: float = WINDOW_BEHIND_ZONES, direction: int = -1) -> tuple[float, float]:
     """The fine window (a_ref radii) for a crack tip at ``tip`` moving inward
-    (``direction`` -1, the contact shrinks) or outward (+1): ``ahead`` process zones l0 of
+    (``direction`` -1, the contact shrinks) or outward (+1): ``ahead`` tip zones ``zone`` of
     room in the direction of motion, ``behind`` zones on the other side."""
     if direction < 0:
-        lo, hi = tip - ahead * l0, tip + behind * l0
+        lo, hi = tip - ahead * zone, tip + behind * zone
     else:
-        lo, hi = tip - behind * l0, tip + ahead * l0
+        lo, hi = tip - behind * zone, tip + ahead * zone
     return max(lo, 0.0), hi
 
 
@@ -285,8 +292,6 @@ def branch_state(scene: Scene, band_resolution: float = 16.0, domain: float | No
     fold of the branch (JKR: a = 0.5): the state exists but is unstable (the indentation
     decreases as the radius grows), so no relaxed state can be held there.
     """
-    from .quasistatic import ElasticBranch
-
     a0 = scene.a0
     br = ElasticBranch(scene.mu, a0, 0.5 * a0, zone_resolution=band_resolution, zone=8.0,
                        domain=domain)
@@ -430,11 +435,11 @@ def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
     ----------
     scene : Scene
     numerics : Numerics, optional
-        Default ``Numerics.preset("balanced")``; the fine spacing is l0 / band_resolution
+        Default ``Numerics.preset("balanced")``; the fine spacing is the tip zone / band_resolution
         (or, with ``nodes`` set, the mesh of that many nodes), the rest as for
         :func:`sweep.engine.bem.simulate` (steps, tolerances, time budget, error indicator).
     ahead, behind : float
-        The window, in process zones l0 (see :func:`tip_window`).
+        The window, in tip zones (see :func:`tip_window`).
 
     Returns
     -------
@@ -442,33 +447,27 @@ def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
         As :func:`sweep.engine.bem.simulate`; ``nodes_used`` is the largest mesh of the run,
         ``reason`` of an ok result says how many meshes it took.
     """
-    from .bem import CHECK_FRACTION, _check_resolution, coarser, resolution_error
-
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t_start = time.perf_counter()
     deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
     res = _attempt(scene, numerics, ahead, behind, deadline)
-    if res.ok and numerics.pull_off_rtol > 0:
-        res.error_estimate = resolution_error(res.spacing, tip_zone(scene.mu))
-        if res.error_estimate > CHECK_FRACTION * numerics.pull_off_rtol:
-            _check_resolution(res, _attempt(scene, coarser(numerics), ahead, behind, deadline))
+    estimate_error(res, derive(scene, numerics).tip_zone,
+                   lambda coarse: _attempt(scene, coarse, ahead, behind, deadline))
     res.wall_s = time.perf_counter() - t_start
     return res
 
 
 def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
-    from .bem import (CHUNK_STEPS, STATUS_TIME_BUDGET, UnloadingState, _finish,
-                         unload_chunk)
-
     if numerics.mesh != "graded" or numerics.exact:
         numerics = dataclasses.replace(numerics, mesh="graded", exact=False)
     res = Result(scene=scene, numerics=numerics)
-    l0 = tip_zone(scene.mu)
-    d_est, a_est, domain = initial_estimates(scene, numerics)
+    scales = derive(scene, numerics)
+    zone = scales.tip_zone
+    d_est, a_est, domain = scales.delta0_estimate, scales.a0_estimate, scales.domain
     # up front: the least steps of the run, with every step as large as the kernel's step
     # control ever lets it grow
     need = estimate_steps(scene, numerics, d_est, a_est, d_est, a_est,
-                          SMOOTH_STEP_FACTOR * numerics.step * units.h0_hat(scene.mu))
+                          SMOOTH_STEP_FACTOR * numerics.step * scales.h0)
     if need.steps > numerics.max_steps:
         res.reason = (f"too many steps: {need.describe()}: > {need.steps} steps (max_steps = "
                       f"{numerics.max_steps}); raise max_steps, or lower band_resolution, or use "
@@ -480,7 +479,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         # the initial state: where the relaxed tip lies outside the first window (delta0
         # scenes, whose radius is a JKR estimate), once more with the window there
         for _ in range(2):
-            pb = prepare(scene, numerics, tip_window(a_est, l0, ahead, behind))
+            pb = prepare(scene, numerics, tip_window(a_est, zone, ahead, behind))
             el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, numerics.tol)
             h_init, delta0 = initial_state(el, scene, branch)
             a_init = el.radius(h_init)
@@ -531,7 +530,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
             direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1
             try:
                 new = prepare(scene, numerics,
-                              tip_window(a[run.n - 1], l0, ahead, behind, direction))
+                              tip_window(a[run.n - 1], zone, ahead, behind, direction))
             except Refused as exc:
                 res.reason = f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"
                 return res
@@ -558,7 +557,8 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     if status == STATUS_LEFT_BAND:
         res.reason = f"more than {MAX_MESHES} meshes (a = {a[-1]:.4g})"
         return res
-    _finish(res, scene, status, t, delta, P, a, a_inner, pb.mesh.spacing)
+    finish(res, status, res.trajectory, pb.mesh.spacing,
+           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING)
     if res.ok:
         note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
         res.reason = f"{res.reason}; {note}" if res.reason else note

@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from sweep import Numerics, Scene, simulate
+from sweep import Numerics, Scene
+from sweep.engine.bem import simulate  # the BEM on the graded mesh (not the model dispatch)
 from sweep.bench.benchmarks import (ROOT, BenchPlan, _bracket, bench_all, campaign_sample,
                               plain_time_at)
 from sweep.campaign.config import load_config

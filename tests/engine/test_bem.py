@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from tests import naive, reference
-from sweep import Numerics, Scene, simulate
+from sweep import Numerics, Scene
+from sweep.engine.bem import simulate  # the BEM on the graded mesh (not the model dispatch)
 from sweep.errors import InputError
 from sweep.theory import jkr_load
 

@@ -9,7 +9,8 @@ import math
 import pytest
 
 from sweep import units
-from sweep import Numerics, Scene, simulate
+from sweep import Numerics, Scene
+from sweep.engine.bem import simulate  # the BEM on the graded mesh (not the model dispatch)
 from sweep.engine import quasistatic as qs
 from sweep.engine.problem import prepare, tip_zone
 

@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from sweep.kernels.solve import stop_reached
-from sweep import Numerics, Scene, simulate
+from sweep import Numerics, Scene
+from sweep.engine.bem import simulate  # the BEM on the graded mesh (not the model dispatch)
 from sweep.engine.mesh import crack_band, graded_mesh, graded_mesh_with_nodes, uniform_mesh
 
 

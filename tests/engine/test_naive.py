@@ -16,7 +16,8 @@ from scipy import integrate
 from tests import naive as nv
 
 from tests import reference
-from sweep import Numerics, Scene, simulate
+from sweep import Numerics, Scene
+from sweep.engine.bem import simulate  # the BEM on the graded mesh (not the model dispatch)
 from sweep.errors import InputError
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,8 @@ DMT limit 2 at low mu (docs/design.md section 2, the issue's targets); monotone 
 import numpy as np
 import pytest
 
-from sweep import Numerics, Scene, simulate
+from sweep import Numerics, Scene
+from sweep.engine.bem import simulate  # the BEM on the graded mesh (not the model dispatch)
 from sweep.engine import quasistatic as qs
 from sweep.errors import InputError
 from tests import reference

@@ -8,7 +8,7 @@ from sweep.kernels import jacobian as jac
 from sweep.kernels import solve as ks
 from sweep.kernels.interface import lj_traction_and_stiffness
 from sweep.engine.mesh import uniform_mesh
-from sweep.engine.bem import lj_constants
+from sweep.engine.problem import lj_constants
 
 
 def _problem(N=200, seed=1, contact=1.8):
