@@ -19,7 +19,8 @@ def _sections() -> set[str]:
 
 
 def _sources():
-    for pattern in ("sweep/**/*.py", "tests/*.py", "configs/*.yaml", "docs/*.md", "README.md"):
+    for pattern in ("sweep/**/*.py", "kernels/*.py", "tests/**/*.py", "configs/*.yaml",
+                    "docs/*.md", "README.md"):
         yield from ROOT.glob(pattern)
 
 

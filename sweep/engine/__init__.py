@@ -17,7 +17,10 @@ exact          the same model with the exact hereditary integral (validation)
 tip_following  the BEM on a mesh refined around the crack tip that follows it
 quasistatic    the elastic, quasi-static branch (k = 1)
 crack_front    the crack-front model: a JKR contact whose edge opens with Gamma(v)
-postprocess    curve fits on an unloading: the load minimum and the crack speed there
+postprocess    a finished unloading turned into a result: the pull-off, the state and the
+               crack speed there (:func:`.postprocess.finish`)
+resolution     the error indicator: the resolution error model and the check on a mesh of
+               half the resolution
 models         the model registry and :func:`simulate`, the one entry for one scene
 =============  =================================================================================
 """
