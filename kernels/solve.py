@@ -20,12 +20,20 @@ without evaluating it (PREDICTED_RESIDUAL).
 On a coarse mesh the discrete equilibrium path can fold (the crack tip snaps from node to
 node); the loop then looks for the snapped state (:func:`snap`, :func:`relax`).
 
+:func:`unload` takes its inputs in groups (named tuples: MeshArrays, Physics, StepControl,
+RunState, Records) and runs each time step as named parts: :func:`predict_step`,
+:func:`solve_step`, :func:`control_step`, :func:`accept_step`, :func:`stop_status` and
+:func:`next_step`. The loop's scalars live in one float64 array named by RUN_*, its arrays
+in a :data:`Work` tuple.
+
 Status codes returned by :func:`unload`:
 0 finished (stop criterion met), 1 no equilibrium at the minimum step, 2 step limit,
 3 contact reached the mesh edge (domain too small), 4 the crack tip left the fine band of a
 graded mesh (the driver widens it and starts again).
 """
 from __future__ import annotations
+
+from collections import namedtuple
 
 import numpy as np
 from numba import njit
@@ -42,6 +50,8 @@ STATUS_NEWTON_FAILED = 1
 STATUS_STEP_LIMIT = 2
 STATUS_DOMAIN = 3
 STATUS_LEFT_BAND = 4
+#: (internal) :func:`stop_status` when the run goes on
+STATUS_RUNNING = -1
 
 # stats vector layout (counters, incremented)
 STAT_ITER = 0                 # Newton iterations
@@ -59,6 +69,75 @@ STAT_REFACTOR_RETRY = 11      # refactorizations: exact Newton on the retry of a
 STAT_PREDICTED = 12           # solves ended on the predicted residual (no residual after)
 N_STATS = 13
 
+# ------------------------------------------------------------------ the kernel's inputs
+
+#: the mesh: A (N, N) influence matrix (scaled by the spacing), r (N,) node positions
+#: (a_ref units, r[0] = 0), wP (N,) load weights (P = 2 pi wP . sigma)
+MeshArrays = namedtuple("MeshArrays", ["A", "r", "wP"])
+
+#: the scene's laws and loading (dimensionless, docs/design.md section 2): h0 and c of the
+#: Lennard-Jones law, the Prony modes (weights, times) of Chat (times may be inf: a lumped
+#: glassy constant), rate = r-hat (d delta/dt = -rate h0)
+Physics = namedtuple("Physics", ["h0", "c", "weights", "times", "rate"])
+
+#: the step control settings:
+#: step_max, step_min: indentation steps (units of h0);
+#: da_max: largest contact-radius change per step (a_ref);
+#: step_tol: relative load error of the step predictor, |P(predicted) - P| / max(|P|, 1),
+#:     below which the step may grow beyond step_max (up to SMOOTH_STEP_FACTOR times) where
+#:     the load evolves smoothly; 0 keeps every step <= step_max;
+#: tol: Newton tolerance on max |F| (units of h0); max_iter: Newton iterations per solve;
+#: max_steps: the run ends with STATUS_STEP_LIMIT when the records reach max_steps + 1;
+#: stop_mode: 0 stop after pull-off and load recovery, 1 follow to separation;
+#: min_travel: crack-tip recession after the minimum required to stop (a_ref, see
+#:     :func:`stop_reached`);
+#: tip_lo, tip_hi: radii the crack tip must stay within (the well-resolved band of a graded
+#:     mesh); leaving them ends the run with STATUS_LEFT_BAND
+StepControl = namedtuple("StepControl", ["step_max", "step_min", "da_max", "step_tol", "tol",
+                                         "max_iter", "max_steps", "stop_mode", "min_travel",
+                                         "tip_lo", "tip_hi"])
+
+#: the run handed in (and, for q and step, back): h (N,) the gap at delta0 (the relaxed
+#: elastic LJ solution at the start, the last accepted state when resuming); delta0 its
+#: indentation (d_ref, used only when n == 0: a resumed run takes the time and indentation
+#: of its last record); q (M, N) the modal history state, in/out (zeros for the relaxed
+#: start; on return the modes of the last accepted step); n the records already written
+#: (0: a new run, record 0 is the initial state; n >= 1: continue after record n - 1, the
+#: stop rule sees all records); step (1,) the indentation step (units of h0), in/out (<= 0
+#: starts at step_max; on return the step the run would take next)
+RunState = namedtuple("RunState", ["h", "delta0", "q", "n", "step"])
+
+#: the outputs: records t, delta, P, a, a_inner (length >= max_steps + 1: time, indentation,
+#: load, contact radius at h_m and at h0) and h (N,), the gap of the last accepted step
+Records = namedtuple("Records", ["t", "delta", "P", "a", "a_inner", "h"])
+
+#: the unloading loop's arrays (:func:`new_work`): the last four accepted gaps (h newest),
+#: Newton's start hp and the quadratic extrapolation h_pred, the tractions of the last
+#: state, of hp and of h_pred, the step's Prony coefficients e and b (M,), H and g of the
+#: equation, r^2/2 at the nodes, and the modes q (M, N) (those of RunState)
+Work = namedtuple("Work", ["h", "h_prev", "h_prev2", "h_prev3", "hp", "h_pred", "sigma",
+                           "sig_new", "sigma_pred", "e", "b", "H", "g", "r2half", "q"])
+
+# the loop's scalars: one float64 array (N_RUN), positions named RUN_*
+RUN_T = 0          # time of the last accepted state
+RUN_DELTA = 1      # its indentation (d_ref)
+RUN_A = 2          # its contact radius at h_m (a_ref)
+RUN_DD = 3         # the indentation step being tried (d_ref)
+RUN_DT = 4         # its time step
+RUN_CEFF = 5       # its C_eff
+RUN_DT_PREV = 6    # the time steps of the last three accepted states (0 until they exist)
+RUN_DT_PREV2 = 7
+RUN_DT_PREV3 = 8
+N_RUN = 9
+
+# outcomes of :func:`solve_step`
+SOLVED = 0         # Newton converged: hp is the new state
+HALVED = 1         # Newton failed: the step was halved, try again
+SNAPPED = 2        # at a fold of the path: hp is the snapped state (no step-error estimate)
+FAILED = 3         # no equilibrium at the smallest step
+
+# ------------------------------------------------------------------ thresholds
+
 #: an iteration with a stale factorization that reduces |F|_2 by less than this factor
 #: refactorizes before the next one (fresh, the chord iteration contracts by 1e-4 to 1e-3 on
 #: the reference scenes; 0.5 let it crawl at 0.46 for ten iterations; 0.1 and 0.03 cost
@@ -74,15 +153,67 @@ PREDICTED_RESIDUAL = 0.1
 #: within a few steps a residual is computed again and the contraction measured anew
 CONTRACTION_GROWTH = 2.0
 
+#: a Newton update may close a gap by at most this fraction of it (every gap stays positive)
+MAX_GAP_CLOSURE = 0.7
+#: the line search accepts a step length lam when |F|_2 falls by the factor 1 - ARMIJO lam
+ARMIJO = 1e-4
+#: ... else it multiplies lam by this factor ...
+BACKTRACK = 0.5
+#: ... at most this many times
+LINE_SEARCH_STEPS = 16
+
+#: pseudo-time step of the first relaxation iteration (:func:`relax`) ...
+RELAX_DTAU_START = 0.1
+#: ... an iteration whose |F|_2 grows by more than this factor (or is not finite) is
+#: rejected ...
+RELAX_DIVERGENCE = 1e3
+#: ... and repeated with the pseudo-time step multiplied by this factor ...
+RELAX_DTAU_CUT = 0.1
+#: ... down to this pseudo-time step, below which the relaxation gives up
+RELAX_DTAU_MIN = 1e-10
+#: the pseudo-time step grows by at most this factor per iteration ...
+RELAX_DTAU_GROWTH = 10.0
+#: ... up to this value (plain Newton)
+RELAX_DTAU_MAX = 1e12
+#: pseudo-time iterations allowed for one snap of the crack tip at a fold
+RELAX_MAX_ITER = 300
+
+#: the snapped state is looked for shifted inward by 1, 2, ... this many nodes
+SNAP_MAX_SHIFT = 6
+#: nodes more than this far inside the crack tip keep their gap in a shifted profile (the
+#: contact interior does not move with the tip)
+SNAP_KEEP_INSIDE = 20
+#: a failed step is halved down to this fraction of the largest step before it is taken
+#: for a fold of the discrete path (and the snapped state is looked for)
+SNAP_STEP_FRACTION = 1.0 / 8.0
+
+#: relative margin of the comparisons of a step with its bounds (steps change by factors
+#: of 2 and are clipped at the bounds: a step within this of a bound is at the bound)
+STEP_RTOL = 1e-4
+
+#: steps in a row whose contact-radius change is below EASY_DA_FRACTION * da_max before
+#: the step doubles (steps change by factors of 2 only)
+EASY_STEPS = 8
+EASY_DA_FRACTION = 0.3
+#: a step rejected for its radius change is halved until the change, assumed proportional
+#: to the step, is below this fraction of da_max
+REJECT_TARGET = 0.8
+#: where the load evolves smoothly the step grows beyond step_max, up to this factor, while
+#: the predictor's load error stays below step_tol and the crack tip moves by less than
+#: SMOOTH_DA_FRACTION da_max per step
+SMOOTH_STEP_FACTOR = 8.0
+SMOOTH_DA_FRACTION = 0.6
+#: the predictor never puts a gap below this fraction of the last accepted one
+PREDICT_FLOOR = 0.5
+
 #: the pull-off is past once the load has recovered by this fraction of |P_min| ...
 RECOVERY = 0.05
 #: ... and by at least this much (units of pi dg R; the elastic pull-off is about 1.5),
 RECOVERY_FLOOR = 0.05
-#: ... at least this many steps after the minimum ...
+#: ... at least this many steps after the minimum, and the crack tip has receded from its
+#: radius at the minimum by at least ``min_travel`` (the caller gives a few node spacings:
+#: a lattice dip of the load, the tip snapping by one node, cannot end the run)
 RECOVERY_STEPS = 5
-#: ... and the crack tip has receded from its radius at the minimum by at least
-#: ``min_travel`` (the caller gives a few node spacings: a lattice dip of the load, the
-#: tip snapping by one node, cannot end the run)
 #: following to separation ends when the contact is lost and |P| < this fraction of |P_min|
 SEPARATION_LOAD = 1e-3
 
@@ -107,12 +238,6 @@ def stop_reached(P, a, n, i_min, stop_mode, min_travel):
         return a_now == 0.0 and n - 1 - i_min >= 1
     return a_now == 0.0 and P_now > P_min and abs(P_now) < SEPARATION_LOAD * abs(P_min)
 
-#: a failed step is halved down to this fraction of the largest step before it is taken
-#: for a fold of the discrete path (and the snapped state is looked for)
-SNAP_STEP_FRACTION = 1.0 / 8.0
-
-#: pseudo-time iterations allowed for one snap of the crack tip at a fold
-RELAX_MAX_ITER = 300
 
 @njit(cache=True)
 def residual(h, g, A, ceff, H, h0, c, sig, w, F):
@@ -131,11 +256,12 @@ def residual(h, g, A, ceff, H, h0, c, sig, w, F):
 
 @njit(cache=True)
 def positive_step(h, dh):
-    """Largest step length <= 1 along ``dh`` that keeps every gap above 30 % of its value."""
+    """Largest step length <= 1 along ``dh`` that closes no gap by more than
+    MAX_GAP_CLOSURE of it."""
     lam = 1.0
     for i in range(h.size):
         if dh[i] < 0.0:
-            lim = -0.7 * h[i] / dh[i]
+            lim = -MAX_GAP_CLOSURE * h[i] / dh[i]
             if lim < lam:
                 lam = lim
     return lam
@@ -156,6 +282,30 @@ def _refactorize(h, A, ceff, h0, c, cache, stats, reason):
     stats[STAT_SUBSET] += m
     if reason >= 0:
         stats[reason] += 1
+
+
+@njit(cache=True)
+def _direction(h, F, A, ceff, h0, c, sig, d, cache, stats):
+    """Newton's direction at ``h`` (residual ``F``) with the cached factorization, made again
+    once when it no longer fits (the crack tip left the zone). Returns (dh, ok,
+    refactorized); ok is False when even the fresh factorization gives none."""
+    lj_traction_and_stiffness(h, h0, c, sig, d)
+    dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
+    if ok:
+        return dh, True, False
+    _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_ZONE)
+    dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
+    return dh, ok, True
+
+
+@njit(cache=True)
+def _end_predicted(h, dh, theta, stats):
+    """Take the full update ``dh`` without its residual (predicted below tolerance): the
+    contraction estimate ``theta[0]`` grows by CONTRACTION_GROWTH (at most 1)."""
+    for i in range(h.size):
+        h[i] += dh[i]
+    theta[0] = min(CONTRACTION_GROWTH * theta[0], 1.0)
+    stats[STAT_PREDICTED] += 1
 
 
 @njit(cache=True)
@@ -196,37 +346,30 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
         if state[STATE_EXACT] == 1 and not fresh:
             _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_RETRY)
             fresh = True
-        lj_traction_and_stiffness(h, h0, c, sig, d)
-        dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
-        if not ok:
-            _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_ZONE)
-            fresh = True
-            dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
-            if not ok:       # singular even on a fresh factorization: give up
-                return False
+        dh, ok, refactorized = _direction(h, F, A, ceff, h0, c, sig, d, cache, stats)
+        fresh = fresh or refactorized
+        if not ok:       # singular even on a fresh factorization: give up
+            return False
         lam = positive_step(h, dh)
         if (it == 0 and lam == 1.0 and state[STATE_EXACT] == 0
                 and theta[0] * norm <= PREDICTED_RESIDUAL * tol):
-            for i in range(N):
-                h[i] += dh[i]
-            theta[0] = min(CONTRACTION_GROWTH * theta[0], 1.0)
-            stats[STAT_PREDICTED] += 1
+            _end_predicted(h, dh, theta, stats)
             return True
         # backtracking on the merit |F|_2 (Newton directions descend it); the max norm
         # decides convergence
         accepted = False
         n2 = _norm2(F)
         nt2 = n2
-        for _ls in range(16):
+        for _ls in range(LINE_SEARCH_STEPS):
             for i in range(N):
                 ht[i] = h[i] + lam * dh[i]
             nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
             stats[STAT_RESIDUALS] += 1
             nt2 = _norm2(Ft)
-            if nt2 < (1.0 - 1e-4 * lam) * n2:
+            if nt2 < (1.0 - ARMIJO * lam) * n2:
                 accepted = True
                 break
-            lam *= 0.5
+            lam *= BACKTRACK
         if not accepted:
             if fresh:        # a line search failed on an exact Jacobian: give up
                 return False
@@ -240,11 +383,9 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
         norm = nt
         if norm <= tol:
             return True
-        if not fresh and nt2 > SLOW_CONTRACTION * n2:
+        fresh = not fresh and nt2 > SLOW_CONTRACTION * n2
+        if fresh:
             _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_SLOW)
-            fresh = True
-        else:
-            fresh = False
     return False
 
 
@@ -254,11 +395,11 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
 
     Integrates the relaxation dh/dtau = -F(h) with linearly implicit Euler steps,
     (I/dtau + J) dh = -F, and the switched-evolution-relaxation rule
-    dtau <- dtau |F_old| / |F_new|: small dtau follows the flow, large dtau is Newton.
-    J = A K (compliance times the energy Hessian), so the flow is attracted to stable
-    equilibria. Used where the discrete equilibrium path folds (the crack tip snapping
-    from one node to the next), as the physical system would. One dense factorization per
-    iteration: a fallback, not the main path.
+    dtau <- dtau |F_old| / |F_new| (RELAX_DTAU_*): small dtau follows the flow, large dtau
+    is Newton. J = A K (compliance times the energy Hessian), so the flow is attracted to
+    stable equilibria. Used where the discrete equilibrium path folds (the crack tip
+    snapping from one node to the next), as the physical system would. One dense
+    factorization per iteration: a fallback, not the main path.
     """
     N = h.size
     sig = np.empty(N)
@@ -269,7 +410,7 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
     ht = np.empty(N)
     norm = residual(h, g, A, ceff, H, h0, c, sig, w, F)
     n2 = _norm2(F)
-    dtau = 0.1
+    dtau = RELAX_DTAU_START
     J = np.empty((N, N))
     for it in range(max_iter):
         if norm <= tol:
@@ -287,32 +428,35 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
             ht[i] = h[i] + lam * dh[i]
         nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
         nt2 = _norm2(Ft)
-        if not np.isfinite(nt2) or nt2 > 1e3 * n2:
-            dtau *= 0.1
-            if dtau < 1e-10:
+        if not np.isfinite(nt2) or nt2 > RELAX_DIVERGENCE * n2:
+            dtau *= RELAX_DTAU_CUT
+            if dtau < RELAX_DTAU_MIN:
                 return False
             continue
         for i in range(N):
             h[i] = ht[i]
             F[i] = Ft[i]
-        dtau = min(dtau * min(n2 / nt2, 10.0), 1e12)
+        dtau = min(dtau * min(n2 / nt2, RELAX_DTAU_GROWTH), RELAX_DTAU_MAX)
         norm, n2 = nt, nt2
     return norm <= tol
 
 
 @njit(cache=True)
-def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, cache, stats):
-    """Newton from the gap profile outside the crack tip shifted inward by 1 to 6 nodes.
+def snap(mesh, physics, work, ceff, tol, max_iter, hm, cache, stats):
+    """Newton from the gap profile ``work.h`` outside the crack tip shifted inward by 1 to
+    SNAP_MAX_SHIFT nodes (the nodes more than SNAP_KEEP_INSIDE inside it kept).
 
     Near a fold of the discrete path the stable state the tip snaps to is, locally, the
     same profile one node further in; starting Newton there finds it in a few iterations.
-    Accepts only a solution whose contact radius moved inward. Solution in ``hp``.
+    Accepts only a solution whose contact radius (at the gap ``hm``) moved inward.
+    Solution in ``work.hp``.
     """
+    h, hp, r = work.h, work.hp, mesh.r
     N = h.size
     a_old = crossing_radius(h, r, hm)
     i_tip = max(int(np.searchsorted(r, a_old)) - 1, 0)
-    for shift in range(1, 7):
-        i0 = max(i_tip - 20, 1)
+    for shift in range(1, SNAP_MAX_SHIFT + 1):
+        i0 = max(i_tip - SNAP_KEEP_INSIDE, 1)
         for i in range(N):
             if i < i0:
                 hp[i] = h[i]
@@ -320,7 +464,8 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, cache, stats):
                 hp[i] = h[i + shift]
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
-        if newton(hp, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
+        if newton(hp, work.g, mesh.A, ceff, work.H, physics.h0, physics.c, tol, max_iter,
+                  cache, stats):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -330,22 +475,6 @@ def snap(h, hp, g, A, ceff, H, h0, c, tol, max_iter, r, hm, cache, stats):
 def load(sigma, wP):
     """P = 2 pi sum_j w_j sigma_j (positive = compressive)."""
     return 2.0 * np.pi * np.dot(wP, sigma)
-
-
-#: steps in a row whose contact-radius change is below EASY_DA_FRACTION * da_max before
-#: the step doubles (steps change by factors of 2 only)
-EASY_STEPS = 8
-EASY_DA_FRACTION = 0.3
-#: a step rejected for its radius change is halved until the change, assumed proportional
-#: to the step, is below this fraction of da_max
-REJECT_TARGET = 0.8
-#: where the load evolves smoothly the step grows beyond step_max, up to this factor, while
-#: the predictor's load error stays below step_tol and the crack tip moves by less than
-#: SMOOTH_DA_FRACTION da_max per step
-SMOOTH_STEP_FACTOR = 8.0
-SMOOTH_DA_FRACTION = 0.6
-#: the predictor never puts a gap below this fraction of the last accepted one
-PREDICT_FLOOR = 0.5
 
 
 @njit(cache=True)
@@ -402,9 +531,9 @@ def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
     it doubles after EASY_STEPS steps in a row while a doubled step would keep the tip
     motion below SMOOTH_DA_FRACTION da_max and the predictor's load error ``err``, 8 err
     for a doubled step (third order), below ``step_tol``; it is halved back as soon as
-    either bound is exceeded.
+    either bound is exceeded. Steps within STEP_RTOL of a bound are at the bound.
     """
-    if dd > dd_max * 1.0001:
+    if dd > dd_max * (1.0 + STEP_RTOL):
         if da > SMOOTH_DA_FRACTION * da_max or err > step_tol:
             return max(0.5 * dd, dd_max), 0
         easy += 1
@@ -413,204 +542,252 @@ def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
     else:
         easy = 0
     if easy >= EASY_STEPS:
-        if dd < dd_max * 0.9999:
+        if dd < dd_max * (1.0 - STEP_RTOL):
             return min(2.0 * dd, dd_max), 0
         if (2.0 * da < SMOOTH_DA_FRACTION * da_max and 8.0 * err < step_tol
-                and dd < SMOOTH_STEP_FACTOR * dd_max * 0.9999):
+                and dd < SMOOTH_STEP_FACTOR * dd_max * (1.0 - STEP_RTOL)):
             return min(2.0 * dd, SMOOTH_STEP_FACTOR * dd_max), 0
     return dd, easy
 
 
+# ------------------------------------------------------------------ the unloading loop
+
 @njit(cache=True)
-def unload(A, r, wP, h_init, delta0, rate, h0, c, weights, times, q, n0, step_io,
-           step_max, step_min, da_max, step_tol, tol, max_iter, max_steps, stop_mode, min_travel,
-           tip_lo, tip_hi, cache, t_out, d_out, P_out, a_out, ai_out, h_out, stats):
-    """Unload at constant rate from the state ``h_init`` with the Prony recursion.
+def new_work(r, h_init, q):
+    """The loop's arrays (:data:`Work`), the last four states all ``h_init``."""
+    N = h_init.size
+    M = q.shape[0]
+    r2half = np.empty(N)
+    for i in range(N):
+        r2half[i] = 0.5 * r[i] ** 2
+    return Work(h_init.copy(), h_init.copy(), h_init.copy(), h_init.copy(), np.empty(N),
+                np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(M),
+                np.empty(M), np.empty(N), np.empty(N), r2half, q)
 
-    Resumable: a run may be continued (in chunks of ``max_steps``, or on another mesh after
-    the state arrays were carried over) by passing back its gap, modal state ``q``, step
-    ``step_io`` and records.
 
-    Parameters (dimensionless, docs/design.md section 2)
+@njit(cache=True)
+def start_run(mesh, physics, start, records, work, run, hm):
+    """The state the loop starts from: the tractions of ``work.h`` and the run's time,
+    indentation and contact radius (record 0, the initial state, written for a new run).
+    Returns (records written, index of the load minimum among them)."""
+    h0, r = physics.h0, mesh.r
+    lj_traction(work.h, h0, physics.c, work.sigma)
+    run[RUN_A] = crossing_radius(work.h, r, hm)
+    if start.n == 0:
+        records.t[0] = 0.0
+        records.delta[0] = start.delta0
+        records.P[0] = load(work.sigma, mesh.wP)
+        records.a[0] = run[RUN_A]
+        records.a_inner[0] = crossing_radius(work.h, r, h0)
+        n = 1
+    else:
+        n = start.n
+    run[RUN_T] = records.t[n - 1]
+    run[RUN_DELTA] = records.delta[n - 1]
+    i_min = 0
+    for i in range(1, n):
+        if records.P[i] < records.P[i_min]:
+            i_min = i
+    return n, i_min
+
+
+@njit(cache=True)
+def predict_step(physics, work, run):
+    """-- predict: the step's time step, C_eff, H and g for the step ``run[RUN_DD]``, and
+    Newton's starting gaps: the quadratic extrapolation in ``work.h_pred`` (and ``hp``),
+    the cubic one, where four states exist, in ``work.hp``. Returns (quadratic, cubic):
+    which extrapolations were made."""
+    h0, dd = physics.h0, run[RUN_DD]
+    dt = dd / (physics.rate * h0)
+    run[RUN_DT] = dt
+    run[RUN_CEFF] = step_coefficients(physics.weights, physics.times, dt, work.e, work.b)
+    history_vector(physics.weights, work.e, work.b, work.q, work.sigma, work.H)
+    delta = run[RUN_DELTA]
+    for i in range(work.g.size):
+        work.g[i] = -(delta - dd) + h0 + work.r2half[i]
+    quadratic = predict(work.h, work.h_prev, work.h_prev2, dt, run[RUN_DT_PREV],
+                        run[RUN_DT_PREV2], work.hp)
+    work.h_pred[:] = work.hp
+    # Newton starts from the cubic extrapolation (where four states exist): on the
+    # vs-numpy scenes its residual is several times smaller, and 1.2-1.8 Newton
+    # iterations per step remain instead of 1.7-2.4; the quadratic one (h_pred) stays
+    # the step-error estimate
+    cubic = predict_cubic(work.h, work.h_prev, work.h_prev2, work.h_prev3, dt,
+                          run[RUN_DT_PREV], run[RUN_DT_PREV2], run[RUN_DT_PREV3], work.hp)
+    return quadratic, cubic
+
+
+@njit(cache=True)
+def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
+    """-- solve: Newton from ``work.hp``, again from the quadratic start where the cubic one
+    failed; after a failure the step is halved, down to SNAP_STEP_FRACTION step_max, and
+    the next solves are exact Newton; below it the path folds and the snapped state is
+    looked for. Returns SOLVED, HALVED, SNAPPED or FAILED (the state, if any, in hp)."""
+    A, h0, c, hp = mesh.A, physics.h0, physics.c, work.hp
+    ceff, tol = run[RUN_CEFF], control.tol * h0
+    ok = newton(hp, work.g, A, ceff, work.H, h0, c, tol, control.max_iter, cache, stats)
+    if not ok and cubic:
+        # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
+        # cubic start can overshoot: again from the quadratic one before the step halves
+        stats[STAT_FAILED_SOLVES] += 1
+        hp[:] = work.h_pred
+        ok = newton(hp, work.g, A, ceff, work.H, h0, c, tol, control.max_iter, cache, stats)
+    if ok:
+        return SOLVED
+    stats[STAT_FAILED_SOLVES] += 1
+    state = cache[CACHE_STATE]
+    state[STATE_VALID] = 0
+    state[STATE_EXACT] = 1
+    dd, dd_min = run[RUN_DD], control.step_min * h0
+    if dd > max(dd_min, SNAP_STEP_FRACTION * (control.step_max * h0)) * (1.0 + STEP_RTOL):
+        run[RUN_DD] = max(0.5 * dd, dd_min)
+        return HALVED
+    # the equilibrium path folds here (the crack tip snaps to the next node): look for the
+    # snapped state by Newton from the profile shifted inward by 1..SNAP_MAX_SHIFT nodes,
+    # else by pseudo-transient relaxation from the last state
+    stats[STAT_JUMPS] += 1
+    if snap(mesh, physics, work, ceff, tol, control.max_iter, hm, cache, stats):
+        return SNAPPED
+    hp[:] = work.h
+    if relax(hp, work.g, A, ceff, work.H, h0, c, tol, RELAX_MAX_ITER, stats):
+        return SNAPPED
+    return FAILED
+
+
+@njit(cache=True)
+def control_step(mesh, physics, control, work, run, hm, stats):
+    """-- control the step: the crack tip (at the gap ``hm``) may move by da_max at most; a
+    step that moves it further is halved until the motion, assumed proportional to the
+    step, is below REJECT_TARGET da_max (not below step_min). Returns (accepted, the new
+    contact radius, its change)."""
+    a_new = crossing_radius(work.hp, mesh.r, hm)
+    da = abs(a_new - run[RUN_A])
+    dd, dd_min, da_max = run[RUN_DD], control.step_min * physics.h0, control.da_max
+    if da > da_max and dd > dd_min * (1.0 + STEP_RTOL):
+        stats[STAT_REJECTED] += 1
+        da_est = da
+        while da_est > REJECT_TARGET * da_max and dd > dd_min:
+            dd = max(0.5 * dd, dd_min)
+            da_est *= 0.5
+        run[RUN_DD] = dd
+        return False, a_new, da
+    return True, a_new, da
+
+
+@njit(cache=True)
+def step_load(mesh, physics, work, quadratic):
+    """The load of the solved state ``work.hp`` (its tractions into ``work.sig_new``) and the
+    step-error estimate: the relative load error of the quadratic extrapolation, inf
+    without one. Returns (P, err)."""
+    h0, c, wP = physics.h0, physics.c, mesh.wP
+    lj_traction(work.hp, h0, c, work.sig_new)
+    P = load(work.sig_new, wP)
+    if not quadratic:
+        return P, np.inf
+    lj_traction(work.h_pred, h0, c, work.sigma_pred)
+    return P, abs(load(work.sigma_pred, wP) - P) / max(abs(P), 1.0)
+
+
+@njit(cache=True)
+def accept_step(mesh, physics, work, run, records, n, P, a_new):
+    """-- accept: the Prony modes, the last four states and time steps move on by the
+    solved state ``work.hp``, and record ``n`` (load ``P``, contact radius ``a_new``) is
+    written."""
+    update_modes(work.e, work.b, work.q, work.sig_new, work.sigma)
+    work.h_prev3[:] = work.h_prev2
+    work.h_prev2[:] = work.h_prev
+    work.h_prev[:] = work.h
+    work.h[:] = work.hp
+    work.sigma[:] = work.sig_new
+    dt = run[RUN_DT]
+    run[RUN_DT_PREV3] = run[RUN_DT_PREV2]
+    run[RUN_DT_PREV2] = run[RUN_DT_PREV]
+    run[RUN_DT_PREV] = dt
+    run[RUN_T] += dt
+    run[RUN_DELTA] -= run[RUN_DD]
+    run[RUN_A] = a_new
+    records.t[n] = run[RUN_T]
+    records.delta[n] = run[RUN_DELTA]
+    records.P[n] = P
+    records.a[n] = a_new
+    records.a_inner[n] = crossing_radius(work.h, mesh.r, physics.h0)
+
+
+@njit(cache=True)
+def stop_status(mesh, control, records, n, i_min):
+    """-- stop: after record ``n - 1``, the status that ends the run (the contact reached the
+    mesh edge, the crack tip left the band, or :func:`stop_reached`), else STATUS_RUNNING."""
+    a_new = records.a[n - 1]
+    if a_new >= mesh.r[mesh.r.size - 1]:
+        return STATUS_DOMAIN
+    if a_new > control.tip_hi or a_new < control.tip_lo:
+        return STATUS_LEFT_BAND
+    if stop_reached(records.P, records.a, n, i_min, control.stop_mode, control.min_travel):
+        return STATUS_DONE
+    return STATUS_RUNNING
+
+
+@njit(cache=True)
+def unload(mesh, physics, control, start, records, cache, stats):
+    """Unload at constant rate from the state ``start.h`` with the Prony recursion.
+
+    Resumable: a run may be continued (in chunks of ``control.max_steps``, or on another
+    mesh after the state arrays were carried over) by passing back its gap, modal state
+    ``q``, step and records.
+
+    Parameters (dimensionless, docs/design.md section 2; steps and tolerances in units of
+    h0, converted to d_ref where used)
     ----------
-    A : (N, N) influence matrix of the mesh.
-    r : (N,) node positions (a_ref units), r[0] = 0.
-    wP : (N,) load weights, P = 2 pi wP . sigma.
-    h_init : (N,) gap at indentation ``delta0``: the relaxed elastic LJ solution at the
-        start, the last accepted state when resuming.
-    delta0 : indentation of ``h_init`` (d_ref units). Used only when ``n0 == 0``; a resumed
-        run takes the time and indentation of its last record.
-    rate : r-hat; d delta/dt = -rate h0.
-    weights, times : Prony modes of Chat (times may be inf: lumped glassy constant).
-    q : (M, N) modal history state of the hereditary integral, in/out: zeros for the
-        relaxed start; on return the modes of the last accepted step.
-    n0 : records already in the output arrays. 0: a new run, record 0 is the initial
-        state; n0 >= 1: continue after record n0 - 1 (the stop rule sees all records).
-    step_io : (1,) indentation step (units of h0), in/out: <= 0 starts at ``step_max``;
-        on return the step the run would take next.
-    step_max, step_min : indentation steps in units of h0.
-    da_max : largest contact-radius change per step (a_ref units).
-    step_tol : relative load error of the step predictor, |P(predicted) - P| / max(|P|, 1),
-        below which the step may grow beyond ``step_max`` (up to SMOOTH_STEP_FACTOR
-        times) where the load evolves smoothly; 0 keeps every step <= step_max.
-    stop_mode : 0 stop after pull-off and load recovery, 1 follow to separation.
-    min_travel : crack-tip recession after the minimum required to stop (a_ref), see
-        :func:`stop_reached`.
-    tip_lo, tip_hi : radii the crack tip must stay within (the well-resolved band of a
-        graded mesh); leaving them ends the run with STATUS_LEFT_BAND.
+    mesh : MeshArrays (A, r, wP).
+    physics : Physics (h0, c, weights, times, rate).
+    control : StepControl (step_max, step_min, da_max, step_tol, tol, max_iter, max_steps,
+        stop_mode, min_travel, tip_lo, tip_hi).
+    start : RunState (h, delta0, q, n, step); q and step are in/out.
+    records : Records (t, delta, P, a, a_inner, h), written.
     cache : tuple
         The Jacobian cache (:func:`new_jacobian_cache`); may carry the factorization of
         the initial solve.
-    t_out, d_out, P_out, a_out, ai_out : output arrays (length >= max_steps + 1).
-    h_out : (N,) receives the gap of the last accepted step.
     stats : int64 array of length N_STATS (incremented).
 
     Returns
     -------
     (status, n_records)
     """
-    state = cache[CACHE_STATE]
-    N = h_init.size
-    M = weights.size
+    h0 = physics.h0
     hm = 3.0 ** (1.0 / 6.0) * h0
-    r2half = np.empty(N)
-    for i in range(N):
-        r2half[i] = 0.5 * r[i] ** 2
-    e = np.empty(M)
-    b = np.empty(M)
-    H = np.empty(N)
-    g = np.empty(N)
-    h = h_init.copy()
-    h_prev = h_init.copy()
-    h_prev2 = h_init.copy()
-    h_prev3 = h_init.copy()
-    hp = np.empty(N)
-    h_pred = np.empty(N)
-    sigma_pred = np.empty(N)
-    sigma = np.empty(N)
-    sig_new = np.empty(N)
-    lj_traction(h, h0, c, sigma)
-
-    a_cur = crossing_radius(h, r, hm)
-    if n0 == 0:
-        t_out[0] = 0.0
-        d_out[0] = delta0
-        P_out[0] = load(sigma, wP)
-        a_out[0] = a_cur
-        ai_out[0] = crossing_radius(h, r, h0)
-        n = 1
-    else:
-        n = n0
-    t = t_out[n - 1]
-    delta = d_out[n - 1]
-    i_min = 0
-    for i in range(1, n):
-        if P_out[i] < P_out[i_min]:
-            i_min = i
-    # units converted once: steps and tolerances in d_ref from here on
-    dd_max = step_max * h0
-    dd_min = step_min * h0
-    tol_gap = tol * h0
-    tol_step = step_tol * h0
-    dd = step_io[0] * h0 if step_io[0] > 0.0 else dd_max
-    dt_prev = 0.0
-    dt_prev2 = 0.0
-    dt_prev3 = 0.0
+    work = new_work(mesh.r, start.h, start.q)
+    run = np.zeros(N_RUN)
+    n, i_min = start_run(mesh, physics, start, records, work, run, hm)
+    run[RUN_DD] = start.step[0] * h0 if start.step[0] > 0.0 else control.step_max * h0
     easy = 0
     status = STATUS_STEP_LIMIT
-    while n <= max_steps:
-        # -- predict
-        dt = dd / (rate * h0)
-        ceff = step_coefficients(weights, times, dt, e, b)
-        history_vector(weights, e, b, q, sigma, H)
-        for i in range(N):
-            g[i] = -(delta - dd) + h0 + r2half[i]
-        quadratic = predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp)
-        h_pred[:] = hp
-        # Newton starts from the cubic extrapolation (where four states exist): on the
-        # vs-numpy scenes its residual is several times smaller, and 1.2-1.8 Newton
-        # iterations per step remain instead of 1.7-2.4; the quadratic one (h_pred) stays
-        # the step-error estimate
-        cubic = predict_cubic(h, h_prev, h_prev2, h_prev3, dt, dt_prev, dt_prev2, dt_prev3, hp)
-        # -- solve
-        ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, cache, stats)
-        if not ok and cubic:
-            # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
-            # cubic start can overshoot: again from the quadratic one before the step halves
-            stats[STAT_FAILED_SOLVES] += 1
-            hp[:] = h_pred
-            ok = newton(hp, g, A, ceff, H, h0, c, tol_gap, max_iter, cache, stats)
-        if not ok:
-            stats[STAT_FAILED_SOLVES] += 1
-            state[STATE_VALID] = 0
-            state[STATE_EXACT] = 1
+    while n <= control.max_steps:
+        quadratic, cubic = predict_step(physics, work, run)
+        outcome = solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats)
+        if outcome != SOLVED:
             easy = 0
-            if dd > max(dd_min, SNAP_STEP_FRACTION * dd_max) * 1.0001:
-                dd = max(0.5 * dd, dd_min)
+            if outcome == HALVED:
                 continue
-            # the equilibrium path folds here (the crack tip snaps to the next node): look
-            # for the snapped state by Newton from the profile shifted inward by 1..6 nodes,
-            # else by pseudo-transient relaxation from the last state
-            stats[STAT_JUMPS] += 1
-            ok = snap(h, hp, g, A, ceff, H, h0, c, tol_gap, max_iter, r, hm, cache, stats)
-            if not ok:
-                hp[:] = h
-                ok = relax(hp, g, A, ceff, H, h0, c, tol_gap, RELAX_MAX_ITER, stats)
-            if not ok:
+            if outcome == FAILED:
                 status = STATUS_NEWTON_FAILED
                 break
             quadratic = False
-        # -- control the step: the crack tip may move by da_max at most
-        a_new = crossing_radius(hp, r, hm)
-        da = abs(a_new - a_cur)
-        if da > da_max and dd > dd_min * 1.0001:
-            stats[STAT_REJECTED] += 1
+        accepted, a_new, da = control_step(mesh, physics, control, work, run, hm, stats)
+        if not accepted:
             easy = 0
-            da_est = da
-            while da_est > REJECT_TARGET * da_max and dd > dd_min:
-                dd = max(0.5 * dd, dd_min)
-                da_est *= 0.5
             continue
-        lj_traction(hp, h0, c, sig_new)
-        P = load(sig_new, wP)
-        if quadratic:
-            lj_traction(h_pred, h0, c, sigma_pred)
-            err = abs(load(sigma_pred, wP) - P) / max(abs(P), 1.0)
-        else:
-            err = np.inf
-        # -- accept
-        state[STATE_EXACT] = 0
-        update_modes(e, b, q, sig_new, sigma)
-        h_prev3[:] = h_prev2
-        h_prev2[:] = h_prev
-        h_prev[:] = h
-        h[:] = hp
-        sigma[:] = sig_new
-        dt_prev3 = dt_prev2
-        dt_prev2 = dt_prev
-        dt_prev = dt
-        t += dt
-        delta -= dd
-        t_out[n] = t
-        d_out[n] = delta
-        P_out[n] = P
-        a_out[n] = a_new
-        ai_out[n] = crossing_radius(h, r, h0)
-        if P < P_out[i_min]:
+        P, err = step_load(mesh, physics, work, quadratic)
+        cache[CACHE_STATE][STATE_EXACT] = 0
+        accept_step(mesh, physics, work, run, records, n, P, a_new)
+        if P < records.P[i_min]:
             i_min = n
         n += 1
-        a_cur = a_new
-        # -- stop
-        if a_new >= r[N - 1]:
-            status = STATUS_DOMAIN
+        stop = stop_status(mesh, control, records, n, i_min)
+        if stop != STATUS_RUNNING:
+            status = stop
             break
-        if a_new > tip_hi or a_new < tip_lo:
-            status = STATUS_LEFT_BAND
-            break
-        if stop_reached(P_out, a_out, n, i_min, stop_mode, min_travel):
-            status = STATUS_DONE
-            break
-        dd, easy = next_step(dd, easy, da, da_max, err, dd_max, tol_step)
-    h_out[:] = h
-    step_io[0] = dd / h0
+        run[RUN_DD], easy = next_step(run[RUN_DD], easy, da, control.da_max, err,
+                                      control.step_max * h0, control.step_tol * h0)
+    records.h[:] = work.h
+    start.step[0] = run[RUN_DD] / h0
     return status, n

@@ -549,10 +549,11 @@ def newton_diagnosis(scene, numerics, at_step: int = 300, ahead: int = 10) -> di
             solver.simulate(scene, dataclasses.replace(numerics, max_steps=k))
             # the run's own kernel call (an error-indicator solve on a cheaper mesh may follow)
             args, n = captured["calls"][0]
-            gaps[k], times[k] = args[-2].copy(), float(args[-7][n - 1])   # h_out, t_out
+            records = args[4]                # kernels.solve.Records
+            gaps[k], times[k] = records.h.copy(), float(records.t[n - 1])
     finally:
         solver.unload = orig
-    A, h0, c = args[0], args[6], args[7]
+    A, h0, c = args[0].A, args[1].h0, args[1].c     # MeshArrays, Physics
     N = A.shape[0]
 
     def stiffness(h):

@@ -26,7 +26,8 @@ import time
 import numpy as np
 
 from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP_LIMIT,
-                             invalidate, unload)
+                             MeshArrays, Physics, Records, RunState, StepControl, invalidate,
+                             unload)
 from ..scene import Numerics, Result, Scene
 from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
@@ -150,12 +151,13 @@ def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int
     numerics = pb.numerics
     h_out = np.empty(pb.mesh.nodes)
     limit = min(run.n + steps, numerics.max_steps)
-    status, run.n = unload(pb.A, pb.mesh.r, pb.wP, run.h, run.delta0, pb.scene.rate, pb.h0,
-                           pb.c, pb.prony_weights, pb.prony_times, run.q, run.n, run.step,
-                           numerics.step, numerics.min_step, numerics.da_max * pb.mesh.spacing,
-                           STEP_TOL, numerics.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
-                           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *tip_range, run.cache,
-                           *run.records, h_out, run.stats)
+    control = StepControl(numerics.step, numerics.min_step, numerics.da_max * pb.mesh.spacing,
+                          STEP_TOL, numerics.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
+                          STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *tip_range)
+    status, run.n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
+                           Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, pb.scene.rate),
+                           control, RunState(run.h, run.delta0, run.q, run.n, run.step),
+                           Records(*run.records, h_out), run.cache, run.stats)
     run.h = h_out
     return int(status)
 

@@ -6,7 +6,8 @@ predictors are exact for polynomials in time of their order.
 """
 import numpy as np
 
-from sweep.kernels.solve import N_STATS, STATUS_DONE, STATUS_STEP_LIMIT, new_jacobian_cache, unload
+from sweep.kernels.solve import (N_STATS, STATUS_DONE, STATUS_STEP_LIMIT, MeshArrays, Physics,
+                                 Records, RunState, StepControl, new_jacobian_cache, unload)
 from sweep.engine.initial import ElasticSolver, relaxed_state
 from sweep.engine.problem import prepare
 from sweep.scene import Numerics, Scene
@@ -30,12 +31,13 @@ def _run(chunk):
     while True:
         h_out = np.empty(N)
         limit = NUMERICS.max_steps if chunk is None else min(n + chunk, NUMERICS.max_steps)
-        status, n = unload(pb.A, pb.mesh.r, pb.wP, h, delta0, SCENE.rate, pb.h0, pb.c,
-                           pb.prony_weights, pb.prony_times, q, n, step, NUMERICS.step,
-                           NUMERICS.min_step, NUMERICS.da_max * pb.mesh.spacing, STEP_TOL, NUMERICS.tol,
-                           MAX_NEWTON_ITER, limit, pb.stop_mode,
-                           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range, cache, *out,
-                           h_out, stats)
+        control = StepControl(NUMERICS.step, NUMERICS.min_step, NUMERICS.da_max * pb.mesh.spacing,
+                              STEP_TOL, NUMERICS.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
+                              STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range)
+        status, n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
+                           Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, SCENE.rate),
+                           control, RunState(h, delta0, q, n, step), Records(*out, h_out),
+                           cache, stats)
         calls += 1
         h = h_out
         if status != STATUS_STEP_LIMIT or limit >= NUMERICS.max_steps:
