@@ -83,9 +83,10 @@ Physics = namedtuple("Physics", ["h0", "c", "weights", "times", "rate"])
 #: the step control settings:
 #: step_max, step_min: indentation steps (units of h0);
 #: da_max: largest contact-radius change per step (a_ref);
-#: step_tol: relative load error of the step predictor, |P(predicted) - P| / max(|P|, 1),
-#:     below which the step may grow beyond step_max (up to SMOOTH_STEP_FACTOR times) where
-#:     the load evolves smoothly; 0 keeps every step <= step_max;
+#: step_tol: relative load error of the step predictor, |P(predicted) - P| / max(|P|,
+#:     LOAD_ERROR_FLOOR), below which the step may grow beyond step_max (up to
+#:     SMOOTH_STEP_FACTOR times) where the load evolves smoothly; 0 keeps every step <=
+#:     step_max;
 #: tol: Newton tolerance on max |F| (units of h0); max_iter: Newton iterations per solve;
 #: max_steps: the run ends with STATUS_STEP_LIMIT when the records reach max_steps + 1;
 #: stop_mode: 0 stop after pull-off and load recovery, 1 follow to separation;
@@ -205,6 +206,9 @@ SMOOTH_STEP_FACTOR = 8.0
 SMOOTH_DA_FRACTION = 0.6
 #: the predictor never puts a gap below this fraction of the last accepted one
 PREDICT_FLOOR = 0.5
+#: the predictor's load error is relative to max(|P|, this) (units of pi dg R; absolute
+#: where the load passes through zero)
+LOAD_ERROR_FLOOR = 1.0
 
 #: the pull-off is past once the load has recovered by this fraction of |P_min| ...
 RECOVERY = 0.05
@@ -685,7 +689,7 @@ def step_load(mesh, physics, work, quadratic):
     if not quadratic:
         return P, np.inf
     lj_traction(work.h_pred, h0, c, work.sigma_pred)
-    return P, abs(load(work.sigma_pred, wP) - P) / max(abs(P), 1.0)
+    return P, abs(load(work.sigma_pred, wP) - P) / max(abs(P), LOAD_ERROR_FLOOR)
 
 
 @njit(cache=True)
