@@ -15,6 +15,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+#: below this dt/tau, b_i = 1 - x/2 (its series, exact to rounding there) instead of
+#: -expm1(-x)/x (undefined at x = 0)
+SERIES_BELOW = 1e-12
+
 
 @njit(cache=True)
 def step_coefficients(weights, times, dt, e, b):
@@ -28,7 +32,7 @@ def step_coefficients(weights, times, dt, e, b):
         else:
             x = dt / tau
             e[i] = np.exp(-x)
-            b[i] = -np.expm1(-x) / x if x > 1e-12 else 1.0 - 0.5 * x
+            b[i] = -np.expm1(-x) / x if x > SERIES_BELOW else 1.0 - 0.5 * x
         ceff -= weights[i] * b[i]
     return ceff
 

@@ -34,7 +34,18 @@ GL16_W = 0.5 * _w16
 _x32, _w32 = np.polynomial.legendre.leggauss(32)
 GL32_X = 0.5 * (_x32 + 1.0)
 GL32_W = 0.5 * _w32
+#: exponent of the graded substitution s - r_i = L t^GRADING on the pieces that touch r_i
 GRADING = 6.0
+#: a smooth piece whose midpoint lies more than this many piece lengths from r_i takes the
+#: 8-point rule (exact to rounding there), a nearer one the 16-point rule
+FAR_PIECES = 3.0
+#: the AGM of :func:`ellipk_complement` stops when its two means agree to this relative
+#: difference (machine precision) ...
+AGM_RTOL = 1e-16
+#: ... or after this many iterations (converging inputs need at most 13, down to kc =
+#: 1e-300; about a quarter of them end with the two means one rounding apart, never
+#: within AGM_RTOL, and run to this cap)
+AGM_MAX_ITER = 60
 
 
 @njit(cache=True)
@@ -45,8 +56,8 @@ def ellipk_complement(kc):
     """
     a = 1.0
     b = kc
-    for _ in range(60):
-        if abs(a - b) <= 1e-16 * a:
+    for _ in range(AGM_MAX_ITER):
+        if abs(a - b) <= AGM_RTOL * a:
             break
         a, b = 0.5 * (a + b), np.sqrt(a * b)
     return np.pi / (2.0 * a)
@@ -80,7 +91,7 @@ def _piece(r, sa, sb, phi_a, phi_b, singular_at, xs_smooth, ws_smooth, xs_sing, 
     L = sb - sa
     total = 0.0
     if singular_at == 0:
-        if abs(0.5 * (sa + sb) - r) > 3.0 * L:
+        if abs(0.5 * (sa + sb) - r) > FAR_PIECES * L:
             xs_smooth = xs_far
             ws_smooth = ws_far
         for q in range(xs_smooth.size):
