@@ -39,7 +39,7 @@ import numpy as np
 from numba import njit
 
 from .history import history_vector, step_coefficients, update_modes
-from .interface import crossing_radius, lj_traction, lj_traction_and_stiffness
+from .interface import TIP_GAP, crossing_radius, lj_traction, lj_traction_and_stiffness
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
 from .jacobian import (CACHE_CONTRACTION, CACHE_STATE, STATE_EXACT,  # noqa: F401
                        STATE_VALID, factorize, invalidate, new_jacobian_cache,
@@ -758,7 +758,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
     (status, n_records)
     """
     h0 = physics.h0
-    hm = 3.0 ** (1.0 / 6.0) * h0
+    hm = TIP_GAP * h0
     work = new_work(mesh.r, start.h, start.q)
     run = np.zeros(N_RUN)
     n, i_min = start_run(mesh, physics, start, records, work, run, hm)
