@@ -103,13 +103,15 @@ CFG := configs
 OUT := results
 endif
 REPRO := $(BIN)/sweep reproduce
+# worker processes of the campaigns (default: the scheduler's; JOBS=1 on a shared machine)
+JOBS ?=
 # run a sweep and its analysis, timing the whole: $(call campaign,config,dir,reproduce-cmd)
 define campaign
 	@mkdir -p $(OUT)/$(2)
 	@start=$$(date +%s); \
-	$(BIN)/sweep run $(CFG)/$(1).yaml --out $(OUT)/$(2)/runs.h5 --progress none && \
+	$(BIN)/sweep run $(CFG)/$(1).yaml --out $(OUT)/$(2)/runs.h5 --progress none $(if $(JOBS),-j $(JOBS)) && \
 	$(REPRO) $(3) $(OUT)/$(2)/runs.h5 $(OUT)/$(2) && \
-	echo "$$(( $$(date +%s) - start )) s: make $@ $(if $(QUICK),QUICK=$(QUICK))" > $(OUT)/$(2)/make_wall_s.txt && \
+	echo "$$(( $$(date +%s) - start )) s: make $@ $(if $(QUICK),QUICK=$(QUICK)) $(if $(JOBS),JOBS=$(JOBS))" > $(OUT)/$(2)/make_wall_s.txt && \
 	cat $(OUT)/$(2)/make_wall_s.txt
 endef
 
