@@ -400,7 +400,41 @@ def _pdms_section(root: Path) -> list[str]:
         f"({_g(pp.get('speed_full_amplification_m_s', math.nan), 3)}) |",
         f"| same at the PDMS's own k (PB Gamma = 0.9/k at vhat = "
         f"{res['vhat_full_amplification_pdms_k']:.2g}) [m/s] | "
-        f"{res['speed_full_amplification_pdms_k_m_s']:.2g} | -- |", ""]
+        f"{res['speed_full_amplification_pdms_k_m_s']:.2g} | -- |"]
+    dp = res.get("discussion_paper_protocol")
+    if dp:
+        lines += [
+            f"| threshold radius for 1.5/k, our collapse fit under the paper's protocol "
+            f"(A = {_g(dp['fits']['threshold']['prefactor'], 3)}, B = "
+            f"{_g(dp['fits']['threshold']['exponent'], 3)}) [a_ref / mm] | {_g(dp['a0t_hat'])} / "
+            f"{_g(dp['a0t_mm'], 3)} | 30.9 / 5.8 |",
+            f"| unloading speed for the full amplification, our v-r fit over the paper's rate "
+            f"range [m/s] | {_g(dp['speed_full_amplification_m_s'], 3)} | 31.4 |"]
+    if res.get("speed_full_amplification_vhat_paper_m_s") is not None:
+        lines.append(f"| same with the paper's reading vhat = 1e9 instead of the 0.9/k criterion, "
+                     f"our v-r fit [m/s] | {_g(res['speed_full_amplification_vhat_paper_m_s'], 3)}"
+                     f" | 31.4 |")
+    g = res.get("gs_over_bem")
+    if g:
+        i4 = len(g["speeds_um_s"]) - 1
+        bem = [b for b in (g.get("bem") or []) if b["speed_um_s"] == g["speeds_um_s"][i4]]
+        b_ratio = (f"{bem[0]['ratio']:.3f} (BEM, +- {100 * bem[0]['error_estimate']:.1f} % "
+                   "in P_lin)" if bem and bem[0]["status"] == "ok" else "BEM not reached")
+        lines += [
+            f"| (dg_eff)_GS/(dg_eff)_lin as the paper defines it (GS at v(r) of the v-r law "
+            f"over the linear pull-off P_lin(r)/P_JKR) at r = {g['speeds_um_s'][i4]:g} um/s | "
+            f"{b_ratio}; crack front {g['crack_front']['ratio'][i4]:.3f} | "
+            f"{g['paper_fit'][i4]:.3g} (its fit 1 + (v/v1)^(1/2) at v(r) = "
+            f"{g['crack_speed_um_s'][i4]:.3g} um/s) |"]
+    gl = res.get("gs_over_linear") or {}
+    if "ratio_at_v1" in gl:
+        lines.append(f"| GS over Gamma_PB(v), the infinite-size PB energy (not the paper's "
+                     f"quantity), at crack speed 1e4 um/s | {gl['ratio_at_v1']:.3f} | -- |")
+    lines.append("")
+    if g:
+        lines += ["The ratio curve at the paper's speeds (BEM and crack front) and its error "
+                  "estimates: [pdms/REPORT.md](pdms/REPORT.md), section 'as the paper defines "
+                  "it'.", ""]
     return lines
 
 
