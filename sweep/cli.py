@@ -546,15 +546,19 @@ def fit_threshold_cmd(results, slope, saturation, boot, as_json):
                f"{_ci(out['prefactor_inner_ci'])}, B = {out['exponent_inner']:.4g}; "
                f"a0 in (R^2 dg/E0*)^(1/3): A = {out['prefactor_no_pi']:.4g}")
     pp = out["paper_protocol"]
-    click.echo(f"paper's protocol: A = {pp['A']:.4g} {_ci(pp['A_ci'])}   B = {pp['B']:.4g} "
-               f"{_ci(pp['B_ci'])}   points = {pp['n_points']}   A (a0 in (R^2 dg/E0*)^(1/3)) "
-               f"= {pp['A_no_pi']:.4g} {_ci(pp['A_no_pi_ci'])}")
-    click.echo(f"# paper's rule: {pp['rule']}")
-    for src in pp["sources"]:
-        click.echo(f"#   {src['choice']}: {src['paper']}")
-    click.echo("B per n (project rule | paper's protocol): " + "; ".join(
-        f"n = {a['n']:g}: {a['B']:.3g} ({a['n_points']}) | {b['B']:.3g} ({b['n_points']})"
-        for a, b in zip(out["per_n"], pp["per_n"])))
+    if pp is None:
+        click.echo("paper's protocol: fewer than 3 threshold points with rate >= 10^0.5 below "
+                   "0.5 x 1.5/k")
+    else:
+        click.echo(f"paper's protocol: A = {pp['A']:.4g} {_ci(pp['A_ci'])}   B = "
+                   f"{pp['B']:.4g} {_ci(pp['B_ci'])}   points = {pp['n_points']}   A (a0 in "
+                   f"(R^2 dg/E0*)^(1/3)) = {pp['A_no_pi']:.4g} {_ci(pp['A_no_pi_ci'])}")
+        click.echo(f"# paper's rule: {pp['rule']}")
+        for src in pp["sources"]:
+            click.echo(f"#   {src['choice']}: {src['paper']}")
+        click.echo("B per n (project rule | paper's protocol): " + "; ".join(
+            f"n = {a['n']:g}: {a['B']:.3g} ({a['n_points']}) | {b['B']:.3g} ({b['n_points']})"
+            for a, b in zip(out["per_n"], pp["per_n"])))
     click.echo(f"{'selection':<42} {'A':>8} {'B':>7} {'B 95 % CI':>18} {'points':>6}")
     for r in out["sensitivity"]:
         click.echo(f"{r['rule']:<42} {r['prefactor']:>8.4g} {r['exponent']:>7.4g} "

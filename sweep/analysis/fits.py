@@ -583,11 +583,14 @@ def threshold_analysis(df: pd.DataFrame, slope: float = THRESHOLD_SLOPE,
                         and r.pull_off_at_a0t < saturation_fraction * r.saturation)}
         for r in table.itertuples()
     ]
-    paper = paper_protocol_fit(table, paper_exponent=None if paper_fit is None
-                               else paper_fit[1], n_boot=n_boot, seed=seed)
-    pp = _collapse_points(table, paper["saturation_fraction"], paper["min_rate"],
-                          paper["ordinate"], paper["radius"])
-    in_paper = set(zip(pp["n"], pp["rate"]))
+    try:
+        paper = paper_protocol_fit(table, paper_exponent=None if paper_fit is None
+                                   else paper_fit[1], n_boot=n_boot, seed=seed)
+        pp = _collapse_points(table, paper["saturation_fraction"], paper["min_rate"],
+                              paper["ordinate"], paper["radius"])
+        in_paper = set(zip(pp["n"], pp["rate"]))
+    except InputError:           # fewer than 3 points under the paper's protocol
+        paper, in_paper = None, set()
     for row in table_rows:
         row["in_paper_fit"] = (row["n"], row["rate"]) in in_paper
     extra = {}

@@ -243,7 +243,9 @@ def test_cli_fit_threshold_and_vr(tmp_path, capsys):
         assert key in out
     assert out["exponent"] == pytest.approx(2.7, abs=1e-2)
     assert main(["fit", "threshold", str(tpath), "--boot", "0"]) == 0
-    assert "P_po = A a0t^B" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "P_po = A a0t^B" in text and "paper's protocol: A = " in text
+    assert "smallest unloading rate considered" in text and "B per n" in text
 
     vpath = tmp_path / "vr.h5"
     write_results(vpath, synthetic_vr_runs())
@@ -254,7 +256,9 @@ def test_cli_fit_threshold_and_vr(tmp_path, capsys):
         assert key in out
     assert out["exponent"] == pytest.approx(1.1, rel=1e-9)
     assert main(["fit", "vr", str(vpath)]) == 0
-    assert "alpha_best" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "alpha_best" in text and "alpha_best per k: k = 0.05" in text
+    assert "paper's rate range r-hat in [1, 1e+06]: A = 3 " in text and "local slope" in text
 
 
 @pytest.mark.parametrize("args, word", [
@@ -430,3 +434,13 @@ def test_bem_power_law_of_points_on_a_power_law():
     assert res[1.6]["beta"] == pytest.approx(2.5, rel=1e-9)
     assert res[1.6]["m"] == pytest.approx(0.3, rel=1e-9)
     assert res[1.6]["n_points"] >= 3
+
+
+def test_threshold_analysis_without_enough_points_for_the_paper_protocol():
+    # only the groups at rates 1 and 10: the paper's protocol keeps rate 10 (a_t = 2.0 for
+    # both n), 2 points: no fit; the project's rule keeps all 4
+    df = synthetic_threshold_runs()
+    df = df[df["rate"] <= 10.0]
+    out = an.threshold_analysis(df, n_boot=0)
+    assert out["paper_protocol"] is None and out["n_points"] == 4
+    assert not any(r["in_paper_fit"] for r in out["table"])
