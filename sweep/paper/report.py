@@ -252,7 +252,7 @@ def _threshold_section(thr, paper) -> list[str]:
     return lines + [""]
 
 
-def _vr_protocol_lines(vr) -> list[str]:
+def _vr_protocol_lines(vr, theory=None) -> list[str]:
     """The v-r fit over the paper's rate range and others, the local slope of the data,
     alpha per k and the BEM's beta and m."""
     lines = []
@@ -306,16 +306,21 @@ def _vr_protocol_lines(vr) -> list[str]:
                   f"BEM points at k = {bp[0]['k']:g} with Gamma_eff between (1/k)^0.25 and "
                   "(1/k)^0.75 (the range the PB-curve fit of theory.json uses; the paper fits "
                   "the PB curve):", "",
-                  "| n | beta (95 % CI) | m (95 % CI) | points | vhat range |",
-                  "| --- | --- | --- | --- | --- |"]
+                  "| n | beta (95 % CI) | m (95 % CI) | points | vhat range | PB curve: beta, m "
+                  "(theory.json) |", "| --- | --- | --- | --- | --- | --- |"]
+        laws = {}
+        if theory and abs(theory["pb_power_law"]["k"] - bp[0]["k"]) < 1e-12:
+            laws = {law["n"]: law for law in theory["pb_power_law"]["laws"]}
         for r in bp:
+            law = laws.get(r["n"])
+            pb = f"{law['beta']:.4g}, {law['m']:.4g}" if law else "-"
             lines.append(f"| {r['n']:g} | {_g(r['beta'])} {_ci(r['beta_ci'])} | "
                          f"{_g(r['m'])} {_ci(r['m_ci'])} | {r['n_points']} | "
-                         f"{_ci(r['vhat_range'])} |")
+                         f"{_ci(r['vhat_range'])} | {pb} |")
     return lines
 
 
-def _vr_section(vr) -> list[str]:
+def _vr_section(vr, theory=None) -> list[str]:
     pb = vr["pb_vs_bem"]
     lines = ["## Crack speed versus unloading rate, Persson-Brener against the BEM (`make vr`)", "",
              f"{vr['rhat_pb_definition']}; vhat = v tau0/l0 with l0 from alpha = pi/9. Fits are "
@@ -329,7 +334,7 @@ def _vr_section(vr) -> list[str]:
             c = pb[key]
             lines.append(f"| {text} | {100 * c['share_within_15pct']:.1f} % | "
                          f"{100 * c['median_abs_error']:.1f} % | {100 * c['max_abs_error']:.1f} % |")
-    lines += _vr_protocol_lines(vr)
+    lines += _vr_protocol_lines(vr, theory)
     lines += ["", _fig("vr/v_vs_r.png", "Fig. r_v inset: crack speed at pull-off vs rhat_PB, "
                        "our fits (all points, unsaturated) and the paper's"),
               _fig("vr/pb_vs_bem.png", "Fig. r_v main panel (left): BEM Gamma_eff vs PB at the "
@@ -466,7 +471,7 @@ def build_report(root, paper: dict, commit: str) -> str:
         out[2:2] = ["**QUICK=1 smoke run on thinned grids with the fast preset: a check of the "
                     "pipeline, not a result.**", ""]
     out += _threshold_section(thr, paper) if thr else ["## Threshold contact radius", "", "Not run.", ""]
-    out += _vr_section(vr) if vr else ["## Crack speed versus rate", "", "Not run.", ""]
+    out += _vr_section(vr, theory) if vr else ["## Crack speed versus rate", "", "Not run.", ""]
     out += ["## Further figures (`make fig3`, `make figures`)", ""]
     for rel, cap in (("fig3/fig3.png", "Fig. 3: P(a) during unloading (BEM trajectories)"),
                      ("aconv/aconv.png", "Fig. aconv: pull-off vs rate for a0 = 1.94, 2.50, "
