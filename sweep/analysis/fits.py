@@ -855,7 +855,8 @@ def alpha_per_k(df: pd.DataFrame) -> list[dict]:
 
 
 def bem_power_law(df: pd.DataFrame, k: float = 0.1, lo: float = 0.25, hi: float = 0.75,
-                  alpha: float = units.ALPHA_PB) -> list[dict]:
+                  alpha: float = units.ALPHA_PB, n_boot: int = N_BOOT,
+                  seed: int = 0) -> list[dict]:
     r"""``Gamma_eff = beta vhat^m`` fitted to the BEM points of each n at ``k`` (the paper's
     Fig. PB_BEM inset, there fitted to the PB curve; here to our runs).
 
@@ -877,7 +878,7 @@ def bem_power_law(df: pd.DataFrame, k: float = 0.1, lo: float = 0.25, hi: float 
         g = d[(d["n"] == n) & (d["gamma_eff"] >= g_lo) & (d["gamma_eff"] <= g_hi)]
         row = {"n": float(n), "k": float(k), "n_points": int(len(g))}
         try:
-            f = power_law_fit(g["vhat"], g["gamma_eff"], n_boot=N_BOOT)
+            f = power_law_fit(g["vhat"], g["gamma_eff"], n_boot=n_boot, seed=seed)
             row.update(beta=f["prefactor"], m=f["exponent"], beta_ci=f["prefactor_ci"],
                        m_ci=f["exponent_ci"],
                        vhat_range=[float(g["vhat"].min()), float(g["vhat"].max())])
@@ -916,7 +917,7 @@ def vr_analysis(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTI
         "paper_range": vr_paper_range(df, n_boot=n_boot, seed=seed),
         "local_slope": vr_local_slope(df),
         "alpha_per_k": alpha_per_k(df),
-        "bem_power_law": bem_power_law(df),
+        "bem_power_law": bem_power_law(df, n_boot=n_boot, seed=seed),
         "prefactor": a["prefactor"], "exponent": a["exponent"],
         "prefactor_ci": a["prefactor_ci"], "exponent_ci": a["exponent_ci"],
         "n_points": a["n_points"], "rms_log_residual": a["rms_log_residual"],

@@ -365,10 +365,10 @@ def _campaign_table(root: Path) -> list[str]:
                      f"{_g((c.get('scene_cpu_s_sum') or math.nan) / 120, 3)} min | "
                      f"{_make_wall(root / d)} | `{p.get('git_commit', '-')}` |")
         failures += [f"- `{d}` {f['scene_id']}: {f['reason']}" for f in c["failures"]]
-    lines += ["", "Times are wall-clock on the project's shared 2-core machine (2 worker "
-              "processes, other jobs running at the same time), so they are upper bounds of "
-              "an idle machine's (load average 6-9 on the 2 cores meanwhile: the scenes' "
-              "CPU time was about a seventh of their wall time). CPU time / 2 estimates the "
+    lines += ["", "Times are wall-clock on the project's shared 2-core machine (the worker "
+              "processes of the make line in `make_wall_s.txt`: JOBS=1 is one; other jobs "
+              "running at the same time), so they are upper bounds of an idle machine's (load "
+              "average 3-9 on the 2 cores meanwhile). CPU time / 2 estimates the "
               "wall time of 2 workers on an idle machine. The sweep elapsed time spans "
               "resumptions, if any.", "",
               "Failures: " + ("none." if not failures else ""), *failures, ""]

@@ -187,7 +187,8 @@ def fake_bem(speeds, factor=1.0, case=PDMS_CASE):
     cf = pdms.model_pull_off("crack_pb", speeds, pdms.bem_case(case, pdms.BEM_MU))
     pts = [{"speed_um_s": float(v), "mu": pdms.BEM_MU, "status": "ok", "reason": "",
             "pull_off_mN": factor * p, "error_indicator": 0.004, "crack_speed_um_s": 1.0,
-            "preset": pdms.BEM_PRESET, "steps": 1, "nodes": 1, "wall_s": 1.0}
+            "preset": pdms.BEM_PRESET, "band_resolution": 9.0, "steps": 1, "nodes": 1,
+            "wall_s": 1.0}
            for v, p in zip(speeds, cf["pull_off_mN"])]
     pts.append({**pts[-1], "speed_um_s": 3.0, "status": "failed", "reason": "time budget",
                 "pull_off_mN": math.nan})
@@ -227,8 +228,9 @@ def test_gs_over_bem_is_the_papers_ratio():
         assert b["ratio"] == pytest.approx(cf["ratio"][i] / 1.1, rel=1e-12)
         assert 1.0 < b["mu_carry_over_factor"] < 1.03
         parts = b["error_parts"]
-        # |P_fast / P_finer - 1| at the check speed, the same for every point
-        assert parts["fast_vs_finer_at_check_speed"] == pytest.approx(1 - 1 / 1.01, rel=1e-9)
+        # |P_fast / P_finer - 1| / (1 - (9/16)^2) at the check speed, the same for every point
+        assert parts["fast_vs_finer_at_check_speed"] == pytest.approx(
+            (1 - 1 / 1.01) / (1 - (9 / 16) ** 2), rel=1e-9)
         assert parts["resolution_indicator"] == 0.004
         assert b["error_estimate"] == pytest.approx(sum(parts.values()), rel=1e-12)
     assert g["bem"][3]["status"] == "failed" and math.isnan(g["bem"][3]["ratio"])
