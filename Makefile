@@ -10,7 +10,7 @@ export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
-        tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms \
+        tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem \
         agreement agreement-high-mu extremes tip-convergence elastic-table
 
 help:
@@ -21,7 +21,8 @@ help:
 	@echo "make coverage-kernels - kernel tests with NUMBA_DISABLE_JIT=1 under coverage"
 	@echo "make reproduce - the paper's campaigns, fits, figures and results/REPORT.md"
 	@echo "               (make threshold | vr | fig3 | figures | report; QUICK=1: thinned grids)"
-	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/)"
+	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/; uses results/pdms/bem.json)"
+	@echo "make pdms-bem - the PDMS's linear BEM pull-off curve (results/pdms/bem.json, ~30 min), then make pdms"
 	@echo "make agreement - BEM vs crack-front model vs PB estimate (results/agreement/)"
 	@echo "make agreement-high-mu - its mu = 15 point (about 35 min), merged by make agreement"
 	@echo "make extremes [QUICK=1] - stability at the extremes of (n, k, rate, a0, mu)"
@@ -103,13 +104,15 @@ CFG := configs
 OUT := results
 endif
 REPRO := $(BIN)/sweep reproduce
+# worker processes of the campaigns (default: the scheduler's; JOBS=1 on a shared machine)
+JOBS ?=
 # run a sweep and its analysis, timing the whole: $(call campaign,config,dir,reproduce-cmd)
 define campaign
 	@mkdir -p $(OUT)/$(2)
 	@start=$$(date +%s); \
-	$(BIN)/sweep run $(CFG)/$(1).yaml --out $(OUT)/$(2)/runs.h5 --progress none && \
+	$(BIN)/sweep run $(CFG)/$(1).yaml --out $(OUT)/$(2)/runs.h5 --progress none $(if $(JOBS),-j $(JOBS)) && \
 	$(REPRO) $(3) $(OUT)/$(2)/runs.h5 $(OUT)/$(2) && \
-	echo "$$(( $$(date +%s) - start )) s: make $@ $(if $(QUICK),QUICK=$(QUICK))" > $(OUT)/$(2)/make_wall_s.txt && \
+	echo "$$(( $$(date +%s) - start )) s: make $@ $(if $(QUICK),QUICK=$(QUICK)) $(if $(JOBS),JOBS=$(JOBS))" > $(OUT)/$(2)/make_wall_s.txt && \
 	cat $(OUT)/$(2)/make_wall_s.txt
 endef
 
@@ -135,6 +138,11 @@ reproduce: threshold vr figures
 
 pdms: $(STAMP)
 	$(BIN)/python -m sweep.paper.pdms --out results/pdms
+
+# the linear BEM pull-off curve of the PDMS (results/pdms/bem.json, resumed; one core, about
+# 30 min on a loaded 2-core machine), then the PDMS report with it
+pdms-bem: $(STAMP)
+	$(BIN)/python -m sweep.paper.pdms --out results/pdms --bem
 
 agreement: $(STAMP)
 	$(BIN)/python -m sweep.bench.agreement --out results/agreement/agreement.json

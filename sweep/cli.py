@@ -545,6 +545,20 @@ def fit_threshold_cmd(results, slope, saturation, boot, as_json):
     click.echo(f"a0t as the h = h0 radius: A = {out['prefactor_inner']:.4g} "
                f"{_ci(out['prefactor_inner_ci'])}, B = {out['exponent_inner']:.4g}; "
                f"a0 in (R^2 dg/E0*)^(1/3): A = {out['prefactor_no_pi']:.4g}")
+    pp = out["paper_protocol"]
+    if pp is None:
+        click.echo("paper's protocol: fewer than 3 threshold points with rate >= 10^0.5 below "
+                   "0.5 x 1.5/k")
+    else:
+        click.echo(f"paper's protocol: A = {pp['A']:.4g} {_ci(pp['A_ci'])}   B = "
+                   f"{pp['B']:.4g} {_ci(pp['B_ci'])}   points = {pp['n_points']}   A (a0 in "
+                   f"(R^2 dg/E0*)^(1/3)) = {pp['A_no_pi']:.4g} {_ci(pp['A_no_pi_ci'])}")
+        click.echo(f"# paper's rule: {pp['rule']}")
+        for src in pp["sources"]:
+            click.echo(f"#   {src['choice']}: {src['paper']}")
+        click.echo("B per n (project rule | paper's protocol): " + "; ".join(
+            f"n = {a['n']:g}: {a['B']:.3g} ({a['n_points']}) | {b['B']:.3g} ({b['n_points']})"
+            for a, b in zip(out["per_n"], pp["per_n"])))
     click.echo(f"{'selection':<42} {'A':>8} {'B':>7} {'B 95 % CI':>18} {'points':>6}")
     for r in out["sensitivity"]:
         click.echo(f"{r['rule']:<42} {r['prefactor']:>8.4g} {r['exponent']:>7.4g} "
@@ -586,6 +600,17 @@ def fit_vr_cmd(results, saturation, boot, as_json):
     click.echo(f"alpha_best = {a['alpha_best']:.4g} ({a['alpha_best_over_paper']:.3f} pi/9): "
                f"RMS ln error {a['rms_log_error_best']:.4g} (pi/9: "
                f"{a['rms_log_error_paper_alpha']:.4g})")
+    click.echo("alpha_best per k: " + "; ".join(
+        f"k = {r['k']:g}: {r['alpha_best']:.4g}" for r in out["alpha_per_k"]))
+    pr = out["paper_range"]
+    click.echo(f"paper's rate range r-hat in [{pr['rate_range'][0]:g}, {pr['rate_range'][1]:g}]: "
+               f"A = {pr['prefactor']:.4g} {_ci(pr['prefactor_ci'])}, B = {pr['exponent']:.4g} "
+               f"{_ci(pr['exponent_ci'])}, points = {pr['n_points']}")
+    click.echo(f"# paper's rule: {pr['rule']}; {pr['source']}")
+    click.echo(f"{'rate':>10} {'rhat_PB':>10} {'vhat/rhat_PB':>13} {'local slope':>12}")
+    for r in out["local_slope"]:
+        click.echo(f"{r['rate']:>10.4g} {r['rhat_pb']:>10.4g} {r['v_over_r_median']:>13.3g} "
+                   f"{r['slope_median']:>12.3g}")
 
 
 def _add_reproduce() -> None:

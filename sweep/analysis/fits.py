@@ -49,12 +49,19 @@ __all__ = [
     "collapse_fit",
     "collapse_sensitivity",
     "threshold_analysis",
+    "paper_protocol_fit",
+    "per_n_fits",
+    "radius_unit_check",
     "vr_fit",
     "pb_gamma_eff_scene",
     "pb_points",
     "pb_comparison",
     "best_alpha",
     "vr_analysis",
+    "vr_paper_range",
+    "vr_local_slope",
+    "alpha_per_k",
+    "bem_power_law",
     "pb_power_law",
     "pb_regimes",
 ]
@@ -361,10 +368,187 @@ def collapse_sensitivity(table: pd.DataFrame, rules=SENSITIVITY_RULES, n_boot: i
     return out
 
 
+#: The paper's protocol of the collapse fit (section "Threshold contact radius"), each choice
+#: with the sentence of the paper it comes from (:func:`paper_protocol_fit`).
+PAPER_THRESHOLD_PROTOCOL = {
+    "min_rate": 10.0**0.5,
+    "saturation_fraction": 0.5,
+    "ordinate": "pull_off_at_a0t",
+    "radius": "a0t",
+}
+PAPER_THRESHOLD_SOURCES = (
+    ("rate >= 10^0.5", '"Notice that, the smallest unloading rate considered in our analysis is '
+     r'$\widehat{r}\approx3$ (see Fig. Threshold (b), inset) as for quasi static unloading the '
+     r'elastic solution is retrieved and $\widehat{P}_{po}$ will not depend on $\widehat{a}_{0}$."'),
+    ("P_po(a0t) < 0.5 x 1.5/k", '"they collapse for all the exponents n into a single power law '
+     r'curve that we find to be $\widehat{P}_{po}=0.3\widehat{a}_{0t}^{2.7}$ ..., which clearly '
+     r'saturates when the maximum enhancement $\widehat{P}_{po}=\widehat{P}_{JKR}/k=1.5/k$ is '
+     'reached" and "the transition from the power-law behaviour to the plateau is faster for '
+     'materials with large material exponent n": the line is fitted where the points follow '
+     'the power law, below the transition. The paper states no number for the cut; 0.5 of the '
+     'saturation is this project\'s reading (the table of cuts shows what another gives)'),
+    ("ordinate P_po at a0t", '"set the condition dP_po/da0 < 0.1 to determine a threshold '
+     'contact radius a0t, above which we considered the pull-off force is converged" and "if '
+     'the data are represented as normalized pull-off force at convergence as a function of '
+     'a0t": the pull-off where convergence is declared (the spline at a0t)'),
+)
+#: The saturation cuts of the paper protocol's sensitivity table (min rate kept at 10^0.5).
+PAPER_PROTOCOL_CUTS = (0.5, 0.6, 0.75, 0.9)
+
+
+def _fit_selected(sel: pd.DataFrame, ordinate: str, radius: str, n_boot: int, seed: int,
+                  fixed_exponent: float | None) -> dict:
+    """Power law of the selected threshold points, the same in the radius unit without pi
+    (``a0t pi^(1/3)``: (R^2 dg/E0*)^(1/3) instead of a_ref = (pi R^2 dg/E0*)^(1/3)), and the
+    prefactor at a fixed exponent (least squares of ln A alone) if one is given."""
+    x = sel[radius].to_numpy(dtype=float)
+    y = sel[ordinate].to_numpy(dtype=float)
+    fit = power_law_fit(x, y, n_boot=n_boot, seed=seed)
+    no_pi = power_law_fit(x * math.pi ** (1.0 / 3.0), y, n_boot=n_boot, seed=seed)
+    out = {"A": fit["prefactor"], "B": fit["exponent"], "A_ci": fit["prefactor_ci"],
+           "B_ci": fit["exponent_ci"], "A_no_pi": no_pi["prefactor"],
+           "A_no_pi_ci": no_pi["prefactor_ci"], "n_points": fit["n_points"],
+           "rms_log_residual": fit["rms_log_residual"]}
+    if fixed_exponent is not None:
+        b = float(fixed_exponent)
+        out["B_fixed"] = b
+        out["A_at_B_fixed"] = float(np.exp(np.mean(np.log(y) - b * np.log(x))))
+        out["A_no_pi_at_B_fixed"] = out["A_at_B_fixed"] * math.pi ** (-b / 3.0)
+    return out
+
+
+def per_n_fits(table: pd.DataFrame, saturation_fraction: float, min_rate: float = 0.0,
+               ordinate: str = "pull_off_at_a0t", n_boot: int = N_BOOT,
+               seed: int = 0) -> list[dict]:
+    """The collapse fit of each material exponent n alone, with the selection of
+    :func:`collapse_fit`: one dict per n (``n``, ``A``, ``B``, ``A_ci``, ``B_ci``,
+    ``n_points``); an n with fewer than 3 points (or 2 distinct radii) gives NaN."""
+    sel = _collapse_points(table, saturation_fraction, min_rate, ordinate, "a0t")
+    out = []
+    for n in sorted(table["n"].unique()):
+        g = sel[sel["n"] == n]
+        try:
+            f = power_law_fit(g["a0t"], g[ordinate], n_boot=n_boot, seed=seed)
+            out.append({"n": float(n), "A": f["prefactor"], "B": f["exponent"],
+                        "A_ci": f["prefactor_ci"], "B_ci": f["exponent_ci"],
+                        "n_points": f["n_points"]})
+        except InputError:
+            out.append({"n": float(n), "A": math.nan, "B": math.nan, "A_ci": None,
+                        "B_ci": None, "n_points": int(len(g))})
+    return out
+
+
+def paper_protocol_fit(table: pd.DataFrame, protocol: dict | None = None,
+                       paper_exponent: float | None = None, n_boot: int = N_BOOT,
+                       seed: int = 0) -> dict:
+    r"""The collapse fit ``P_po = A a0t^B`` under the paper's protocol.
+
+    The selection (:data:`PAPER_THRESHOLD_PROTOCOL`, sources in
+    :data:`PAPER_THRESHOLD_SOURCES`): interior thresholds (as :func:`collapse_fit`), rates
+    ``r-hat >= 10^0.5`` (the paper: "the smallest unloading rate considered in our analysis
+    is r-hat ~ 3"), pull-off at a0t below ``0.5 x 1.5/k`` (the power law below its
+    saturation; the cut itself is this project's reading).
+
+    Parameters
+    ----------
+    table : DataFrame
+        :func:`threshold_table` output.
+    protocol : dict, optional
+        Overrides of :data:`PAPER_THRESHOLD_PROTOCOL` (``min_rate``, ``saturation_fraction``,
+        ``ordinate``, ``radius``).
+    paper_exponent : float, optional
+        An exponent at which the prefactor is also fitted alone (``A_at_B_fixed``; the report
+        passes the paper's 2.7).
+
+    Returns
+    -------
+    dict
+        ``A``, ``B``, ``A_ci``, ``B_ci`` (95 % bootstrap), ``A_no_pi`` (+ ``_ci``: A with a0t
+        in (R^2 dg/E0*)^(1/3), i.e. ``A pi^(-B/3)``), ``n_points``, ``rms_log_residual``,
+        ``rule`` (text), ``sources`` (the paper's sentences), the selection values,
+        ``per_n`` (:func:`per_n_fits` under the same rule), ``cuts`` (the fit at each
+        saturation cut of :data:`PAPER_PROTOCOL_CUTS` and with the plateau pull-off as
+        ordinate), and with ``paper_exponent`` ``A_at_B_fixed``, ``A_no_pi_at_B_fixed``.
+    """
+    p = {**PAPER_THRESHOLD_PROTOCOL, **(protocol or {})}
+    frac = check_positive("saturation_fraction", p["saturation_fraction"])
+    min_rate = float(p["min_rate"])
+    sel = _collapse_points(table, frac, min_rate, p["ordinate"], p["radius"])
+    out = _fit_selected(sel, p["ordinate"], p["radius"], n_boot, seed, paper_exponent)
+    out["rule"] = (f"the project's a0t (first a0 where the spline through P_po(a0) has "
+                   f"dP_po/da0 < 0.1, interior crossings); points with rate r-hat >= "
+                   f"{min_rate:.4g} and {p['ordinate']} < {frac:g} x 1.5/k; least squares in "
+                   f"log-log; 95 % percentile intervals from {n_boot} bootstrap resamples")
+    out["sources"] = [{"choice": c, "paper": q} for c, q in PAPER_THRESHOLD_SOURCES]
+    out.update(min_rate=min_rate, saturation_fraction=frac, ordinate=p["ordinate"],
+               radius=p["radius"])
+    out["per_n"] = per_n_fits(table, frac, min_rate, p["ordinate"], n_boot, seed)
+    cuts = []
+    for ordinate in ("pull_off_at_a0t", "pull_off_plateau"):
+        for c in PAPER_PROTOCOL_CUTS:
+            row = {"ordinate": ordinate, "saturation_fraction": c, "min_rate": min_rate}
+            try:
+                f = _fit_selected(_collapse_points(table, c, min_rate, ordinate, p["radius"]),
+                                  ordinate, p["radius"], n_boot, seed, None)
+                row.update({key: f[key] for key in ("A", "B", "A_ci", "B_ci", "A_no_pi",
+                                                    "n_points")})
+            except InputError:
+                row.update(A=math.nan, B=math.nan, A_ci=None, B_ci=None, A_no_pi=math.nan,
+                           n_points=0)
+            cuts.append(row)
+    out["cuts"] = cuts
+    return out
+
+
+def radius_unit_check(table: pd.DataFrame, prefactor: float, exponent: float,
+                      saturation_fraction: float = 0.6, min_rate: float = 0.0) -> dict:
+    r"""Which radius a published line ``P = prefactor a^exponent`` gives for our pull-offs.
+
+    For each interior threshold point with ``P_po(a0t) < saturation_fraction x 1.5/k`` the
+    radius of the line at the same pull-off, ``a_line = (P/prefactor)^(1/exponent)``, is
+    compared with our ``a0t``: a constant ratio ``a_line / a0t`` says the two differ by a
+    unit (``pi^(1/3) = 1.465`` is the ratio of a_ref = (pi R^2 dg/E0*)^(1/3) to
+    (R^2 dg/E0*)^(1/3)); a constant difference ``a_line - a0t`` would say an offset. Both are
+    reported with their spread and a straight line ``a_line = c0 + c1 a0t`` through the
+    points. An inference, not a measurement of the paper's unit.
+
+    Returns
+    -------
+    dict
+        ``n_points``, ``ratio_mean``, ``ratio_std``, ``ratio_min``, ``ratio_max``,
+        ``pi_cbrt``, ``offset_min``, ``offset_max``, ``line_intercept``, ``line_slope``,
+        the inputs.
+    """
+    prefactor = check_positive("prefactor", prefactor)
+    exponent = check_positive("exponent", exponent)
+    sel = _collapse_points(table, saturation_fraction, min_rate, "pull_off_at_a0t", "a0t")
+    if len(sel) < 3:
+        raise InputError("radius_unit_check needs at least 3 threshold points below the cut")
+    a = sel["a0t"].to_numpy(dtype=float)
+    a_line = (sel["pull_off_at_a0t"].to_numpy(dtype=float) / prefactor) ** (1.0 / exponent)
+    ratio, offset = a_line / a, a_line - a
+    slope, icept = np.polyfit(a, a_line, 1)
+    return {"n_points": int(a.size), "ratio_mean": float(ratio.mean()),
+            "ratio_std": float(ratio.std(ddof=1)), "ratio_min": float(ratio.min()),
+            "ratio_max": float(ratio.max()), "pi_cbrt": math.pi ** (1.0 / 3.0),
+            "offset_min": float(offset.min()), "offset_max": float(offset.max()),
+            "line_intercept": float(icept), "line_slope": float(slope),
+            "a0t_range": [float(a.min()), float(a.max())],
+            "prefactor": prefactor, "exponent": exponent,
+            "saturation_fraction": float(saturation_fraction)}
+
+
 def threshold_analysis(df: pd.DataFrame, slope: float = THRESHOLD_SLOPE,
                        saturation_fraction: float = SATURATION_FRACTION,
-                       n_boot: int = N_BOOT, seed: int = 0) -> dict:
+                       n_boot: int = N_BOOT, seed: int = 0,
+                       paper_fit: tuple[float, float] | None = None) -> dict:
     """Everything ``fit.json`` of the threshold campaign holds, from its runs table.
+
+    The project's rule (:data:`SENSITIVITY_RULES` [0]) gives the headline numbers; the
+    paper's protocol (:func:`paper_protocol_fit`) is beside it in ``paper_protocol``. With
+    ``paper_fit`` (A, B) of a published line, ``paper_protocol`` also holds the prefactor at
+    the published exponent and ``radius_unit`` the radius-unit check
+    (:func:`radius_unit_check`) of that line against these points.
 
     Returns
     -------
@@ -373,9 +557,12 @@ def threshold_analysis(df: pd.DataFrame, slope: float = THRESHOLD_SLOPE,
         ``rms_log_residual`` (chosen rule: :data:`SENSITIVITY_RULES` [0]), ``rule`` (text),
         ``prefactor_inner`` (+ ``_ci``, ``exponent_inner``: the same points with a0t the
         h = h0 radius), ``prefactor_no_pi`` (A for a0 in (R^2 dg/E0*)^(1/3), i.e.
-        ``A pi^(-B/3)``), ``sensitivity`` (:func:`collapse_sensitivity`), ``table`` (rows
-        of n, rate, a0t, P_at_a0t, ...), ``overshoots`` (groups whose spline peak exceeds
-        the largest-a0 pull-off by more than 5 %), ``scenes``, ``failed``.
+        ``A pi^(-B/3)``), ``sensitivity`` (:func:`collapse_sensitivity`), ``per_n`` (the
+        chosen rule per n, :func:`per_n_fits`), ``paper_protocol``
+        (:func:`paper_protocol_fit`), ``radius_unit`` (with ``paper_fit``), ``table``
+        (rows of n, rate, a0t, P_at_a0t, ..., ``in_fit``, ``in_paper_fit``),
+        ``overshoots`` (groups whose spline peak exceeds the largest-a0 pull-off by more
+        than 5 %), ``scenes``, ``failed``.
     """
     table = threshold_table(df, slope)
     fit = collapse_fit(table, saturation_fraction, 0.0, "pull_off_at_a0t", "a0t", n_boot, seed)
@@ -396,8 +583,27 @@ def threshold_analysis(df: pd.DataFrame, slope: float = THRESHOLD_SLOPE,
                         and r.pull_off_at_a0t < saturation_fraction * r.saturation)}
         for r in table.itertuples()
     ]
+    try:
+        paper = paper_protocol_fit(table, paper_exponent=None if paper_fit is None
+                                   else paper_fit[1], n_boot=n_boot, seed=seed)
+        pp = _collapse_points(table, paper["saturation_fraction"], paper["min_rate"],
+                              paper["ordinate"], paper["radius"])
+        in_paper = set(zip(pp["n"], pp["rate"]))
+    except InputError:           # fewer than 3 points under the paper's protocol
+        paper, in_paper = None, set()
+    for row in table_rows:
+        row["in_paper_fit"] = (row["n"], row["rate"]) in in_paper
+    extra = {}
+    if paper_fit is not None:
+        try:
+            extra["radius_unit"] = radius_unit_check(table, *paper_fit)
+        except InputError:
+            extra["radius_unit"] = None
     over = table[table["overshoot"] > 0.05]
     return {
+        **extra,
+        "per_n": per_n_fits(table, saturation_fraction, 0.0, "pull_off_at_a0t", n_boot, seed),
+        "paper_protocol": paper,
         "prefactor": fit["prefactor"], "exponent": fit["exponent"],
         "prefactor_ci": fit["prefactor_ci"], "exponent_ci": fit["exponent_ci"],
         "n_points": fit["n_points"], "rms_log_residual": fit["rms_log_residual"],
@@ -536,6 +742,152 @@ def best_alpha(df: pd.DataFrame, bounds=(0.05, 2.0)) -> dict:
             "error_measure": "RMS of ln(Gamma_BEM / Gamma_PB(vhat(alpha))) over MPL scenes"}
 
 
+#: The paper's rate grid, r-hat = r tau0/h0 in [10^0, 10^6] (:func:`vr_paper_range`), and the
+#: sentence it comes from.
+PAPER_VR_RATE_RANGE = (1.0, 1.0e6)
+PAPER_VR_SOURCE = (
+    r'"every marker shown corresponds to the threshold contact radius obtained for that '
+    r'material exponent n and at that given normalized unloading rate $\widehat{r} \in '
+    r'[10^0,10^6]$" (section "Threshold contact radius"); the v-r section states no range of '
+    r'its own ("scales approximately as v = 2.887 r_PB^1.171 over about 10 orders of magnitude '
+    r'in term of unloading rate"), and Fig. r_v shows "the same simulations results" for '
+    r'n = [0.4, 0.6, 0.8, 1.6] and k = [0.01, 0.05, 0.1], saturated points included')
+#: Further rate ranges of the v-r sensitivity rows (r-hat, inclusive).
+VR_RANGES = ((1.0, 1.0e4), (0.1, 1.0e6))
+
+
+def vr_paper_range(df: pd.DataFrame, rate_range=PAPER_VR_RATE_RANGE,
+                   alpha: float = units.ALPHA_PB, n_boot: int = N_BOOT, seed: int = 0) -> dict:
+    r"""``vhat = A rhat_PB^B`` over the finished MPL scenes whose rate r-hat lies in
+    ``rate_range`` (default the paper's grid [1, 1e6], :data:`PAPER_VR_SOURCE`), all k and n,
+    saturated points included as in the paper's Fig. r_v.
+
+    Returns
+    -------
+    dict
+        ``prefactor``, ``exponent``, ``prefactor_ci``, ``exponent_ci``, ``n_points``,
+        ``rms_log_residual``, ``rate_range``, ``rule`` (text), ``source`` (the paper's
+        sentence) and ``ranges``: the same fit over each range of :data:`VR_RANGES`.
+    """
+    lo, hi = (float(x) for x in rate_range)
+    if not 0.0 < lo < hi:
+        raise InputError(f"rate_range must be two rates 0 < lo < hi (got {rate_range!r})")
+    d = _vr_points(df, alpha)
+
+    def fit_in(lo_, hi_):
+        r = d["rate"].to_numpy(dtype=float)
+        sel = d[(r >= lo_ * (1 - 1e-9)) & (r <= hi_ * (1 + 1e-9))]
+        return power_law_fit(sel["rhat_pb"], sel["vhat"], n_boot, seed)
+
+    fit = fit_in(lo, hi)
+    ranges = []
+    for lo_, hi_ in VR_RANGES:
+        try:
+            f = fit_in(lo_, hi_)
+            ranges.append({"rate_range": [lo_, hi_], **{key: f[key] for key in (
+                "prefactor", "exponent", "prefactor_ci", "exponent_ci", "n_points")}})
+        except InputError:
+            continue
+    return {**fit, "rate_range": [lo, hi],
+            "rule": (f"finished MPL scenes (every n and k of the campaign) with rate r-hat = r "
+                     f"tau0/h0 in [{lo:g}, {hi:g}], saturated ones included; vhat = A "
+                     f"rhat_PB^B by least squares in log-log, rhat_PB = rate * h0; 95 % "
+                     f"percentile intervals from {n_boot} bootstrap resamples"),
+            "source": PAPER_VR_SOURCE, "ranges": ranges}
+
+
+def vr_local_slope(df: pd.DataFrame, alpha: float = units.ALPHA_PB) -> list[dict]:
+    r"""How far the v-r data are from one power law: the local slope ``d ln vhat / d ln
+    rhat_PB`` between neighbouring rates of each (n, k) MPL group, and ``vhat / rhat_PB``.
+
+    Returns
+    -------
+    list of dict
+        One row per rate of the campaign (ascending): ``rate``, ``rhat_pb``, ``v_over_r``
+        (median, min, max over the groups of vhat/rhat_PB at that rate) and, from the second
+        rate on, ``slope`` (median, min, max over the groups of the local slope between this
+        rate and the one below), ``n_groups``.
+    """
+    d = _vr_points(df, alpha)
+    rates = np.sort(d["rate"].unique())
+    slopes = {}
+    for _, g in d.groupby(["n", "k"]):
+        g = g.sort_values("rate")
+        r = g["rate"].to_numpy(dtype=float)
+        lr, lv = np.log(g["rhat_pb"].to_numpy(dtype=float)), np.log(g["vhat"].to_numpy(dtype=float))
+        for i in range(1, r.size):
+            slopes.setdefault(float(r[i]), []).append(float((lv[i] - lv[i - 1])
+                                                           / (lr[i] - lr[i - 1])))
+    out = []
+    for rate in rates:
+        g = d[d["rate"] == rate]
+        ratio = (g["vhat"] / g["rhat_pb"]).to_numpy(dtype=float)
+        row = {"rate": float(rate), "rhat_pb": float(g["rhat_pb"].iloc[0]),
+               "v_over_r_median": float(np.median(ratio)), "v_over_r_min": float(ratio.min()),
+               "v_over_r_max": float(ratio.max()), "n_groups": int(len(g))}
+        s = slopes.get(float(rate))
+        row.update(slope_median=float(np.median(s)) if s else math.nan,
+                   slope_min=float(np.min(s)) if s else math.nan,
+                   slope_max=float(np.max(s)) if s else math.nan)
+        out.append(row)
+    return out
+
+
+def alpha_per_k(df: pd.DataFrame) -> list[dict]:
+    """:func:`best_alpha` of each k of the v-r campaign alone (the paper: alpha ~ pi/9
+    "independently on the ratio rubbery to glassy modulus k"). One dict per k: ``k``,
+    ``alpha_best``, ``alpha_best_over_paper``, ``rms_log_error_best``,
+    ``rms_log_error_paper_alpha``, ``n_points``."""
+    d = _vr_points(df, units.ALPHA_PB)
+    out = []
+    for k in sorted(d["k"].unique()):
+        sub = df[(df["k"] == k) & (df["material"] == "mpl")]
+        try:
+            a = best_alpha(sub)
+        except InputError:
+            continue
+        out.append({"k": float(k), "alpha_best": a["alpha_best"],
+                    "alpha_best_over_paper": a["alpha_best_over_paper"],
+                    "rms_log_error_best": a["rms_log_error_best"],
+                    "rms_log_error_paper_alpha": a["rms_log_error_paper_alpha"],
+                    "n_points": int((d["k"] == k).sum())})
+    return out
+
+
+def bem_power_law(df: pd.DataFrame, k: float = 0.1, lo: float = 0.25, hi: float = 0.75,
+                  alpha: float = units.ALPHA_PB, n_boot: int = N_BOOT,
+                  seed: int = 0) -> list[dict]:
+    r"""``Gamma_eff = beta vhat^m`` fitted to the BEM points of each n at ``k`` (the paper's
+    Fig. PB_BEM inset, there fitted to the PB curve; here to our runs).
+
+    The points are the finished MPL scenes at ``k`` whose ``Gamma_eff = P_po/1.5`` lies in
+    the intermediate range ``[(1/k)^lo, (1/k)^hi]`` (the range :func:`pb_power_law` fits the PB
+    curve over); least squares in log-log.
+
+    Returns
+    -------
+    list of dict
+        Per n: ``n``, ``beta``, ``m`` (+ ``_ci``, bootstrap), ``n_points``, ``vhat_range``;
+        an n with fewer than 3 points in the range gives NaN.
+    """
+    d = _vr_points(df, alpha)
+    d = d[np.isclose(d["k"].to_numpy(dtype=float), k)]
+    g_lo, g_hi = (1.0 / k) ** lo, (1.0 / k) ** hi
+    out = []
+    for n in sorted(d["n"].unique()):
+        g = d[(d["n"] == n) & (d["gamma_eff"] >= g_lo) & (d["gamma_eff"] <= g_hi)]
+        row = {"n": float(n), "k": float(k), "n_points": int(len(g))}
+        try:
+            f = power_law_fit(g["vhat"], g["gamma_eff"], n_boot=n_boot, seed=seed)
+            row.update(beta=f["prefactor"], m=f["exponent"], beta_ci=f["prefactor_ci"],
+                       m_ci=f["exponent_ci"],
+                       vhat_range=[float(g["vhat"].min()), float(g["vhat"].max())])
+        except InputError:
+            row.update(beta=math.nan, m=math.nan, beta_ci=None, m_ci=None, vhat_range=None)
+        out.append(row)
+    return out
+
+
 def vr_analysis(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTION,
                 n_boot: int = N_BOOT, seed: int = 0,
                 paper_fit: tuple[float, float] | None = None) -> dict:
@@ -549,7 +901,10 @@ def vr_analysis(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTI
         ``pb_share_within_15pct`` (Gamma_PB at the measured vhat), ``pb_vs_bem`` (both ways
         of :func:`pb_comparison` with this fit, plus ``predicted_paper_fit`` if ``paper_fit``
         (A, B) is given), ``alpha_best`` (:func:`best_alpha`) and its details, ``scenes``,
-        ``failed``.
+        ``failed``; beside them ``paper_range`` (the fit over the paper's rate grid,
+        :func:`vr_paper_range`), ``local_slope`` (:func:`vr_local_slope`), ``alpha_per_k``
+        (:func:`alpha_per_k`) and ``bem_power_law`` (beta, m of the BEM points,
+        :func:`bem_power_law`).
     """
     fits = vr_fit(df, saturation_fraction, n_boot=n_boot, seed=seed)
     a = fits["all"]
@@ -559,6 +914,10 @@ def vr_analysis(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTI
         comp["predicted_paper_fit"] = comp_p["predicted"]
     alpha = best_alpha(df)
     return {
+        "paper_range": vr_paper_range(df, n_boot=n_boot, seed=seed),
+        "local_slope": vr_local_slope(df),
+        "alpha_per_k": alpha_per_k(df),
+        "bem_power_law": bem_power_law(df, n_boot=n_boot, seed=seed),
         "prefactor": a["prefactor"], "exponent": a["exponent"],
         "prefactor_ci": a["prefactor_ci"], "exponent_ci": a["exponent_ci"],
         "n_points": a["n_points"], "rms_log_residual": a["rms_log_residual"],

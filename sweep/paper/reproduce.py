@@ -104,10 +104,17 @@ def threshold_cmd(runs, outdir):
     from .figures import threshold_figure
 
     p = _paper()["threshold_radius"]["collapse_fit"]
-    df, fit, out = _fit_campaign(runs, outdir, analysis.threshold_analysis)
-    threshold_figure(df, fit, out / "threshold.png", paper=(p["prefactor"], p["exponent"]))
+    paper = (float(p["prefactor"]), float(p["exponent"]))
+    df, fit, out = _fit_campaign(runs, outdir,
+                                 lambda d: analysis.threshold_analysis(d, paper_fit=paper))
+    threshold_figure(df, fit, out / "threshold.png", paper=paper)
+    pp = fit["paper_protocol"]
+    paper_text = ("paper protocol: fewer than 3 points" if pp is None else
+                  f"paper protocol: A = {pp['A']:.4g} {pp['A_ci']}, B = {pp['B']:.4g} "
+                  f"{pp['B_ci']}, A_no_pi = {pp['A_no_pi']:.4g}, {pp['n_points']} points")
     click.echo(f"{out / 'fit.json'}: A = {fit['prefactor']:.4g} {fit['prefactor_ci']}, "
-               f"B = {fit['exponent']:.4g} {fit['exponent_ci']}, {fit['n_points']} points")
+               f"B = {fit['exponent']:.4g} {fit['exponent_ci']}, {fit['n_points']} points; "
+               f"{paper_text}")
 
 
 @cli.command("vr")
@@ -127,9 +134,11 @@ def vr_cmd(runs, outdir):
     # PB against the BEM, the SLS scenes included as in the paper's figure
     cpts = analysis.pb_points(pts[pts["vhat"] > 0], fit["prefactor"], fit["exponent"])
     pb_vs_bem_figure(cpts, fit["pb_vs_bem"], out / "pb_vs_bem.png")
+    pr = fit["paper_range"]
     click.echo(f"{out / 'fit.json'}: vhat = {fit['prefactor']:.4g} rhat_PB^{fit['exponent']:.4g}, "
                f"PB within 15 %: {fit['pb_share_within_15pct']:.3f}, "
-               f"alpha_best = {fit['alpha_best']:.4g}")
+               f"alpha_best = {fit['alpha_best']:.4g}; paper's rate range "
+               f"{pr['rate_range']}: vhat = {pr['prefactor']:.4g} rhat_PB^{pr['exponent']:.4g}")
 
 
 @cli.command("fig3")

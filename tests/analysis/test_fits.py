@@ -243,7 +243,9 @@ def test_cli_fit_threshold_and_vr(tmp_path, capsys):
         assert key in out
     assert out["exponent"] == pytest.approx(2.7, abs=1e-2)
     assert main(["fit", "threshold", str(tpath), "--boot", "0"]) == 0
-    assert "P_po = A a0t^B" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "P_po = A a0t^B" in text and "paper's protocol: A = " in text
+    assert "smallest unloading rate considered" in text and "B per n" in text
 
     vpath = tmp_path / "vr.h5"
     write_results(vpath, synthetic_vr_runs())
@@ -254,7 +256,9 @@ def test_cli_fit_threshold_and_vr(tmp_path, capsys):
         assert key in out
     assert out["exponent"] == pytest.approx(1.1, rel=1e-9)
     assert main(["fit", "vr", str(vpath)]) == 0
-    assert "alpha_best" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "alpha_best" in text and "alpha_best per k: k = 0.05" in text
+    assert "paper's rate range r-hat in [1, 1e+06]: A = 3 " in text and "local slope" in text
 
 
 @pytest.mark.parametrize("args, word", [
@@ -276,3 +280,167 @@ def test_cli_fit_bad_input_one_line_exit_2(tmp_path, capsys, args, word):
     err = capsys.readouterr().err.strip()
     assert err.startswith("error: ") and word in err and "\n" not in err
     assert thr.read_bytes() == before
+
+
+# ------------------------------------------------------------------ the paper's protocols
+def protocol_table():
+    """A threshold table whose points on the paper's protocol (rate >= 10^0.5, P(a0t) below
+    0.5 x 1.5/k = 7.5) lie exactly on P = 0.3 a0t^2.7, while the slow rates (r-hat = 1) sit
+    20 % high and the points near the plateau 5 % low (the bend toward saturation)."""
+    rows = []
+    for n, radii in ((0.4, (1.6, 2.0, 2.4, 2.7)), (1.6, (1.8, 2.2, 2.6, 3.4, 4.0))):
+        for j, a in enumerate(radii):
+            for rate in (1.0, 10.0 ** (0.5 + j)):
+                p = 0.3 * a**2.7
+                if rate < 3.0:
+                    p *= 1.2
+                elif p > 7.5:
+                    p *= 0.95
+                rows.append({"material": "mpl", "n": n, "k": 0.1, "mu": 3.24, "rate": rate,
+                             "a0t": a, "pull_off_at_a0t": p, "pull_off_plateau": 1.02 * p,
+                             "a0t_inner": 0.8 * a, "status": "interior", "saturation": 15.0})
+    rows.append({**rows[0], "status": "at_lower_edge", "pull_off_at_a0t": 99.0})
+    return pd.DataFrame(rows)
+
+
+def test_paper_protocol_recovers_the_line_its_rule_selects():
+    table = protocol_table()
+    pp = an.paper_protocol_fit(table, paper_exponent=2.7, n_boot=200)
+    # kept: rate >= 10^0.5 and P < 7.5: n = 0.4 radii 1.6..2.7 (P <= 4.4), n = 1.6 radii
+    # 1.8, 2.2, 2.6 (P(3.4) = 0.95 x 8.16 = 7.75 > 7.5 is dropped): 7 points, on the line
+    assert pp["n_points"] == 7
+    assert pp["A"] == pytest.approx(0.3, rel=1e-10) and pp["B"] == pytest.approx(2.7, rel=1e-10)
+    assert pp["B_ci"][1] - pp["B_ci"][0] < 1e-8
+    # the radius in (R^2 dg/E0*)^(1/3) is a_ref / pi^(1/3) ... times pi^(1/3) larger
+    assert pp["A_no_pi"] == pytest.approx(0.3 * math.pi ** (-2.7 / 3), rel=1e-10)
+    assert pp["A_at_B_fixed"] == pytest.approx(0.3, rel=1e-10)
+    assert pp["A_no_pi_at_B_fixed"] == pytest.approx(0.3 * math.pi ** -0.9, rel=1e-10)
+    assert [s["choice"] for s in pp["sources"]][0] == "rate >= 10^0.5"
+    assert "smallest unloading rate considered" in pp["sources"][0]["paper"]
+    # per n under the same rule: both n on the line
+    per_n = {r["n"]: r for r in pp["per_n"]}
+    assert per_n[0.4]["B"] == pytest.approx(2.7, rel=1e-10) and per_n[0.4]["n_points"] == 4
+    assert per_n[1.6]["B"] == pytest.approx(2.7, rel=1e-10) and per_n[1.6]["n_points"] == 3
+    # the project's rule keeps the slow and the bent points: another line
+    proj = an.collapse_fit(table, 0.9, n_boot=0)
+    assert proj["n_points"] > pp["n_points"] and abs(proj["exponent"] - 2.7) > 0.05
+    # the cuts table: the 0.9 cut at rate >= 10^0.5 takes the bent points (7.75, 12.0 < 13.5)
+    cut = {(r["ordinate"], r["saturation_fraction"]): r for r in pp["cuts"]}
+    assert cut[("pull_off_at_a0t", 0.5)]["B"] == pytest.approx(pp["B"], rel=1e-12)
+    assert cut[("pull_off_at_a0t", 0.9)]["B"] < 2.65
+    # the plateau ordinate 1.02 P: same exponent, prefactor 1.02 x
+    assert cut[("pull_off_plateau", 0.5)]["A"] == pytest.approx(0.306, rel=1e-9)
+    with pytest.raises(InputError, match="saturation_fraction"):
+        an.paper_protocol_fit(table, protocol={"saturation_fraction": 0.0})
+
+
+def test_radius_unit_check_tells_a_factor_from_an_offset():
+    table = protocol_table()
+    table = table[table["rate"] > 3].copy()
+    a = table["a0t"].to_numpy()
+    # a line in a unit pi^(1/3) smaller: the same pull-offs at radii pi^(1/3) a0t
+    table["pull_off_at_a0t"] = 0.3 * (math.pi ** (1 / 3) * a) ** 2.7
+    res = an.radius_unit_check(table, 0.3, 2.7, saturation_fraction=10.0)
+    assert res["ratio_mean"] == pytest.approx(math.pi ** (1 / 3), rel=1e-12)
+    assert res["ratio_std"] < 1e-12 and res["line_intercept"] == pytest.approx(0.0, abs=1e-9)
+    assert res["offset_max"] - res["offset_min"] > 0.5
+    # an additive offset of 0.5: constant difference, a ratio that falls with a0t
+    table["pull_off_at_a0t"] = 0.3 * (a + 0.5) ** 2.7
+    res = an.radius_unit_check(table, 0.3, 2.7, saturation_fraction=10.0)
+    assert res["offset_min"] == pytest.approx(0.5, rel=1e-10)
+    assert res["offset_max"] == pytest.approx(0.5, rel=1e-10)
+    assert res["ratio_std"] > 0.02 and res["line_slope"] == pytest.approx(1.0, rel=1e-10)
+    with pytest.raises(InputError, match="prefactor"):
+        an.radius_unit_check(table, -1.0, 2.7)
+
+
+def test_threshold_analysis_carries_both_protocols():
+    out = an.threshold_analysis(synthetic_threshold_runs(), n_boot=50, paper_fit=(0.3, 2.7))
+    pp = out["paper_protocol"]
+    for key in ("A", "B", "A_ci", "B_ci", "A_no_pi", "n_points", "rule", "per_n", "cuts"):
+        assert key in pp
+    # synthetic thresholds on P = 0.3 a0t^2.7: both rules find the line; the paper's keeps
+    # rates >= 10^0.5 (groups j >= 1) with P < 7.5 (a_t = 2.0 .. 3.2): 4 groups x 2 n
+    assert pp["n_points"] == 8 and pp["B"] == pytest.approx(2.7, abs=1e-2)
+    assert sum(r["in_paper_fit"] for r in out["table"]) == pp["n_points"]
+    assert out["radius_unit"]["ratio_mean"] == pytest.approx(1.0, abs=2e-3)
+    assert {r["n"] for r in out["per_n"]} == {0.4, 1.6}
+    json.dumps(out)
+
+
+def two_law_vr_runs():
+    """vhat = 3 rhat^1.1 for rate >= 1 and 5 rhat^1 below (the slow points the paper's grid
+    does not have)."""
+    df = synthetic_vr_runs()
+    rhat = units.rhat_pb(df["rate"].to_numpy(), 3.24)
+    slow = df["rate"].to_numpy() < 1 - 1e-9
+    vhat = np.where(slow, 5.0 * rhat, 3.0 * rhat**1.1)
+    df["crack_speed"] = vhat * units.l0_hat(3.24)
+    return df
+
+
+def test_vr_paper_range_keeps_the_paper_rates_only():
+    df = two_law_vr_runs()
+    pr = an.vr_paper_range(df, n_boot=50)
+    # rates 10^(-1 + j/2): j >= 2 are >= 1: 13 of 15 rates x 4 groups
+    assert pr["n_points"] == 52 and pr["rate_range"] == [1.0, 1e6]
+    assert pr["prefactor"] == pytest.approx(3.0, rel=1e-10)
+    assert pr["exponent"] == pytest.approx(1.1, rel=1e-10)
+    everything = an.vr_fit(df, n_boot=0)["all"]
+    assert abs(everything["exponent"] - 1.1) > 0.01
+    ranges = {tuple(r["rate_range"]): r for r in pr["ranges"]}
+    assert ranges[(1.0, 1e4)]["exponent"] == pytest.approx(1.1, rel=1e-10)
+    assert ranges[(0.1, 1e6)]["n_points"] == 60
+    assert "10^0,10^6" in pr["source"]
+    with pytest.raises(InputError, match="rate_range"):
+        an.vr_paper_range(df, rate_range=(10.0, 1.0))
+
+
+def test_vr_local_slope_and_ratio():
+    ls = an.vr_local_slope(two_law_vr_runs())
+    assert len(ls) == 15 and math.isnan(ls[0]["slope_median"])
+    rhat = [r["rhat_pb"] for r in ls]
+    for i, r in enumerate(ls):
+        if r["rate"] >= 1.0 - 1e-9:
+            assert r["v_over_r_median"] == pytest.approx(3.0 * rhat[i] ** 0.1, rel=1e-10)
+        if r["rate"] > 1.0 + 1e-9:           # both neighbours on the 3 rhat^1.1 law
+            assert r["slope_median"] == pytest.approx(1.1, rel=1e-10)
+            assert r["slope_max"] == pytest.approx(1.1, rel=1e-10)
+    assert ls[1]["slope_median"] == pytest.approx(1.0, rel=1e-10)    # on 5 rhat
+    assert ls[0]["v_over_r_median"] == pytest.approx(5.0, rel=1e-10)
+
+
+def test_alpha_per_k_recovers_each_k():
+    a = synthetic_vr_runs(alpha_true=0.5)
+    b = synthetic_vr_runs(alpha_true=units.ALPHA_PB)
+    df = pd.concat([a[a["k"] == 0.05], b[b["k"] == 0.1]], ignore_index=True)
+    rows = {r["k"]: r for r in an.alpha_per_k(df)}
+    assert rows[0.05]["alpha_best"] == pytest.approx(0.5, rel=1e-3)
+    assert rows[0.1]["alpha_best"] == pytest.approx(units.ALPHA_PB, rel=1e-3)
+    assert rows[0.05]["n_points"] == 30
+
+
+def test_bem_power_law_of_points_on_a_power_law():
+    rows = []
+    for n, (beta, m) in ((0.4, (1.5, 0.2)), (1.6, (2.5, 0.3))):
+        for vhat in np.logspace(-1, 4, 21):
+            rows.append({"material": "mpl", "n": n, "k": 0.1, "mu": 3.24, "rate": 1.0,
+                         "status": "ok", "crack_speed": vhat * units.l0_hat(3.24),
+                         "pull_off": 1.5 * min(beta * vhat**m, 12.0)})
+    res = {r["n"]: r for r in an.bem_power_law(pd.DataFrame(rows))}
+    # Gamma in [10^0.25, 10^0.75] = [1.78, 5.62]: on the power law, below the cap 12
+    assert res[0.4]["beta"] == pytest.approx(1.5, rel=1e-9)
+    assert res[0.4]["m"] == pytest.approx(0.2, rel=1e-9)
+    assert res[1.6]["beta"] == pytest.approx(2.5, rel=1e-9)
+    assert res[1.6]["m"] == pytest.approx(0.3, rel=1e-9)
+    assert res[1.6]["n_points"] >= 3
+
+
+def test_threshold_analysis_without_enough_points_for_the_paper_protocol():
+    # only the groups at rates 1 and 10: the paper's protocol keeps rate 10 (a_t = 2.0 for
+    # both n), 2 points: no fit; the project's rule keeps all 4
+    df = synthetic_threshold_runs()
+    df = df[df["rate"] <= 10.0]
+    out = an.threshold_analysis(df, n_boot=0)
+    assert out["paper_protocol"] is None and out["n_points"] == 4
+    assert not any(r["in_paper_fit"] for r in out["table"])

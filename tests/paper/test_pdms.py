@@ -179,3 +179,76 @@ def test_full_amplification_at_the_pdms_k_against_the_small_tau_asymptote():
     c = ((1.0 / f - 1.0) * k / (1.0 - k) * math.gamma(n) / J) ** (1.0 / n)
     assert full_amplification_vhat(n, k, f) == pytest.approx(f / k / (2 * math.pi * c),
                                                               rel=1e-4)
+
+
+def fake_bem(speeds, factor=1.0, case=PDMS_CASE):
+    """A bem_curve result whose pull-offs are the crack-front model's at mu = BEM_MU times
+    ``factor`` (no BEM run), with a finer check point 1 % above the 1e4 um/s one."""
+    cf = pdms.model_pull_off("crack_pb", speeds, pdms.bem_case(case, pdms.BEM_MU))
+    pts = [{"speed_um_s": float(v), "mu": pdms.BEM_MU, "status": "ok", "reason": "",
+            "pull_off_mN": factor * p, "error_indicator": 0.004, "crack_speed_um_s": 1.0,
+            "preset": pdms.BEM_PRESET, "band_resolution": 9.0, "steps": 1, "nodes": 1,
+            "wall_s": 1.0}
+           for v, p in zip(speeds, cf["pull_off_mN"])]
+    pts.append({**pts[-1], "speed_um_s": 3.0, "status": "failed", "reason": "time budget",
+                "pull_off_mN": math.nan})
+    check = {**pts[-2], "preset": pdms.BEM_CHECK_PRESET, "band_resolution": 16.0,
+             "pull_off_mN": pts[-2]["pull_off_mN"] * 1.01}
+    return {"case": dict(case), "mu": pdms.BEM_MU, "points": pts, "check": check}
+
+
+def test_bem_case_sets_the_tabor_parameter():
+    c = pdms.bem_case(PDMS_CASE, 100.0)
+    assert pdms.pdms_scene(1e-6, c).mu == pytest.approx(100.0, rel=1e-12)
+    assert c["h0"] > PDMS_CASE["h0"]          # mu ~ 1/h0
+    assert {k: v for k, v in c.items() if k != "h0"} == \
+        {k: v for k, v in PDMS_CASE.items() if k != "h0"}
+
+
+def test_gs_over_bem_is_the_papers_ratio():
+    speeds = [1.0, 100.0, 1e4]
+    fits = {"threshold": {"prefactor": 0.3, "exponent": 2.7},
+            "v_vs_r": {"prefactor": 3.0, "exponent": 1.0, "source": "test"}}
+    g = pdms.gs_over_bem(PDMS_CASE, fake_bem(speeds, factor=1.1), fits, pf=paper_fits())
+    ctx = pdms._context(PDMS_CASE)
+    sc, tau0 = ctx["sc"], ctx["tau0"]
+    # v(r) = 3 (r tau0/l0) l0/tau0 = 3 r: independent of the scales for exponent 1
+    assert g["crack_speed_um_s"][:3] == pytest.approx([3.0, 300.0, 3e4], rel=1e-12)
+    p_jkr = 1.5 * sc.load_ref * 1e3
+    cf = g["crack_front"]
+    for i, v in enumerate([3.0, 300.0, 3e4]):
+        gs = 1.0 + (v / 213.5) ** 0.4154
+        assert g["gs"][i] == pytest.approx(gs, rel=1e-12)
+        assert cf["ratio"][i] == pytest.approx(gs * p_jkr / cf["pull_off_mN"][i], rel=1e-12)
+        b = g["bem"][i]
+        # the BEM rows at mu = 100 carried over by the crack front's mu ratio: 1.1 x the
+        # crack front at the PDMS's mu, whatever the carry-over factor
+        assert b["pull_off_mN"] == pytest.approx(1.1 * cf["pull_off_mN"][i], rel=1e-12)
+        assert b["bem_vs_crack_front"] == pytest.approx(0.1, rel=1e-10)
+        assert b["ratio"] == pytest.approx(cf["ratio"][i] / 1.1, rel=1e-12)
+        assert 1.0 < b["mu_carry_over_factor"] < 1.03
+        parts = b["error_parts"]
+        # |P_fast / P_finer - 1| / (1 - (9/16)^2) at the check speed, the same for every point
+        assert parts["fast_vs_finer_at_check_speed"] == pytest.approx(
+            (1 - 1 / 1.01) / (1 - (9 / 16) ** 2), rel=1e-9)
+        assert parts["resolution_indicator"] == 0.004
+        assert b["error_estimate"] == pytest.approx(sum(parts.values()), rel=1e-12)
+    assert g["bem"][3]["status"] == "failed" and math.isnan(g["bem"][3]["ratio"])
+    # the paper's fit of the ratio at v(r), and the paper's v-r law through the same code
+    assert g["paper_fit"][2] == pytest.approx(1 + (3e4 / 1e4) ** 0.5, rel=1e-12)
+    rhat = 1e4 * 1e-6 * tau0 / sc.l0
+    assert g["v_paper_law_um_s"][2] == pytest.approx(
+        PFIT["prefactor"] * rhat ** PFIT["exponent"] * sc.l0 / tau0 * 1e6, rel=1e-12)
+    json.dumps(g)
+
+
+def test_report_labels_what_each_ratio_divides_by(tmp_path):
+    res = compute(SMALL, bem=fake_bem([1.0, 1e4]))
+    assert "Gamma_PB" in res["gs_over_linear"]["divides_by"]
+    assert res["gs_over_bem"]["bem"][0]["status"] == "ok"
+    pdms.report(res, tmp_path / "REPORT.md")
+    text = (tmp_path / "REPORT.md").read_text()
+    assert "NOT the paper's" in text and "as the paper defines it" in text
+    assert "failed: time budget" in text
+    # the full-amplification criterion and the paper's vhat reading beside the headline
+    assert "criterion: Gamma_PB = 0.9/k" in text and "with the paper's reading vhat" in text
