@@ -165,7 +165,7 @@ def test_sweep_runs_the_scene_models(tmp_path):
 def test_si_config_runs_and_gives_rows_back_in_si(tmp_path, capsys):
     """`units: si` end to end: sweep run, then the rows in both systems from the file alone
     (si_table and `sweep info --si`); pull_off_N = pull_off pi dg R, 1.5 pi dg R closed form."""
-    from sweep.campaign.si import si_table
+    from sweep.campaign.store import si_table
 
     p = tmp_path / "si.yaml"
     p.write_text("name: si\nunits: si\ngrid:\n  model: [crack, pb]\n  R: 5.19e-3\n"
@@ -203,7 +203,7 @@ def test_shipped_pdms_config_runs_and_matches_make_pdms(tmp_path):
     from pathlib import Path
 
     from sweep.paper import pdms
-    from sweep.campaign.si import si_table
+    from sweep.campaign.store import si_table
 
     cfg = Path(__file__).resolve().parents[2] / "configs" / "pdms.yaml"
     out = tmp_path / "p.h5"
