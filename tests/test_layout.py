@@ -1,4 +1,4 @@
-"""The house's layout: which module may import which (docs/design.md, "The house in wings").
+"""The house's layout: which module may import which (the issue "The house in wings").
 
 Every module of the package (``sweep/**/*.py``, and ``kernels/*.py`` as ``sweep.kernels.*``) is
 parsed with :mod:`ast`; every import is collected, at module level and inside functions, with
