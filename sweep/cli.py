@@ -3,51 +3,80 @@
 Every command validates its input through :mod:`sweep.errors`; an invalid
 value prints one line ``error: <parameter> must be ... (got ...)`` on stderr
 and exits with code 2 (runtime failures exit 1). No traceback is shown.
+
+Start-up: this module imports click and the vocabulary only (errors, scene: numpy); each
+command imports its machinery (numba, scipy, h5py, pandas ...) in its body, when it runs, and
+the ``reproduce`` group (:mod:`sweep.paper.reproduce`) is imported when it is invoked, so that
+``sweep --help`` and ``sweep CMD --help`` start at once (tests/test_layout.py).
 """
 from __future__ import annotations
 
 import json
 import math
 import sys
+from importlib import import_module
 from pathlib import Path
 
 import click
-import numpy as np
+import numpy as np  # loaded anyway by sweep.scene
+from click.core import ParameterSource
 
-from .errors import InputError
-from .scene import AXES, PRESETS
+from .errors import (InputError, as_float, check_array, check_choice, check_int, check_positive,
+                     check_range)
+from .scene import AXES, PRESETS, Numerics, Scene
 
 
 def parse_floats(name: str, text: str) -> list[float]:
     """Parse a comma-separated list of numbers given to option ``name``."""
-    from .errors import as_float
-
     items = [s for s in text.split(",") if s.strip()]
     if not items:
         raise InputError(f"{name} must be a comma-separated list of numbers (got {text!r})")
     return [as_float(name, s.strip()) for s in items]
 
 
-def to_jsonable(obj):
-    """Recursively convert numpy arrays/scalars so ``json.dumps`` accepts them."""
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, float) and not np.isfinite(obj):
-        return None
-    return obj
-
-
 def echo_json(obj) -> None:
+    from .campaign.store import to_jsonable  # h5py: only commands that print JSON pay it
+
     click.echo(json.dumps(to_jsonable(obj), indent=None))
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class LazyGroup(click.Group):
+    """A click group some of whose subcommands live in other modules, imported when invoked.
+
+    ``lazy``: {name: ("module:attribute", help)}; ``help`` is the first paragraph of the
+    command's own help, what ``--help`` lists without importing the module
+    (tests/test_layout.py checks that the two agree).
+    """
+
+    def __init__(self, *args, lazy: dict | None = None, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.lazy = dict(lazy or {})
+        self._listing = False
+
+    def list_commands(self, ctx):
+        return sorted({*super().list_commands(ctx), *self.lazy})
+
+    def get_command(self, ctx, name):
+        if name in self.lazy and name not in self.commands:
+            target, help_ = self.lazy[name]
+            if self._listing:               # --help of the group: no import
+                return click.Command(name, help=help_)
+            module, attr = target.split(":")
+            self.add_command(getattr(import_module(module), attr), name)
+        return super().get_command(ctx, name)
+
+    def format_commands(self, ctx, formatter):
+        self._listing = True
+        try:
+            super().format_commands(ctx, formatter)
+        finally:
+            self._listing = False
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]},
+             lazy={"reproduce": ("sweep.paper.reproduce:cli",
+                                 "Fits, figures and the report of the paper's campaigns (called "
+                                 "by the Makefile).")})
 @click.version_option(package_name="visco-sweep")
 def cli():
     """Viscoelastic adhesive contact of a sphere: BEM scenes, sweeps and theory."""
@@ -61,8 +90,6 @@ def cli():
 # == theory & materials commands (pb, material) ==
 def _floats_in(name: str, text: str, lo=None, lo_open=False) -> np.ndarray:
     """A comma list given to option ``name``, every value checked >= lo (> lo if lo_open)."""
-    from .errors import check_array
-
     return check_array(name, parse_floats(name, text), lo=lo, lo_open=lo_open)
 
 
@@ -75,7 +102,6 @@ def _floats_in(name: str, text: str, lo=None, lo_open=False) -> np.ndarray:
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of a table.")
 def pb(n_text, k_text, v_text, as_json):
     """Persson-Brener effective surface energy Gamma_eff(vhat) of the MPL spectrum."""
-    from .errors import as_float
     from .theory import pb_gamma_eff
 
     n, k = as_float("n", n_text), as_float("k", k_text)
@@ -115,7 +141,6 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
     Parameter ranges are those of sweep.materials.
     """
     from . import materials
-    from .errors import check_choice
 
     model = check_choice("model", model, ["mpl", "sls"])
     if model == "mpl":
@@ -182,9 +207,6 @@ def scene_options(func):
 
 def scene_from_options(values: dict):
     """A Scene from the option strings of :func:`scene_options` (numbers parsed, named)."""
-    from .errors import as_float
-    from .scene import Scene
-
     return Scene(**{name: as_float(name, v) if AXES[name].numeric and v is not None else v
                     for name, v in values.items()})
 
@@ -222,9 +244,7 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
 def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, **values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
-    from .errors import as_float
-    from .engine.models import simulate_scene
-    from .scene import Numerics
+    from .engine.models import simulate
 
     si_values = {name: values.pop(name) for name in _SI_OPTIONS}
     axes = values
@@ -252,7 +272,7 @@ def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, *
     if exact:
         overrides["exact"] = True
     num = Numerics.preset(preset, **overrides)
-    res = simulate_scene(sc, num)
+    res = simulate(sc, num)
     if as_json:
         echo_json(res.to_dict(trajectory=trajectory))
     else:
@@ -278,9 +298,6 @@ def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, *
 
 def _scene_si(axes, as_json, values):
     """``sweep scene --si``: build an SIScene, run it, print both unit systems."""
-    from click.core import ParameterSource
-
-    from .errors import as_float
     from .campaign.si import SIScene, run_si
 
     ctx = click.get_current_context()
@@ -321,8 +338,6 @@ def _scene_si(axes, as_json, values):
 @click.option("--out", default=None, help="Output PNG (default: RESULTS with suffix .png).")
 def plot_command(results, out):
     """Plot pull-off vs rate (and P(a) trajectories, if stored) of a results file."""
-    from pathlib import Path
-
     from .analysis.plots import plot_sweep
 
     if not Path(results).exists():
@@ -376,13 +391,11 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
               help="With --si: also write every SI and dimensionless column as CSV.")
 def info_cmd(results, slowest, as_si, csv_out):
     """Summarize a results file: counts by status, parameter ranges, slowest scenes."""
-    from .campaign.store import summary
+    from .campaign.store import si_table, summary
 
     if not Path(results).exists():
         raise InputError(f"no results at {results}")
     if as_si:
-        from .campaign.si import si_table
-
         df = si_table(results)
         if csv_out:
             df.to_csv(csv_out, index=False)
@@ -422,7 +435,6 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
     sweep (T_C,f_Hz,E_storage_Pa,E_loss_Pa), shifted to --tref with the WLF equation.
     """
     from .analysis.dma import fit_maxwell, fit_mpl, kramers_kronig_check, plot_dma, read_dma_csv
-    from .errors import as_float, check_int
 
     c = parse_floats("wlf", wlf)
     if len(c) != 3:
@@ -472,20 +484,6 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
 
 
 # == fit commands (fit threshold, fit vr): the paper's fits of a results file ==
-def _load_results(path: str):
-    """The runs table of the results file ``path``, or an InputError naming it."""
-    from pathlib import Path
-
-    from .campaign.store import load
-
-    if not Path(path).is_file():
-        raise InputError(f"results: no such file {path!r}")
-    try:
-        return load(path)
-    except (OSError, KeyError, ValueError) as exc:
-        raise InputError(f"results: {path!r} is not a sweep results file ({exc})") from None
-
-
 def _ci(ci) -> str:
     return "-" if ci is None else f"[{ci[0]:.4g}, {ci[1]:.4g}]"
 
@@ -506,8 +504,6 @@ def _with_fit_options(fn):
 
 
 def _fit_numbers(saturation: str, boot: str) -> tuple[float, int]:
-    from .errors import check_int, check_range
-
     try:
         n_boot = int(boot.strip())
     except ValueError:
@@ -529,11 +525,11 @@ def fit_group():
 def fit_threshold_cmd(results, slope, saturation, boot, as_json):
     """Threshold radius a0t per (n, rate) and the collapse fit P_po = A a0t^B of an a0 sweep."""
     from .analysis.fits import threshold_analysis
-    from .errors import check_positive
+    from .campaign.store import load_results
 
     slope = check_positive("slope", slope)
     sat, n_boot = _fit_numbers(saturation, boot)
-    out = threshold_analysis(_load_results(results), slope, sat, n_boot)
+    out = threshold_analysis(load_results(results), slope, sat, n_boot)
     if as_json:
         echo_json(out)
         return
@@ -576,9 +572,10 @@ def fit_threshold_cmd(results, slope, saturation, boot, as_json):
 def fit_vr_cmd(results, saturation, boot, as_json):
     """Crack speed at pull-off vs rate, vhat = A rhat_PB^B, and Persson-Brener vs the BEM."""
     from .analysis.fits import vr_analysis
+    from .campaign.store import load_results
 
     sat, n_boot = _fit_numbers(saturation, boot)
-    out = vr_analysis(_load_results(results), sat, n_boot)
+    out = vr_analysis(load_results(results), sat, n_boot)
     if as_json:
         echo_json(out)
         return
@@ -611,16 +608,6 @@ def fit_vr_cmd(results, saturation, boot, as_json):
     for r in out["local_slope"]:
         click.echo(f"{r['rate']:>10.4g} {r['rhat_pb']:>10.4g} {r['v_over_r_median']:>13.3g} "
                    f"{r['slope_median']:>12.3g}")
-
-
-def _add_reproduce() -> None:
-    """``sweep reproduce ...``: the paper's fits, figures and report (sweep/paper/reproduce.py)."""
-    from .paper.reproduce import cli as reproduce_group
-
-    cli.add_command(reproduce_group, "reproduce")
-
-
-_add_reproduce()
 
 
 def main(argv=None) -> int:

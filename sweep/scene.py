@@ -459,7 +459,7 @@ class Result:
         Wall-clock time of the run in seconds.
     model_used : str
         The model that ran ("bem", "crack", "pb"; "" when a model's simulate function was
-        called directly rather than through :func:`sweep.engine.models.simulate_scene`).
+        called directly rather than through :func:`sweep.engine.models.simulate`).
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
     """

@@ -10,10 +10,16 @@ from pathlib import Path
 
 import numpy as np
 
+from ..campaign.config import AXES
+from ..campaign.store import load, load_trajectory
 from ..errors import InputError
+from ..scene import AXES as AXIS_INFO
+from ..theory import jkr_load
 
 
-def _pyplot():
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (matplotlib is the optional ``plot`` extra,
+    imported here on first use), or an InputError saying how to install it."""
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -33,12 +39,7 @@ def plot_sweep(path, out=None) -> Path:
     out : str or Path, optional
         Output PNG; default: the results file with the suffix ``.png``.
     """
-    from ..campaign.config import AXES
-    from ..scene import AXES as AXIS_INFO
-    from ..campaign.store import load, load_trajectory
-    from ..theory import jkr_load
-
-    plt = _pyplot()
+    plt = pyplot()
     path = Path(path)
     df = load(path)
     if df.empty:

@@ -23,8 +23,10 @@ import sys
 import time
 from pathlib import Path
 
+from ..campaign.store import provenance
 from ..engine.crack_front import simulate_crack
-from ..engine.models import simulate_pb
+from ..engine.models import bem_node_budget, bem_nodes_needed, simulate_pb
+from ..engine.problem import BEM_MU_RANGE
 from ..scene import Numerics, Scene
 from ..engine.bem import simulate
 
@@ -66,7 +68,6 @@ def run(a0s=A0S, rates=RATES, mus=MUS) -> dict:
     for mu in mus:
         mu_rows.append(_row(Scene(n=0.8, k=0.1, mu=mu, a0=3.0, rate=10**2.5)))
         print(_fmt(mu_rows[-1]), flush=True)
-    from ..campaign.store import provenance
 
     return {"a0_scan": rows, "mu_scan": mu_rows, "wall_s": time.perf_counter() - t0,
             "git_commit": provenance()["git_commit"]}
@@ -100,9 +101,6 @@ def merged(res: dict, extra=()) -> dict:
 def _reach(res: dict) -> str:
     """Why the mu scan stops where it does: the highest mu measured, its BEM cost, and the
     nodes the BEM's range end (sweep.engine.problem.BEM_MU_RANGE) would need with today's mesh."""
-    from ..engine.models import bem_node_budget, bem_nodes_needed
-    from ..engine.problem import BEM_MU_RANGE
-
     top = max(res["mu_scan"], key=lambda r: r["mu"], default=None)
     if top is None:
         return ""

@@ -34,9 +34,26 @@ from pathlib import Path
 
 import click
 import numpy as np
+import pandas as pd
+import yaml
+from joblib.externals.loky import get_reusable_executor
+from numba import njit
 
+from ..campaign.config import AXES, config_from_dict, load_config, scale_grid
+from ..campaign.scheduler import run_sweep, start_group
+from ..campaign.store import ResultStore, load
+from ..engine import bem as solver
+from ..engine import diskcache, initial, mesh, problem
+from ..engine.bem import simulate, warm_up
+from ..engine import models
+from ..kernels import solve as ks
+from ..kernels.interface import lj_traction_and_stiffness
+from ..kernels.jacobian import ZONE_IN, ZONE_OUT, crack_tip_index
+from ..scene import PRESETS, Numerics, Scene
+from .plain_solver import plain_unload
 from .tradeoff import (REFERENCE_OVERRIDES, REFERENCES, TRADEOFF_SCENES, VS_NUMPY_SCENES,
-                       compute_reference, existing, write_tradeoff)
+                       compute_reference, existing, load_references, reference_for,
+                       relative_error, to_numerics, write_tradeoff)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -49,8 +66,6 @@ def _machine() -> dict:
 
 def scaled_smoke(scenes: int = 40, base: str | Path | None = None):
     """configs/smoke.yaml with its rate axis refined so the grid has about ``scenes`` scenes."""
-    from ..campaign.config import load_config, scale_grid
-
     cfg = load_config(base or ROOT / "configs" / "smoke.yaml")
     g = cfg.grids[0]
     per_rate = max(1, len(cfg.tasks()) // len(g["rate"]))
@@ -63,8 +78,6 @@ def scaled_smoke(scenes: int = 40, base: str | Path | None = None):
 def _fresh_loky_workers() -> None:
     """Shut the reusable loky executor down, so the next sweep spawns new workers."""
     try:
-        from joblib.externals.loky import get_reusable_executor
-
         get_reusable_executor().shutdown(wait=True)
     except Exception:  # pragma: no cover
         pass
@@ -79,10 +92,6 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
     ``j{jobs}`` always starts fresh worker processes, like a new ``sweep run`` does;
     ``j{jobs}_warm`` reuses the workers of the previous call.
     """
-    from ..engine import bem as solver
-    from ..campaign.scheduler import run_sweep
-    from ..campaign.store import load
-
     cfg = scaled_smoke(scenes)
     tasks = cfg.tasks()
     n = len(tasks)
@@ -157,8 +166,6 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
         },
     }
     if cli:
-        import yaml
-
         cfg_path = tmp / "smoke_scaled.yaml"
         cfg_path.write_text(yaml.safe_dump({**cfg.to_dict(), "name": "smoke_scaled"},
                                            sort_keys=False))
@@ -179,8 +186,6 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
 
 def bench_store(rows: int = 1000, trajectories: bool = False, steps: int = 2000) -> dict:
     """Cost of ResultStore.append per row and of one consolidation with ``rows`` rows."""
-    from ..campaign.store import ResultStore
-
     tmp = Path(tempfile.mkdtemp(prefix="bench-store-"))
     base = {"scene_id": "", "n": 0.8, "k": 0.1, "mu": 3.24, "rate": 1.0, "a0": 2.0,
             "delta0": None, "material": "mpl", "stop": "pulloff", "status": "ok",
@@ -213,7 +218,6 @@ class _KernelTimer:
     """Times the unloading kernel inside ``simulate`` (everything else is setup)."""
 
     def __enter__(self):
-        from ..engine import bem as solver
         self._solver = solver
         self._orig = solver.unload
         self.seconds = 0.0
@@ -233,8 +237,6 @@ class _KernelTimer:
 def matvec_seconds(N: int, repeat: int = 2000) -> float:
     """Median wall time of one dense N x N matrix-vector product inside Numba (the floor
     of any dense BEM step: one evaluation of the deflection)."""
-    from numba import njit
-
     @njit(cache=False)
     def loop(A, x, k):
         s = 0.0
@@ -255,7 +257,6 @@ def matvec_seconds(N: int, repeat: int = 2000) -> float:
 
 
 def _scene_run(scene, numerics, repeat: int) -> dict:
-    from ..engine.bem import simulate
     best = None
     for _ in range(repeat):
         with _KernelTimer() as kt:
@@ -291,8 +292,6 @@ def compile_seconds() -> dict:
 def bench_scene(repeat: int = 3, compile_: bool = True) -> dict:
     """Issue-3 numbers: per-preset wall time of the paper's scene, time per step over one
     dense matvec, Prony vs exact speed-up at equal steps, compile time."""
-    from ..scene import PRESETS, Numerics, Scene
-    from ..engine.bem import warm_up
     warm_up()
     scene = Scene(**PAPER_SCENE)
     report = {"kind": "scene", "machine": _machine(), "scene": PAPER_SCENE, "presets": {},
@@ -329,9 +328,6 @@ REFERENCE_YAML = ROOT / "tests" / "data" / "independent_solutions.yaml"
 def bench_presets(repeat: int = 1) -> dict:
     """Speed/accuracy of the presets: error against the independent solver's values
     (shared/reference/independent_solutions.yaml) and cost, per case and preset."""
-    import yaml
-    from ..scene import PRESETS, Numerics, Scene
-    from ..engine.bem import warm_up
     warm_up()
     ref = yaml.safe_load(REFERENCE_YAML.read_text())
     rows = []
@@ -359,8 +355,6 @@ def bench_presets(repeat: int = 1) -> dict:
 def bench_convergence(mu: float = 6.0, nodes=(1000, 1500, 2000), domain: float = 5.0) -> dict:
     """Mesh convergence of the elastic pull-off at a large Tabor parameter (lattice trapping
     at coarse spacing), against the independent solver's value for that mu if it has one."""
-    import yaml
-    from ..scene import Numerics, Scene
     ref = yaml.safe_load(REFERENCE_YAML.read_text()) if REFERENCE_YAML.exists() else {}
     ref_po = next((e["pull_off"] for e in ref.get("elastic", []) if e["mu"] == mu), None)
     rows = []
@@ -431,7 +425,6 @@ class BenchPlan:
 
 
 def _numerics(overrides: dict):
-    from .tradeoff import to_numerics
     return to_numerics(overrides)
 
 
@@ -442,7 +435,6 @@ def step_cost(scene, numerics, repeat: int = 2) -> dict:
     Uses only the public API (``Result.wall_s``, ``Result.steps``): setup (mesh, Prony
     series, relaxed start) cancels in the difference.
     """
-    from ..engine.bem import simulate
     full = min((simulate(scene, numerics) for _ in range(repeat)), key=lambda r: r.wall_s)
     cut_num = dataclasses.replace(numerics, max_steps=10)
     cut = min((simulate(scene, cut_num) for _ in range(repeat)), key=lambda r: r.wall_s)
@@ -470,9 +462,6 @@ def kernel_counters(scene, numerics) -> dict:
     crack-tip zone's Schur complement (``zone_refreshes``), factorizations of the contact
     (with the reason of the refactorizations) and the mean size of the interacting set
     |S|/N."""
-    from ..kernels import solve as ks
-
-    from ..engine import bem as solver
     captured = {}
     orig = solver.unload
 
@@ -504,8 +493,6 @@ def compare_results(before, after) -> dict:
     in both, status changes, and over the scenes ``ok`` in both the relative differences
     |after / before - 1| of the pull-off and the crack speed (max and median), with the sums
     of the scenes' wall times."""
-    from ..campaign.store import load
-
     a = load(before).set_index("scene_id")
     b = load(after).set_index("scene_id")
     common = a.index.intersection(b.index)
@@ -529,10 +516,6 @@ def newton_diagnosis(scene, numerics, at_step: int = 300, ahead: int = 10) -> di
     as factorized at ``at_step`` (dense eigenvalues: the staleness of the Jacobian), and the
     cubic predictor's error |h_pred - h| / h0 (max over the nodes, where, and median) for
     each of the last steps (the distance Newton starts from)."""
-    from ..kernels.interface import lj_traction_and_stiffness
-    from ..kernels.jacobian import ZONE_IN, ZONE_OUT, crack_tip_index
-
-    from ..engine import bem as solver
     captured = {}
     orig = solver.unload
 
@@ -594,7 +577,6 @@ def newton_diagnosis(scene, numerics, at_step: int = 300, ahead: int = 10) -> di
 def bench_step_over_matvec(plan: BenchPlan) -> dict:
     """Time per step over the time of one dense N x N mat-vec at the mesh's N, with the
     kernel's counters (:func:`kernel_counters`)."""
-    from ..scene import Numerics, Scene
     scene = Scene(**plan.matvec_scene)
     out = {}
     for N in plan.matvec_nodes:
@@ -615,8 +597,6 @@ def bench_prony_speedup(plan: BenchPlan) -> dict:
     mesh, no second error-check solve). The
     speed-up is the ratio of wall time per step (whole runs, setup included).
     """
-    from ..scene import Numerics, Scene
-    from ..engine.bem import simulate
     scene = Scene(**plan.prony_scene)
     base = existing({"mesh": "uniform", "pull_off_rtol": 0.0, **plan.prony_numerics})
     probe = simulate(scene, Numerics(**base, step=0.1))
@@ -638,8 +618,6 @@ def bench_prony_speedup(plan: BenchPlan) -> dict:
 
 def _listed(config, scenes, name: str):
     """A config with the numerics of ``config`` whose grid lists ``scenes`` one by one."""
-    from ..campaign.config import AXES, config_from_dict
-
     grid = [{k: v for k, v in s.to_dict().items() if k in AXES and v is not None}
             for s in scenes]
     return config_from_dict({**config.to_dict(), "grid": grid, "name": name})
@@ -663,13 +641,10 @@ def campaign_sample(config, size: int, seed: int = 0):
 
 def _clear_scene_caches() -> None:
     """Empty this process's per-scene caches (relaxed starts, Prony series, meshes)."""
-    from ..engine import initial
-    from ..engine import mesh
-    from ..engine import problem
-
-    initial._RELAXED.clear()
+    initial.clear_relaxed_cache()
     problem.prony_series.cache_clear()
-    mesh._MESH_CACHE.clear()
+    problem.derive.cache_clear()
+    mesh.clear_mesh_cache()
 
 
 class _fresh_disk_cache:
@@ -678,24 +653,19 @@ class _fresh_disk_cache:
     what a first run on a new machine pays. Restores the previous cache directory."""
 
     def __enter__(self):
-        from ..engine import diskcache
-        from ..engine import mesh
         self._env = os.environ.get(diskcache.CACHE_ENV)
-        self._unit = mesh._UNIT[0]
         os.environ[diskcache.CACHE_ENV] = tempfile.mkdtemp(prefix="bench-cache-")
-        mesh._UNIT[0] = np.zeros((0, 0))
+        self._unit = mesh.set_unit_influence(None)
         _clear_scene_caches()
         _fresh_loky_workers()
         return self
 
     def __exit__(self, *exc):
-        from ..engine import diskcache
-        from ..engine import mesh
         if self._env is None:
             os.environ.pop(diskcache.CACHE_ENV, None)
         else:
             os.environ[diskcache.CACHE_ENV] = self._env
-        mesh._UNIT[0] = self._unit
+        mesh.set_unit_influence(self._unit)
         _clear_scene_caches()
         _fresh_loky_workers()
 
@@ -714,12 +684,6 @@ def bench_scale(plan: "BenchPlan") -> dict:
     and worker, divided by the parallel speed-up measured on the sample (-j1 cold / -j{jobs}
     cold). The sample's statuses are reported with it: a failed scene costs its time too.
     """
-    import pandas as pd
-
-    from ..engine.models import simulate_scene
-    from ..campaign.scheduler import run_sweep, start_group
-    from ..campaign.store import load
-
     cfg = load_config_path(plan.scale_config)
     sample = campaign_sample(cfg, plan.scale_sample, plan.scale_seed)
     scenes = [s for _, s in sample.tasks()]
@@ -735,7 +699,7 @@ def bench_scale(plan: "BenchPlan") -> dict:
         for label in ("cold", "warm"):
             t = time.perf_counter()
             for scene in scenes:
-                simulate_scene(scene, sample.numerics)
+                models.simulate(scene, sample.numerics)
             seq[label] = time.perf_counter() - t
     n = len(scenes)
     total = len(cfg.tasks())
@@ -763,8 +727,6 @@ def bench_scale(plan: "BenchPlan") -> dict:
 
 def load_config_path(path: str):
     """A sweep config by path relative to the repository root (or absolute)."""
-    from ..campaign.config import load_config
-
     p = Path(path)
     return load_config(p if p.is_absolute() else ROOT / p)
 
@@ -777,11 +739,6 @@ def bench_campaign(plan: BenchPlan) -> dict:
     Both timed runs start from the same state: an on-disk cache filled by a first run of
     the sample (``wall_s.first_j1``, which fits every Prony series once) and empty
     in-memory caches (relaxed starts, meshes) in every process."""
-    from ..campaign.config import config_from_dict
-    from ..campaign.scheduler import run_sweep
-    from ..engine.bem import warm_up
-    from ..campaign.store import load
-
     cfg = load_config_path(plan.campaign)
     sub_cfg = campaign_subset(cfg, plan.campaign_stride)
     tasks = sub_cfg.tasks()
@@ -880,11 +837,6 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
     ``ratio_interpolated`` the plain time interpolated to the engine's error on the plain
     solver's time/error frontier (:func:`plain_time_at`), the estimate at equal accuracy.
     """
-    from .plain_solver import plain_unload
-    from ..scene import Numerics, Scene
-    from ..engine.bem import simulate
-    from .tradeoff import load_references, reference_for, relative_error
-
     refs = load_references()
     fallback = Numerics(**plan.reference_fallback) if plan.reference_fallback else None
     out = {}
@@ -934,7 +886,6 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
 
 def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     """Every figure of ``results/bench.json`` (issue 9, item 7)."""
-    from ..engine.bem import warm_up
     plan = plan or BenchPlan()
     t0 = time.perf_counter()
     report = {"kind": "bench", "machine": {**_machine(), "loadavg_before": os.getloadavg()},
@@ -1092,8 +1043,6 @@ def all_cmd(tiny, out):
 @click.option("--out", default=None, help="JSON report path.")
 def scale_cmd(sample, jobs, config, out):
     """Estimated minutes for the 10,640-scene grid over the paper's ranges (a random sample)."""
-    from ..engine.bem import warm_up
-
     warm_up()
     _write(bench_scale(BenchPlan(scale_config=config, scale_sample=sample, jobs=jobs)), out)
 
@@ -1153,7 +1102,6 @@ def compare_cmd(before, after):
 def newton_diagnosis_cmd(n, k, mu, rate, delta0, preset, max_nodes, at_step, out):
     """Newton's cost on one scene: counters, the chord map's contraction and the predictor's
     error at the crack tip (default: the scale campaign's costliest kind of scene)."""
-    from ..scene import Numerics, Scene
     _write(newton_diagnosis(Scene(n=n, k=k, mu=mu, rate=rate, delta0=delta0),
                             Numerics.preset(preset, max_nodes=max_nodes), at_step), out)
 

@@ -1,6 +1,6 @@
 r"""Stability at the extremes of the scene space: every corner of (n, k, rate, a0, mu).
 
-Each scene runs with the model a user gets (:func:`sweep.engine.models.simulate_scene`, model
+Each scene runs with the model a user gets (:func:`sweep.engine.models.simulate`, model
 "bem": the fixed-band or tip-following BEM, the quasi-static branch for k = 1) and is
 judged against physical bounds that do not come from the BEM:
 
@@ -20,9 +20,16 @@ without saying so. ``python -m sweep.bench.extremes [--quick]`` prints the table
 """
 from __future__ import annotations
 
+import argparse
 import itertools
 import math
+import time
 from functools import lru_cache
+
+from ..engine.models import simulate
+from ..engine.problem import tip_zone
+from ..engine.quasistatic import elastic_pull_off
+from ..scene import Numerics, Scene
 
 N_VALUES = (0.05, 0.2, 2.5)
 K_VALUES = (1e-4, 0.5, 0.999)
@@ -59,15 +66,11 @@ def all_scenes() -> list[dict]:
 @lru_cache(maxsize=None)
 def relaxed_pull_off(mu: float, a0: float) -> float:
     """The relaxed elastic (quasi-static) pull-off from the contact radius a0."""
-    from ..engine.quasistatic import elastic_pull_off
-
     return elastic_pull_off(mu, a_start=a0).pull_off
 
 
 def upper_bound(mu: float, k: float, a0: float) -> float:
     """max(2/k, pi sigma_0 (a0 + 2 l)^2): see the module docstring (units pi dg R)."""
-    from ..engine.problem import tip_zone
-
     sigma0 = 16.0 * mu / (9.0 * math.sqrt(3.0) * math.pi ** (1.0 / 3.0))
     return max(2.0 / k, math.pi * sigma0 * (a0 + 2.0 * tip_zone(mu)) ** 2)
 
@@ -91,16 +94,11 @@ def judge(scene: dict, res) -> str:
 def run(scenes, numerics=None, on_row=None) -> list[dict]:
     """Run and judge ``scenes`` (dicts of Scene fields); rows for :func:`print_table`
     (``on_row(row)`` is called as each is done)."""
-    import time
-
-    from ..engine.models import simulate_scene
-    from ..scene import Numerics, Scene
-
     numerics = numerics or Numerics.preset("balanced", time_budget_s=TIME_BUDGET_S)
     rows = []
     for d in scenes:
         t0 = time.perf_counter()
-        res = simulate_scene(Scene(**d), numerics)
+        res = simulate(Scene(**d), numerics)
         rows.append(dict(d, status=res.status, pull_off=res.pull_off, model=res.model_used,
                          nodes=res.nodes_used, lower=relaxed_pull_off(d["mu"], d["a0"]),
                          upper=upper_bound(d["mu"], d["k"], d["a0"]),
@@ -124,8 +122,6 @@ def print_table(rows, out=print, header=True) -> None:
 
 
 def _main(argv=None) -> int:
-    import argparse
-
     p = argparse.ArgumentParser(prog="python -m sweep.bench.extremes",
                                 description="stability at the extremes of the scene space")
     p.add_argument("--quick", action="store_true", help="the covering subset only")

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engine.bem import simulate, warm_up
 from ..scene import PRESETS, Numerics, Scene
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -172,7 +173,6 @@ def load_references(path: str | Path = REFERENCES) -> dict:
 
 def compute_reference(scene: dict) -> dict:
     """Reference values of one scene: the refined run and the accurate preset beside it."""
-    from ..engine.bem import simulate
     sc = Scene(**scene)
     ref = simulate(sc, Numerics.preset("accurate", **existing(REFERENCE_OVERRIDES)))
     acc = simulate(sc, Numerics.preset("accurate"))
@@ -190,7 +190,6 @@ def reference_for(name: str, scene: dict, refs: dict, fallback: Numerics | None 
     ref = refs.get(name)
     if ref is not None and ref["scene"] == scene and ref["status"] == "ok":
         return {**ref, "source": "configs/references.json (refined run)"}
-    from ..engine.bem import simulate
     num = fallback or Numerics.preset("accurate")
     res = simulate(Scene(**scene), num)
     return {"scene": scene, "pull_off": res.pull_off, "crack_speed": res.crack_speed,
@@ -207,7 +206,6 @@ def run_tradeoff(quick: bool = False, repeat: int = 1, progress=print,
     """Run the grid on the reference scenes; rows with errors against the references.
     With ``partial``, the table so far is rewritten there after each scene (a long run
     that is stopped keeps its finished scenes)."""
-    from ..engine.bem import simulate, warm_up
     warm_up()
     refs = load_references()
     points = grid(quick)

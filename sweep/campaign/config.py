@@ -30,7 +30,7 @@ combine a ``preset`` with explicit overrides (``{preset: fast, nodes: 120}``).
 n, tau0, dg, h0, speed`` and one of ``preload``, ``a0``, ``indentation``) besides ``model``,
 ``material``, ``stop``; every point becomes a :class:`sweep.campaign.si.SIScene` and its
 dimensionless :class:`Scene` (the one hashed, stored and run; :meth:`SweepConfig.si_tasks`
-maps ids back to the SI points, :func:`sweep.campaign.si.si_table` gives stored rows in SI).
+maps ids back to the SI points, :func:`sweep.campaign.store.si_table` gives stored rows in SI).
 
 YAML 1.1 reads ``1e6`` as a string; numeric strings such as ``"1e6"`` are accepted as
 numbers wherever a number is expected. Configs are read with a safe loader (no Python
@@ -55,6 +55,7 @@ import yaml
 from ..errors import InputError, as_float, check_choice, check_int, check_range
 from ..scene import AXES as SCENE_AXIS_INFO
 from ..scene import Numerics, Scene, scene_id
+from .si import SI_AXES, SI_INITIAL, SIScene
 
 #: Top-level keys of a config file.
 TOP_KEYS = ("name", "description", "units", "grid", "numerics", "store", "output")
@@ -326,15 +327,11 @@ def _check_grid(where: str, grid, problems: list[str]) -> dict | None:
 
 
 def _si_order(name: str) -> int:
-    from .si import SI_AXES
-
     return SI_AXES[name].order if name in SI_AXES else SCENE_AXIS_INFO[name].order
 
 
 def _si_point(point: dict, where: str):
     """The SIScene and the Scene of one point of an SI grid (InputError naming the point)."""
-    from .si import SIScene
-
     extra = {a: point[a] for a in SI_SCENE_AXES if a in point and a != "material"}
     phys = {a: v for a, v in point.items() if a not in SI_SCENE_AXES}
     try:
@@ -347,8 +344,6 @@ def _si_point(point: dict, where: str):
 
 def _check_si_grid(where: str, grid, problems: list[str]) -> dict | None:
     """Validate a ``units: si`` grid: SI fields (sweep.campaign.si.SI_AXES) and model/material/stop."""
-    from .si import SI_AXES, SI_INITIAL
-
     allowed = (*SI_SCENE_AXES, *SI_AXES)
     if not isinstance(grid, dict):
         problems.append(f"{where}: must be a mapping of SI fields ({_fmt_choices(allowed)}) "

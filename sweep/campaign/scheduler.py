@@ -2,7 +2,7 @@
 
 :func:`run_sweep` is the Python entry point behind ``sweep run``::
 
-    from .. import run_sweep
+    from sweep import run_sweep
     report = run_sweep("configs/smoke.yaml", jobs=2)          # joblib/loky on this machine
     report = run_sweep(cfg, backend="dask", scheduler="tcp://head:8786")   # a cluster
 
@@ -42,6 +42,8 @@ from typing import Callable
 
 import click
 import numpy as np
+from joblib import Parallel, delayed, parallel_config
+from tqdm import tqdm
 
 from .config import SweepConfig, as_config
 from ..errors import InputError, check_int, check_range
@@ -97,6 +99,8 @@ def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
         limit_env(THREAD_VARS)
         limit_loaded_pools()
     if warm:
+        # the engine (numba) is imported here, after the thread limits above: numba reads
+        # NUMBA_NUM_THREADS when it loads (the same in run_scene and _warm_parent)
         from ..engine import bem as solver
 
         solver.warm_up()
@@ -118,8 +122,8 @@ def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | 
     """
     if in_worker:
         _prepare_worker(warm=simulate is None)
-    if simulate is None:
-        from ..engine.models import simulate_scene as simulate   # dispatches on scene.model
+    if simulate is None:   # after _prepare_worker: see there
+        from ..engine.models import simulate   # the front door: dispatches on scene.model
     t0 = time.perf_counter()
     c0 = time.process_time()
     try:
@@ -199,8 +203,6 @@ class Progress:
 
     def start(self) -> None:
         if self.mode == "bar":
-            from tqdm import tqdm
-
             self.bar = tqdm(total=self.total, initial=self.already, file=self.stream,
                             unit="scene", dynamic_ncols=True, postfix="0 failed")
 
@@ -242,6 +244,7 @@ def estimated_cost(scene, numerics) -> float:
     scene (no mesh is built); a scene it cannot size gets cost 1.
     """
     try:
+        # lazy: engine.problem loads numba, which a worker loads only after _prepare_worker
         from ..engine.problem import initial_estimates, tip_zone
 
         _, a_est, _ = initial_estimates(scene, numerics)
@@ -337,7 +340,7 @@ def _first_line(exc: BaseException) -> str:
 
 
 def _connect_dask(scheduler, jobs, timeout):
-    try:
+    try:  # optional dependency (visco-sweep[cluster])
         from dask.distributed import Client, LocalCluster
     except ImportError:
         raise SweepRuntimeError("backend dask needs dask.distributed: pip install "
@@ -514,7 +517,7 @@ def _close_dask(client, cluster) -> None:
 
 def _warm_parent() -> None:
     """Compile (or load) the Numba kernels once, in the parent, before the workers start."""
-    try:
+    try:  # lazy: see _prepare_worker
         from ..engine import bem as solver
     except ImportError as exc:
         raise SweepRuntimeError(f"cannot import the solver ({exc})") from None
@@ -530,8 +533,6 @@ def run_chunk(scenes, numerics, trajectories: bool = False,
 
 def _results(chunks, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate):
     """Yield ``(row, trajectory)`` per scene: chunk by chunk in completion order."""
-    from joblib import Parallel, delayed, parallel_config
-
     calls = (delayed(run_chunk)([scene for _, scene in chunk], cfg.numerics,
                                 cfg.trajectories, simulate)
              for chunk in chunks)

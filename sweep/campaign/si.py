@@ -19,18 +19,20 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+from .. import units
+from ..engine.crack_front import pb_law_for_scene, unload
+from ..engine.models import choose_model, pb_estimate, simulate_model
 from ..errors import InputError, check_choice, check_positive, check_range
+from ..scene import SCENE_LIMITS, Axis, Scene
 from ..theory import jkr_contact_radius, jkr_pull_off
 from ..units import PhysicalScale
 
-__all__ = ["SIScene", "run_si", "SI_MODELS", "SI_AXES", "si_table"]
+__all__ = ["SIScene", "run_si", "SI_MODELS", "SI_AXES", "si_row"]
 
 SI_MODELS = ("bem", "crack", "pb", "auto")
 
 
 def _si_axis(name, unit, help, lo=0.0, hi=None, lo_open=True, required=True, order=0):
-    from ..scene import Axis
-
     return Axis(name=name, default=None, required=required, help=help, unit=unit,
                 limits=(lo, hi), lo_open=lo_open, choices=None, label=name, order=order,
                 plot_group=True, cli_default=None)
@@ -134,8 +136,6 @@ class SIScene:
 
     def to_scene(self, **extra):
         """The :class:`sweep.Scene` (raises InputError outside the Scene's ranges, e.g. mu)."""
-        from ..scene import Scene
-
         d = self.dimensionless()
         if d["a0"] is None:
             d.pop("a0")
@@ -212,20 +212,16 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
         ``vhat``, ``a0``, ``delta0`` ...) and their SI values (``pull_off_N``, ``a_pulloff_m``,
         ``crack_speed_m_s``, ...) with ``mu``, ``l0_m``, ``jkr_pull_off_N``.
     """
-    from .. import units
-    from ..engine.crack_front import pb_law_for_scene, unload
-    from ..engine.models import pb_estimate, simulate_model
-
     model = check_choice("model", model, SI_MODELS)
     d = si.dimensionless()
     if model == "auto":
-        from ..engine.models import choose_model
-        from ..scene import SCENE_LIMITS
-
         lo, hi = SCENE_LIMITS["mu"]
         model = choose_model(si.to_scene(), numerics) if lo <= d["mu"] <= hi else "crack"
     res = {"model": model}
     if model == "bem":
+        # engine.problem loads the compiled kernels (numba): imported on this path only, so
+        # that a sweep worker (which imports this module through the config) sets its thread
+        # limits before numba loads (sweep.campaign.scheduler._prepare_worker)
         from ..engine.problem import BEM_MU_RANGE
 
         lo, hi = BEM_MU_RANGE
@@ -275,34 +271,3 @@ def si_row(si: SIScene, row) -> dict:
     out = {f"si_{k}": v for k, v in si.to_dict().items() if v is not None and k != "material"}
     out.update(_si_of(si, dim))
     return out
-
-
-def si_table(results) -> "pandas.DataFrame":  # noqa: F821 - annotation only
-    """The rows of a results file written by a ``units: si`` config, in both systems.
-
-    The SI inputs of each scene come from the config the file records (``config_text``),
-    expanded again: columns ``scene_id``, ``model_used``, ``status``, the SI inputs
-    (``si_R``, ``si_speed``, ...), ``mu``, ``k``, ``rate``, ``l0_m``, ``a_ref_m``,
-    ``d_ref_m``, ``load_ref_N``, ``jkr_pull_off_N``, ``pull_off_N``, ``a_pulloff_m``,
-    ``crack_speed_m_s``, ... and the dimensionless ``pull_off``. InputError if the file was
-    not written by an SI config.
-    """
-    import pandas as pd
-
-    from .config import parse_config
-    from .store import load, read_attrs
-
-    text = str(read_attrs(results).get("config_text", ""))
-    cfg = parse_config(text, source=str(results)) if text else None
-    if cfg is None or cfg.units != "si":
-        raise InputError(f"results: {results} was not written by a `units: si` config")
-    by_id = dict(cfg.si_tasks())
-    rows = []
-    for row in load(results).to_dict("records"):
-        si = by_id.get(row["scene_id"])
-        if si is None:
-            continue
-        rows.append({"scene_id": row["scene_id"], "model_used": row.get("model_used"),
-                     "status": row.get("status"), "pull_off": row.get("pull_off"),
-                     **si_row(si, row)})
-    return pd.DataFrame(rows)

@@ -62,21 +62,27 @@ import shutil
 import subprocess
 import time
 from datetime import datetime, timezone
+from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import h5py
 import numpy as np
 
+from .._version import __version__
 from ..errors import InputError
 from ..scene import SCENE_AXES, SCENE_ID_VERSION
+from .config import parse_config
+from .si import si_row
 
 try:
     import fcntl
 except ImportError:  # pragma: no cover - not POSIX: no advisory lock
     fcntl = None
 
-if TYPE_CHECKING:  # pandas is imported lazily: sweep workers never need it
+if TYPE_CHECKING:
+    # pandas (about 0.3 s to import) is imported in the functions that build tables: every
+    # sweep worker imports this module (through the scheduler) and never needs pandas.
     import pandas as pd
 
 FORMAT = "visco-sweep-results"
@@ -138,6 +144,22 @@ def plain_row(row: dict) -> dict:
     return {str(k): plain(v) for k, v in row.items()}
 
 
+def to_jsonable(obj):
+    """``obj`` with numpy arrays and scalars made plain Python (lists, floats), dict keys made
+    strings and non-finite floats made None, so that ``json.dumps`` accepts it."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
+
+
 def _column_kind(values) -> str:
     """Storage kind of a column: "str", "bool", "int" or "float" (None -> NaN)."""
     has_none = False
@@ -171,7 +193,8 @@ def _column_array(values, kind: str) -> np.ndarray:
 
 
 def _frame_from_rows(rows: list[dict], columns: list[str] | None = None) -> pd.DataFrame:
-    import pandas as pd
+    import pandas as pd  # lazy: see TYPE_CHECKING above (workers never build a table)
+
     if columns is None:
         columns = _column_order(rows)
     data = {}
@@ -228,7 +251,8 @@ def _open_main(path: Path):
 
 
 def _read_runs_frame(f) -> pd.DataFrame:
-    import pandas as pd
+    import pandas as pd  # lazy: see TYPE_CHECKING above
+
     if "runs" not in f:
         return pd.DataFrame({"scene_id": pd.Series([], dtype=object)})
     g = f["runs"]
@@ -276,7 +300,8 @@ def load(path) -> pd.DataFrame:
     scalar results, ``status``, ``reason``, ``wall_s``, ``task_wall_s``, ``worker``,
     ``finished_at``. Missing numbers are NaN (e.g. ``delta0`` of an ``a0`` scene).
     """
-    import pandas as pd
+    import pandas as pd  # lazy: see TYPE_CHECKING above
+
     path = Path(path)
     # journal first, then main: a consolidation that removes the journal in between has
     # already put its rows into the main file.
@@ -300,6 +325,17 @@ def load(path) -> pd.DataFrame:
     if len(main) == 0:
         return _dedupe(jf)
     return _dedupe(pd.concat([main, jf], ignore_index=True))
+
+
+def load_results(path) -> pd.DataFrame:
+    """:func:`load` of a path a user gave (``results``): an InputError naming it if it is not
+    a file or not a sweep results file."""
+    if not Path(path).is_file():
+        raise InputError(f"results: no such file {str(path)!r}")
+    try:
+        return load(path)
+    except (OSError, KeyError, ValueError) as exc:
+        raise InputError(f"results: {str(path)!r} is not a sweep results file ({exc})") from None
 
 
 def _dedupe(df: pd.DataFrame) -> pd.DataFrame:
@@ -329,13 +365,37 @@ def load_trajectory(path, scene_id: str) -> dict:
     raise KeyError(f"no trajectory for scene {scene_id!r} in {path}")
 
 
+def si_table(results) -> pd.DataFrame:
+    """The rows of a results file written by a ``units: si`` config, in both systems.
+
+    The SI inputs of each scene come from the config the file records (``config_text``),
+    expanded again: columns ``scene_id``, ``model_used``, ``status``, the SI inputs
+    (``si_R``, ``si_speed``, ...), ``mu``, ``k``, ``rate``, ``l0_m``, ``a_ref_m``,
+    ``d_ref_m``, ``load_ref_N``, ``jkr_pull_off_N``, ``pull_off_N``, ``a_pulloff_m``,
+    ``crack_speed_m_s``, ... and the dimensionless ``pull_off``. InputError if the file was
+    not written by an SI config.
+    """
+    import pandas as pd  # lazy: see TYPE_CHECKING above
+
+    text = str(read_attrs(results).get("config_text", ""))
+    cfg = parse_config(text, source=str(results)) if text else None
+    if cfg is None or cfg.units != "si":
+        raise InputError(f"results: {results} was not written by a `units: si` config")
+    by_id = dict(cfg.si_tasks())
+    rows = []
+    for row in load(results).to_dict("records"):
+        si = by_id.get(row["scene_id"])
+        if si is None:
+            continue
+        rows.append({"scene_id": row["scene_id"], "model_used": row.get("model_used"),
+                     "status": row.get("status"), "pull_off": row.get("pull_off"),
+                     **si_row(si, row)})
+    return pd.DataFrame(rows)
+
+
 # ----------------------------------------------------------------------------- provenance
 def provenance() -> dict:
     """Versions and git commit of the code that writes a results file."""
-    import numba
-
-    from .._version import __version__
-
     commit = "unknown"
     here = Path(__file__).resolve().parent
     try:
@@ -353,11 +413,20 @@ def provenance() -> dict:
     return {
         "package_version": __version__,
         "git_commit": commit,
-        "numba_version": numba.__version__,
+        "numba_version": _distribution_version("numba"),
         "numpy_version": np.__version__,
         "h5py_version": h5py.__version__,
         "python_version": platform.python_version(),
     }
+
+
+def _distribution_version(name: str) -> str:
+    """The installed version of the distribution ``name`` (read from its metadata, without
+    importing it), or "unknown"."""
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:  # pragma: no cover - a dependency of this package
+        return "unknown"
 
 
 # ----------------------------------------------------------------------------- writing

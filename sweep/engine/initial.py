@@ -42,6 +42,11 @@ def jkr_gap_guess(r: np.ndarray, delta: float, h0: float) -> np.ndarray:
     return np.maximum(gap, h0)
 
 
+def clear_relaxed_cache() -> None:
+    """Forget this process's relaxed initial states (a cold start, as in a new worker)."""
+    _RELAXED.clear()
+
+
 class ElasticSolver:
     """Elastic (Chat = 1) LJ solves on one mesh, with a reusable inverse Jacobian."""
 

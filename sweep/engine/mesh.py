@@ -189,6 +189,20 @@ _MESH_CACHE: dict = {}
 _MESH_CACHE_SIZE = 32
 
 
+def clear_mesh_cache() -> None:
+    """Forget this process's influence matrices of meshes (not the unit matrix)."""
+    _MESH_CACHE.clear()
+
+
+def set_unit_influence(matrix=None) -> np.ndarray:
+    """Replace this process's in-memory unit-spacing influence matrix (``None``: empty, so the
+    next mesh reads it from disk or assembles it, as a cold process does); returns the
+    previous one, to be put back."""
+    previous = _UNIT[0]
+    _UNIT[0] = np.zeros((0, 0)) if matrix is None else matrix
+    return previous
+
+
 def _unit_files(d: Path) -> list:
     """[(size, path)] of the cached unit matrices of this kernels/influence.py, largest
     first."""

@@ -16,7 +16,9 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
-from ..analysis.plots import _pyplot
+from ..analysis.plots import pyplot as _pyplot
+from ..materials import SLS, MPLRelaxation, MPLRetardation
+from ..theory import jkr_load
 
 __all__ = ["threshold_figure", "vr_figure", "pb_vs_bem_figure", "fig3_figure",
            "aconv_figure", "mplplot_figure", "pb_bem_figure", "b1_figure"]
@@ -147,7 +149,7 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
 
 def _plain_log_ticks(ax, x=None, y=None):
     """Plain-number ticks on log axes that span less than a decade or two."""
-    from matplotlib.ticker import NullFormatter, ScalarFormatter
+    from matplotlib.ticker import NullFormatter, ScalarFormatter  # optional dependency
 
     for axis, ticks in ((ax.xaxis, x), (ax.yaxis, y)):
         if ticks is not None:
@@ -231,8 +233,6 @@ def fig3_figure(runs: pd.DataFrame, trajectories: dict, out) -> Path:
     """The paper's Fig. 3: ``P(a)`` during unloading; panels (a) rates (n = 0.8, a0 = 3.61),
     (b) n (rate 10^2.5), (c) a0 (n = 1.6, rate 10^2.5); the JKR curve for reference.
     ``trajectories`` maps scene_id to the dict of :func:`sweep.load_trajectory`."""
-    from ..theory import jkr_load
-
     plt = _pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(16, 5))
     r25 = 10**2.5
@@ -289,8 +289,6 @@ def mplplot_figure(out, n_values=(0.2, 0.4, 0.6), k=0.1) -> Path:
     """The paper's Fig. MPLplot: (a) relaxation ``R(t)/E0`` of the MPL relaxation model
     (eq. Rt3), (b) creep ``C(t)/C0`` of the MPL retardation model (eq. Ctgen), against the
     SLS (dashed blue)."""
-    from ..materials import SLS, MPLRelaxation, MPLRetardation
-
     plt = _pyplot()
     t = np.logspace(-4, 6, 300)
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))

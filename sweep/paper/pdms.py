@@ -50,6 +50,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import yaml
 from scipy.optimize import brentq
 
 from .. import units
@@ -120,8 +121,6 @@ def own_fits(root=ROOT) -> dict:
 def paper_fits() -> dict:
     """The paper's collapse fit, v-r fit and vhat reading (tests/data/paper_values.yaml),
     for the comparison column only."""
-    import yaml
-
     p = ROOT / "tests" / "data" / "paper_values.yaml"
     if not p.is_file():
         return {}
@@ -676,8 +675,6 @@ def plot(res: dict, out) -> Path:
 
 def _paper_values():
     """The paper's printed numbers (tests/data/paper_values.yaml), for the comparison column."""
-    import yaml
-
     p = ROOT / "tests" / "data" / "paper_values.yaml"
     return yaml.safe_load(p.read_text())["pdms_experiment"] if p.is_file() else {}
 

@@ -1,7 +1,9 @@
 r"""Reproduction of the paper: turn this project's runs into fit files, figures and a report.
 
 The Makefile targets call this module after ``sweep run`` (``sweep reproduce ...``, or
-``python -m sweep.paper.reproduce ...``):
+``python -m sweep.paper.reproduce ...``). Like :mod:`sweep.cli`, of which it is the
+``reproduce`` group, it imports its commands' machinery (fits, figures, the results store) in
+their bodies, so that ``sweep reproduce --help`` starts at once:
 
 =================  =========================================================================
 command            writes (in OUTDIR)
@@ -29,14 +31,16 @@ from pathlib import Path
 
 import click
 import numpy as np
+import yaml
 
 from ..errors import InputError
+from .report import build_report
 
 PAPER_VALUES = Path(__file__).resolve().parents[2] / "tests" / "data" / "paper_values.yaml"
 
 
 def _load_results(path):
-    from ..cli import _load_results as load_results  # sweep.cli imports this module
+    from ..campaign.store import load_results
 
     return load_results(path)
 
@@ -64,7 +68,7 @@ def _cost(df) -> dict:
 
 
 def _write_json(obj, path: Path) -> Path:
-    from ..cli import to_jsonable
+    from ..campaign.store import to_jsonable
 
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".json.tmp")
@@ -74,8 +78,6 @@ def _write_json(obj, path: Path) -> Path:
 
 
 def _paper() -> dict:
-    import yaml
-
     return yaml.safe_load(PAPER_VALUES.read_text())
 
 
@@ -229,8 +231,6 @@ def theory_cmd(outdir, vr_runs):
 @click.option("--out", "out", default=None, help="Default: RESULTS/REPORT.md.")
 def report_cmd(results_dir, out):
     """REPORT.md: every fit beside the paper's value, the figures, counts, failures, times."""
-    from .report import build_report
-
     root = Path(results_dir)
     if not root.is_dir():
         raise InputError(f"results: no such directory {results_dir!r}")
@@ -251,13 +251,9 @@ def _git_commit() -> str:
     return (head or "unknown") + ("-dirty" if dirty else "")
 
 
-def main(argv=None) -> int:
-    """``sweep reproduce ARGS``: the error mapping of :func:`sweep.cli.main` (exit 2 on bad
-    input, one line)."""
-    from ..cli import main as sweep_main
-
-    return sweep_main(["reproduce", *(sys.argv[1:] if argv is None else argv)])
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    # run as a program (python -m sweep.paper.reproduce ARGS): `sweep reproduce ARGS`, with
+    # the CLI's error mapping (exit 2 on bad input, one line)
+    from sweep.cli import main
+
+    sys.exit(main(["reproduce", *sys.argv[1:]]))

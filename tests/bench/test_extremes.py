@@ -12,12 +12,12 @@ import pytest
 
 from sweep.bench import extremes
 from sweep import Numerics, Scene
-from sweep.engine.models import simulate_scene
+from sweep.engine.models import simulate
 
 
 def _check(d):
     num = Numerics.preset("balanced", time_budget_s=extremes.TIME_BUDGET_S)
-    res = simulate_scene(Scene(**d), num)
+    res = simulate(Scene(**d), num)
     verdict = extremes.judge(d, res)
     assert not verdict.startswith("WRONG"), (d, verdict)
     if res.status == "ok":

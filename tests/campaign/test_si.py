@@ -122,7 +122,7 @@ def test_cli_scene_si_options_need_si(capsys):
 
 
 def test_scene_model_field_and_auto_choice():
-    from sweep.engine.models import bem_node_budget, bem_nodes_needed, choose_model, simulate_scene
+    from sweep.engine.models import bem_node_budget, bem_nodes_needed, choose_model, simulate
     from sweep.scene import Numerics
 
     assert Scene(n=0.8, a0=3.0, rate=1.0).model == "bem"
@@ -134,9 +134,9 @@ def test_scene_model_field_and_auto_choice():
     # l0 = 1.693/mu^2: 0.16 a_ref at mu = 3.24 (a few hundred nodes), 0.0042 at mu = 20
     assert bem_nodes_needed(small, num) <= bem_node_budget(num) < bem_nodes_needed(big, num)
     assert choose_model(small, num) == "bem" and choose_model(big, num) == "crack"
-    res = simulate_scene(big, num)
+    res = simulate(big, num)
     assert res.ok and res.model_used == "crack" and res.to_row()["model"] == "auto"
-    assert simulate_scene(Scene(n=0.8, a0=3.0, rate=1.0, model="pb")).model_used == "pb"
+    assert simulate(Scene(n=0.8, a0=3.0, rate=1.0, model="pb")).model_used == "pb"
 
 
 def test_config_model_axis(tmp_path):
@@ -165,7 +165,7 @@ def test_sweep_runs_the_scene_models(tmp_path):
 def test_si_config_runs_and_gives_rows_back_in_si(tmp_path, capsys):
     """`units: si` end to end: sweep run, then the rows in both systems from the file alone
     (si_table and `sweep info --si`); pull_off_N = pull_off pi dg R, 1.5 pi dg R closed form."""
-    from sweep.campaign.si import si_table
+    from sweep.campaign.store import si_table
 
     p = tmp_path / "si.yaml"
     p.write_text("name: si\nunits: si\ngrid:\n  model: [crack, pb]\n  R: 5.19e-3\n"
@@ -203,7 +203,7 @@ def test_shipped_pdms_config_runs_and_matches_make_pdms(tmp_path):
     from pathlib import Path
 
     from sweep.paper import pdms
-    from sweep.campaign.si import si_table
+    from sweep.campaign.store import si_table
 
     cfg = Path(__file__).resolve().parents[2] / "configs" / "pdms.yaml"
     out = tmp_path / "p.h5"

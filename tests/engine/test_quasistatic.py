@@ -144,7 +144,7 @@ def test_elastic_scenes_of_a_sweep_take_the_quasistatic_branch():
     # the example (mu = 10, k = 1): the hereditary BEM ran 616 s and failed; through
     # the model registry (what `sweep scene` and sweeps call) it is the equilibrium branch,
     # within 1 % of JKR's 1.5 (the LJ excess at mu = 10 is 0.0093, measured above)
-    from sweep.engine.models import simulate_scene
+    from sweep.engine.models import simulate as simulate_scene
 
     res = simulate_scene(Scene(n=0.5, k=1.0, mu=10.0, a0=2.5, rate=1.0))
     assert res.ok and res.model_used == "elastic"

@@ -4,10 +4,15 @@ import json
 
 import pytest
 
-from sweep.paper.reproduce import main
+from sweep.cli import main as sweep_main
 from tests.analysis.test_fits import synthetic_threshold_runs, synthetic_vr_runs, write_results
 
 pytest.importorskip("matplotlib")
+
+
+def main(argv):
+    """``sweep reproduce ARGV`` (what python -m sweep.paper.reproduce runs)."""
+    return sweep_main(["reproduce", *argv])
 
 
 def test_pipeline_writes_fits_figures_and_report(tmp_path, capsys):
