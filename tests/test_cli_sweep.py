@@ -96,15 +96,73 @@ def test_fresh_keeps_old_file_as_backup(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     cfg = write(tmp_path / "tiny.yaml", TINY)
     run_sweep(cfg, jobs=1, simulate=fake_simulate, progress="none")
-    other = write(tmp_path / "other.yaml", TINY.replace("rate: [1, 100]", "rate: [1, 10]"))
+    other = write(tmp_path / "other.yaml", TINY.replace("rate: [1, 100]", "rate: [1, 10]")
+                  .replace("nodes: 60", "nodes: 80"))
     before = (tmp_path / "out/tiny.h5").read_bytes()
-    # a different config into the same output: refused, file untouched, exit 2
+    # other numerics into the same output: refused with the reason, file untouched, exit 2
     assert main(["run", str(other), "--progress", "none"]) == 2
     assert (tmp_path / "out/tiny.h5").read_bytes() == before
     # --fresh moves the old file aside before writing the new one
     run_sweep(other, jobs=1, simulate=fake_simulate, progress="none", resume=False)
     assert (tmp_path / "out/tiny.h5.bak").read_bytes() == before
     assert sorted(load("out/tiny.h5").rate.unique()) == [1.0, 10.0]
+
+
+# ----------------------------------------------------------------------------- growing
+def _must_not_run(scene, numerics):
+    raise AssertionError(f"scene recomputed: {scene}")
+
+
+def test_grow_a_sweep_runs_only_the_new_scenes(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    run_sweep(cfg, jobs=1, simulate=fake_simulate, progress="none")
+    before = load("out/tiny.h5").set_index("scene_id").finished_at.to_dict()
+    grown = write(tmp_path / "grown.yaml", TINY.replace("rate: [1, 100]", "rate: [1, 100, 1e4]")
+                  .replace("n: [0.4, 1.6]", "n: [0.4, 1.0, 1.6]"))
+    seen = []
+
+    def progress(info):
+        seen.append(info["row"]["scene_id"])
+
+    report = run_sweep(grown, jobs=1, simulate=fake_simulate, progress=progress)
+    new_ids = {sid for sid, _ in load_config(grown).tasks()} - set(before)
+    assert (report.total, report.skipped, report.ran) == (9, 4, 5)
+    assert set(seen) == new_ids and len(seen) == 5              # only the new scenes ran
+    df = load("out/tiny.h5")
+    assert len(df) == 9 and df.scene_id.is_unique
+    for sid, fin in before.items():                              # old rows untouched
+        assert df.set_index("scene_id").finished_at[sid] == fin
+    attrs = read_attrs("out/tiny.h5")
+    assert attrs["complete"] and attrs["n_scenes"] == 9
+    assert attrs["config_hash"] == load_config(grown).config_hash
+    assert main(["info", "out/tiny.h5"]) == 0
+    out = capsys.readouterr().out
+    assert "scenes: 9 finished of 9" in out and "grown: the grid is the union" in out
+    assert "rate: 3 values in [1, 1e+04]" in out
+    # the smaller config again: nothing recomputed, nothing dropped, the file stays complete
+    again = run_sweep(cfg, jobs=1, simulate=_must_not_run, progress="none")
+    assert (again.ran, again.skipped) == (0, 4)
+    assert len(load("out/tiny.h5")) == 9 and read_attrs("out/tiny.h5")["n_scenes"] == 9
+
+
+@pytest.mark.parametrize("change, needle", [
+    (("nodes: 60", "nodes: 80"), "numerics differ (nodes 60 -> 80)"),
+    (("output:", "store: {trajectories: true}\noutput:"),
+     "store.trajectories differs (file false, this config true)"),
+])
+def test_grow_refused_when_numerics_or_trajectories_change(tmp_path, monkeypatch, capsys,
+                                                           change, needle):
+    monkeypatch.chdir(tmp_path)
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    run_sweep(cfg, jobs=1, simulate=fake_simulate, progress="none")
+    before = (tmp_path / "out/tiny.h5").read_bytes()
+    text = TINY.replace("rate: [1, 100]", "rate: [1, 100, 1e4]").replace(*change)
+    other = write(tmp_path / "other.yaml", text)
+    assert main(["run", str(other), "--progress", "none"]) == 2
+    line = one_error_line(capsys.readouterr().err)
+    assert needle in line and "--fresh" in line and "--out" in line
+    assert (tmp_path / "out/tiny.h5").read_bytes() == before
 
 
 # ----------------------------------------------------------------------------- bad input
@@ -326,3 +384,56 @@ def test_info_on_a_directory_is_one_line(tmp_path, capsys):
     assert main(["info", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "is a directory" in err
+
+
+def test_sigkill_while_growing_then_resume(tmp_path):
+    """Grow a finished sweep (rates 1, 10 -> 1, 10, 100, 1000), SIGKILL the growing run at
+    several moments: the first grid's rows are never lost or recomputed, and the resumed run
+    completes the union with every scene run once."""
+    small = write(tmp_path / "small.yaml", KILL_CFG.replace("rate: [1, 10, 100, 1000]",
+                                                            "rate: [1, 10]"))
+    cfg = write(tmp_path / "kill.yaml", KILL_CFG)
+    out = tmp_path / "kill.h5"
+    first = run_cli(["run", str(small), "-j", "2", "--progress", "log"], cwd=tmp_path)
+    assert first.returncode == 0, first.stderr
+    old = load(out).set_index("scene_id").finished_at.to_dict()
+    assert len(old) == 12
+    tasks = [sid for sid, _ in load_config(cfg).tasks()]
+    args = ["run", str(cfg), "-j", "2", "--progress", "log", "--consolidate-every", "0"]
+    logged: Counter = Counter()
+    snapshot: dict[str, float] = dict(old)
+    kills = 0
+    for step in [("time", 0.5), ("lines", 1, 0.0), ("lines", 2, 0.5)]:
+        run = Sweep(tmp_path, args)
+        if step[0] == "time":
+            time.sleep(step[1])
+        else:
+            run.wait_lines(step[1])
+            time.sleep(step[2] * run.scene_interval())
+        if run.p.poll() is not None:
+            run.drain()
+            logged.update(run.ids)
+            break
+        assert run.kill() == -signal.SIGKILL
+        kills += 1
+        logged.update(run.ids)
+        df = load(out)                               # readable right after the kill
+        assert df.scene_id.is_unique
+        assert set(old) <= set(df.scene_id)          # the first grid is never lost
+        assert set(run.ids) <= set(df.scene_id)
+        for sid, fin in zip(df.scene_id, df.finished_at):
+            assert snapshot.setdefault(sid, fin) == fin   # never recomputed
+    assert kills >= 2, "sweep finished too quickly to be killed"
+    final = run_cli(args, cwd=tmp_path)
+    assert final.returncode == 0, final.stderr
+    logged.update(LOG_RE.match(ln).group(1) for ln in final.stderr.splitlines()
+                  if LOG_RE.match(ln))
+    df = load(out)
+    assert sorted(df.scene_id) == sorted(tasks)
+    assert not set(logged) & set(old)                # no scene of the first grid ran again
+    assert max(logged.values()) == 1, logged.most_common(3)
+    for sid, fin in zip(df.scene_id, df.finished_at):
+        if sid in snapshot:
+            assert snapshot[sid] == fin
+    attrs = read_attrs(out)
+    assert attrs["complete"] and attrs["n_scenes"] == 24 and not parts_dir(out).exists()

@@ -133,3 +133,18 @@ def test_new_files_record_the_id_version(tmp_path):
     cfg = parse_config(read_attrs(V1_FILE)["config_text"])
     run_sweep(cfg, jobs=1, out=tmp_path / "new.h5", simulate=_fake, progress="none")
     assert read_attrs(tmp_path / "new.h5")["scene_id_version"] == SCENE_ID_VERSION
+
+
+def test_version_1_file_grows_or_refuses_in_one_line(tmp_path, capsys):
+    # a grown version of the v1 file's config (its preset was redefined since): refused with
+    # the reason, the file untouched and still loading; the pinned numerics grow it
+    path = tmp_path / "v1.h5"
+    shutil.copyfile(V1_FILE, path)
+    before = path.read_bytes()
+    text = read_attrs(path)["config_text"].replace("n: [0.4, 1.6]", "n: [0.4, 1.0, 1.6]")
+    cfg_path = tmp_path / "cfg.yaml"
+    cfg_path.write_text(text)
+    assert main(["run", str(cfg_path), "--out", str(path), "--progress", "none"]) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert len(err) == 1 and "numerics meant other values" in err[0], err
+    assert path.read_bytes() == before and len(load(path)) == 3

@@ -421,7 +421,7 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
     store = ResultStore(path, config_hash=cfg.config_hash, config_name=cfg.name,
                         config_text=cfg.text, config_source=cfg.source, n_scenes=len(tasks),
                         trajectories=cfg.trajectories, template_row=template_row(cfg),
-                        interval=consolidate_every)
+                        interval=consolidate_every, config=cfg)
     try:
         store.prepare(resume=resume)
     except StoreBusyError as exc:
@@ -453,6 +453,10 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
         prog.message(f"sweep {cfg.name}: all {len(tasks)} scenes already done -> {path}")
     if store.backup is not None:
         prog.message(f"previous results moved to {store.backup}")
+    if store.grown_from:
+        prog.message(f"growing {path}: same numerics as the config that wrote it, so its "
+                     f"finished scenes are kept and only new ones run ({len(done)} in the "
+                     f"file, {store.meta['n_scenes']} in the grown grid)")
 
     ran = failed = 0
     failed_ids = []

@@ -338,6 +338,18 @@ def load_results(path) -> pd.DataFrame:
         raise InputError(f"results: {str(path)!r} is not a sweep results file ({exc})") from None
 
 
+def _history(value) -> list[dict]:
+    """The ``config_history`` attribute of a grown file: a list of {config_hash, config_text,
+    until} of the earlier configs whose scenes it holds (empty for a file that never grew)."""
+    if not value:
+        return []
+    try:
+        items = json.loads(str(value))
+    except ValueError:
+        return []
+    return [e for e in items if isinstance(e, dict) and "config_hash" in e]
+
+
 def _dedupe(df: pd.DataFrame) -> pd.DataFrame:
     return df.drop_duplicates("scene_id", keep="first").reset_index(drop=True)
 
@@ -382,6 +394,10 @@ def si_table(results) -> pd.DataFrame:
     if cfg is None or cfg.units != "si":
         raise InputError(f"results: {results} was not written by a `units: si` config")
     by_id = dict(cfg.si_tasks())
+    for entry in _history(read_attrs(results).get("config_history", "")):
+        with contextlib.suppress(InputError):   # a grown file: the earlier grids' points too
+            for sid, si in parse_config(entry["config_text"]).si_tasks():
+                by_id.setdefault(sid, si)
     rows = []
     for row in load(results).to_dict("records"):
         si = by_id.get(row["scene_id"])
@@ -457,8 +473,15 @@ class ResultStore:
 
     def __init__(self, path, *, config_hash: str, config_name: str = "", config_text: str = "",
                  config_source: str = "", n_scenes: int = 0, trajectories: bool = False,
-                 template_row: dict | None = None, interval: float = 5.0):
+                 template_row: dict | None = None, interval: float = 5.0, config=None):
         self.path = Path(path)
+        #: the SweepConfig being run (optional): lets a results file of the same numerics and
+        #: trajectory flag *grow* to this config's grid (see :meth:`prepare`)
+        self.config = config
+        #: (config hash, config text) of the earlier configs whose results this file holds
+        #: when it grew; empty when it did not
+        self.grown_from: list[tuple[str, str]] = []
+        self._grow_ids: set[str] = set()
         self.parts = parts_dir(self.path)
         self.config_hash = config_hash
         self.meta = {
@@ -569,13 +592,52 @@ class ResultStore:
                         f"are kept and still load): use --fresh to recompute (the old file is "
                         f"kept as a .bak) or --out to write elsewhere")
                 if h != self.config_hash:
+                    reason = self._grow_refusal(h, text)
+                    if reason is None:
+                        continue          # the same numerics: the grid grows onto this file
                     raise InputError(
                         f"{where} holds results of a different config (config hash {h}, this "
-                        f"config {self.config_hash}); use --fresh to start over (the old file "
-                        f"is kept as a .bak) or --out to write elsewhere")
+                        f"config {self.config_hash}) that cannot grow into this one: {reason}; "
+                        f"use --fresh to start over (the old file is kept as a .bak) or --out "
+                        f"to write elsewhere")
         except BaseException:
             self._release()
             raise
+
+    def _grow_refusal(self, old_hash: str, old_text: str) -> str | None:
+        """Why results of the config ``old_text`` (hash ``old_hash``) cannot grow into this
+        config's file, or None when they can: the same units, numerics and trajectory flag
+        (the grid alone changed; scene ids depend on the scene and the numerics only, so the
+        finished scenes are kept and only the new ones run). Records what it accepts."""
+        if not old_text:
+            return "the file records no config text to compare numerics with"
+        try:
+            old = parse_config(old_text, source="the file's config")
+        except InputError as exc:
+            return f"its recorded config no longer reads ({exc})"
+        if old.config_hash != old_hash:
+            return ("its config's numerics meant other values when it was written (a preset "
+                    "or default changed since)")
+        new = self.config
+        if new is None:
+            try:
+                new = parse_config(str(self.meta.get("config_text", "")), source="config")
+            except InputError as exc:
+                return f"this config's text does not read ({exc})"
+        if old.units != new.units:
+            return f"units differ (file {old.units}, this config {new.units})"
+        if old.numerics != new.numerics:
+            a, b = old.numerics.to_dict(), new.numerics.to_dict()
+            diff = [f"{k} {a.get(k)!r} -> {b.get(k)!r}" for k in sorted(set(a) | set(b))
+                    if a.get(k) != b.get(k)]
+            return f"numerics differ ({', '.join(diff) or 'preset'})"
+        if old.trajectories != new.trajectories:
+            return (f"store.trajectories differs (file {str(old.trajectories).lower()}, this "
+                    f"config {str(new.trajectories).lower()})")
+        if (old_hash, old_text) not in self.grown_from:
+            self.grown_from.append((old_hash, old_text))
+            self._grow_ids.update(sid for sid, _ in old.tasks())
+        return None
 
     # -- opening ----------------------------------------------------------------
     def begin(self, fresh: bool = False) -> set[str]:
@@ -589,28 +651,45 @@ class ResultStore:
             if self.parts.exists():
                 os.replace(self.parts, parts_dir(self.backup))
         started = None
+        history = []
         if self.path.exists():
             with _open_main(self.path) as f:
                 started = f.attrs.get("started_at")
+                history = _history(f.attrs.get("config_history", ""))
                 self._main_complete = bool(f.attrs.get("complete", 0))
                 for row in _read_runs_rows(f):
                     self._add(row)
         meta = self.parts / META
         if meta.exists() and started is None:
             with contextlib.suppress(ValueError, OSError, KeyError):
-                started = json.loads(meta.read_text())["started_at"]
+                m = json.loads(meta.read_text())
+                history = history or _history(m.get("config_history", ""))
+                started = m["started_at"]
         if started:
             self.meta["started_at"] = str(started)
         for row in _read_journal(self.path):
             if row["scene_id"] not in self._ids:
                 self._add(row)
                 self._dirty = True
+        if self.grown_from:
+            # growing: the file's grid is the union of this config's and the earlier ones'
+            # (the attribute config_history keeps the earlier configs' hashes and texts)
+            for h, text in self.grown_from:
+                if not any(e["config_hash"] == h for e in history):
+                    history.append({"config_hash": h, "config_text": text,
+                                    "until": now_iso()})
+            self._dirty = True   # consolidate now: the main file records the grown grid
+        if history:
+            self.meta["config_history"] = json.dumps(history)
+        if self.config is not None and (self.grown_from or history):
+            ids = {sid for sid, _ in self.config.tasks()} | set(self._ids) | self._grow_ids
+            self.meta["n_scenes"] = len(ids)
         # the main file exists before the journal does, so a reader always finds a schema
         if not self.path.exists() or self._dirty:
             self.consolidate()
         # journal: create or repair (truncate a torn last line), then open for appending
         (self.parts / "traj").mkdir(parents=True, exist_ok=True)
-        if not meta.exists():
+        if not meta.exists() or self.grown_from:
             tmp = meta.with_name(META + ".tmp")
             tmp.write_text(json.dumps(self.meta))
             os.replace(tmp, meta)
@@ -770,6 +849,11 @@ def summary(path, slowest: int = 5) -> str:
                  f"{attrs.get('updated_at', '?')}  finished "
                  f"{attrs.get('finished_at') or '(not finished)'}")
     pending = parts_dir(path).exists()
+    grown = _history(attrs.get("config_history", ""))
+    if grown:
+        lines.append(f"  grown: the grid is the union of this config and {len(grown)} earlier "
+                     f"one{'s' if len(grown) > 1 else ''} (config hash "
+                     f"{', '.join(e['config_hash'] for e in grown)})")
     lines.append(f"  scenes: {len(df)} finished of {total}"
                  + ("  (journal present: running, or killed; rerun to resume)" if pending
                     else ""))
