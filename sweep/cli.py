@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import shlex
 import sys
 from importlib import import_module
 from pathlib import Path
@@ -369,7 +370,7 @@ def plot_command(results, out):
 def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_timeout,
             consolidate_every):
     """Run (or resume) the sweep described by the YAML file CONFIG."""
-    from .campaign.scheduler import SweepRuntimeError, run_sweep
+    from .campaign.scheduler import SweepInterrupted, SweepRuntimeError, run_sweep
 
     try:
         report = run_sweep(config, jobs=jobs, backend=backend, scheduler=scheduler, out=out,
@@ -377,6 +378,15 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
                            consolidate_every=consolidate_every)
     except SweepRuntimeError as exc:
         raise click.ClickException(" ".join(str(exc).split())) from None
+    except SweepInterrupted as exc:
+        again = ["sweep", "run", config]
+        if out is not None:
+            again += ["--out", out]
+        if backend != "loky":
+            again += ["--backend", backend] + (["--scheduler", scheduler] if scheduler else [])
+        click.echo(f"\ninterrupted: {exc.kept} of {exc.total} scenes are kept in "
+                   f"{exc.output}; to resume, run: {shlex.join(again)}", err=True)
+        raise SystemExit(130) from None
     click.echo(report.line())
 
 

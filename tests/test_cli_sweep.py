@@ -272,10 +272,13 @@ class Sweep:
         self.lines: queue.Queue = queue.Queue()
         self.ids: list[str] = []
         self.times: list[float] = []
-        threading.Thread(target=self._pump, daemon=True).start()
+        self.raw: list[str] = []                     # every stderr line, in order
+        self.pump = threading.Thread(target=self._pump, daemon=True)
+        self.pump.start()
 
     def _pump(self):
         for line in self.p.stderr:
+            self.raw.append(line)
             self.lines.put((time.monotonic(), line))
 
     def _take(self, item):
@@ -437,3 +440,98 @@ def test_sigkill_while_growing_then_resume(tmp_path):
             assert snapshot[sid] == fin
     attrs = read_attrs(out)
     assert attrs["complete"] and attrs["n_scenes"] == 24 and not parts_dir(out).exists()
+
+
+# ----------------------------------------------------------------------------- what is said
+def test_log_lines_name_the_scene_inputs(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    run_sweep(cfg, jobs=1, simulate=fake_simulate, progress="log")
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if LOG_RE.match(ln)]
+    assert len(lines) == 4
+    for sid, scene in load_config(cfg).tasks():
+        line = next(ln for ln in lines if LOG_RE.match(ln).group(1) == sid)
+        assert (f" ok n={scene.n:g} k={scene.k:g} mu={scene.mu:g} a0={scene.a0:g} "
+                f"rate={scene.rate:g} pull_off=") in line
+
+
+def test_first_run_says_it_compiles(monkeypatch):
+    from sweep.campaign import scheduler
+    from sweep.engine import bem
+
+    said = []
+
+    class Prog:
+        def message(self, text):
+            said.append(text)
+
+    monkeypatch.setattr(bem, "warm_up", lambda: 42.25)
+    monkeypatch.setattr(bem, "kernels_cached", lambda: False)
+    scheduler._warm_parent(Prog())
+    assert said == ["compiling kernels (first run only) ...",
+                    "compiling kernels (first run only): done in 42.2 s"]
+    said.clear()
+    monkeypatch.setattr(bem, "kernels_cached", lambda: True)
+    scheduler._warm_parent(Prog())
+    assert said == []                                  # a warm cache: nothing to say
+
+
+def test_kernels_cached_looks_at_the_numba_cache(tmp_path, monkeypatch):
+    from sweep.engine import bem
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    assert not bem.kernels_cached()                     # an empty cache: cold
+
+
+_CALLS = []
+
+
+def _interrupt_after_3(scene, numerics):
+    _CALLS.append(scene)
+    if len(_CALLS) > 3:
+        raise KeyboardInterrupt
+    return fake_simulate(scene, numerics)
+
+
+def test_sigint_says_what_is_kept_and_how_to_resume(tmp_path, monkeypatch, capsys):
+    from sweep.campaign import scheduler
+
+    monkeypatch.chdir(tmp_path)
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    real = scheduler.run_sweep
+
+    def interrupted(*args, **kw):
+        kw.update(jobs=1, simulate=_interrupt_after_3)
+        return real(*args, **kw)
+
+    _CALLS.clear()
+    monkeypatch.setattr(scheduler, "run_sweep", interrupted)
+    assert main(["run", str(cfg), "--progress", "none"]) == 130
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    out = tmp_path / "out" / "tiny.h5"
+    assert err == [f"interrupted: 3 of 4 scenes are kept in {out}; to resume, run: "
+                   f"sweep run {cfg}"]
+    assert len(load(out)) == 3
+    monkeypatch.setattr(scheduler, "run_sweep", real)
+    report = run_sweep(cfg, jobs=1, simulate=fake_simulate, progress="none")
+    assert (report.ran, report.skipped) == (1, 3)
+
+
+def test_sigint_to_the_process_group_keeps_scenes(tmp_path):
+    """Ctrl-C in a terminal signals the parent and its loky workers: one line says how many
+    scenes are kept (as many as the file holds) and the command that resumes."""
+    cfg = write(tmp_path / "big.yaml", KILL_CFG.replace("{preset: fast, nodes: 60}",
+                                                        "{preset: balanced}")
+                .replace("a0: [2.0, 2.5]", "a0: [3.0, 4.0, 5.0]"))
+    run = Sweep(tmp_path, ["run", str(cfg), "-j", "2", "--progress", "log"])
+    run.wait_lines(2)
+    assert run.p.poll() is None, "sweep finished before the interrupt"
+    os.killpg(run.p.pid, signal.SIGINT)
+    assert run.p.wait(timeout=60) == 130
+    run.pump.join(timeout=30)                        # stderr read to its end
+    text = "".join(run.raw)
+    m = re.search(r"^interrupted: (\d+) of 36 scenes are kept in (\S+); to resume, run: "
+                  r"sweep run \S+big.yaml$", text, re.M)
+    assert m, text
+    assert int(m.group(1)) == len(load(tmp_path / "kill.h5")) >= 2
+    assert "Traceback" not in text

@@ -62,6 +62,16 @@ class SweepRuntimeError(RuntimeError):
     """
 
 
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by SIGINT (Ctrl-C): ``kept`` finished scenes of ``total`` are saved in
+    ``output``; running the same command again resumes. A KeyboardInterrupt, so code that
+    catches those still does."""
+
+    def __init__(self, kept: int, total: int, output: Path):
+        super().__init__(f"interrupted: {kept} of {total} scenes are kept in {output}")
+        self.kept, self.total, self.output = kept, total, output
+
+
 @dataclass
 class SweepReport:
     """What :func:`run_sweep` did."""
@@ -157,11 +167,37 @@ def template_row(config: SweepConfig) -> dict:
 
 
 # ----------------------------------------------------------------------------- progress
+def _num(x) -> str | None:
+    if x is None or isinstance(x, bool):
+        return None
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return None
+    return None if math.isnan(x) else f"{x:.4g}"
+
+
+def scene_inputs(row: dict) -> str:
+    """The inputs of a scene as ``n=0.8 k=0.5 mu=3.24 a0=2 rate=100`` (``delta0=`` for a
+    scene started from an indentation; ``material=`` and ``model=`` when not the default)."""
+    parts = []
+    for name in ("n", "k", "mu", "a0", "delta0", "rate"):
+        v = _num(row.get(name))
+        if v is not None:
+            parts.append(f"{name}={v}")
+    for name, default in (("material", "mpl"), ("model", "bem")):
+        v = row.get(name)
+        if v not in (None, "", default):
+            parts.append(f"{name}={v}")
+    return " ".join(parts)
+
+
 class Progress:
     """Progress display: a tqdm bar on a terminal ("bar"), one line per scene ("log").
 
     "log" is the mode for files and CI logs (no carriage returns): each finished scene prints
-    ``[done/total] <scene_id> <status> pull_off=... wall=...s`` (and the reason of a failure).
+    ``[done/total] <scene_id> <status> n=... k=... mu=... a0=... rate=... pull_off=...
+    wall=...s`` (the scene's inputs, :func:`scene_inputs`; and the reason of a failure).
     A callable ``mode`` gets a dict (done, total, failed, eta, row) after each scene instead.
     """
 
@@ -219,8 +255,10 @@ class Progress:
         elif self.mode == "log":
             po = row.get("pull_off")
             po = f"{po:.5g}" if isinstance(po, float) else str(po)
+            inputs = scene_inputs(row)
             text = (f"[{self.done:{self.width}d}/{self.total}] {row['scene_id']} "
-                    f"{row.get('status')} pull_off={po} wall={row.get('wall_s', 0.0):.3g}s")
+                    f"{row.get('status')} {inputs + ' ' if inputs else ''}pull_off={po} "
+                    f"wall={row.get('wall_s', 0.0):.3g}s")
             if row.get("status") != "ok" and row.get("reason"):
                 text += f" reason: {row['reason']}"
             self._echo(text)
@@ -464,7 +502,7 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
     try:
         if todo:
             if simulate is None:
-                _warm_parent()
+                _warm_parent(prog)
             prog.start()
             chunks = dispatch_chunks(todo, cfg.numerics, n_jobs)
             results = _results(chunks, cfg, backend, n_jobs, client, simulate)
@@ -482,7 +520,12 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
                     warnings.simplefilter("ignore")
                     results.close()
         completed = True
-    except (KeyboardInterrupt, SystemExit):
+    except KeyboardInterrupt:
+        prog.close()
+        _finish_store(store)
+        raise SweepInterrupted(kept=len(store.rows), total=store.meta["n_scenes"],
+                               output=path) from None
+    except SystemExit:
         prog.close()
         _finish_store(store)
         raise
@@ -519,13 +562,21 @@ def _close_dask(client, cluster) -> None:
                 pass
 
 
-def _warm_parent() -> None:
-    """Compile (or load) the Numba kernels once, in the parent, before the workers start."""
+def _warm_parent(prog: Progress | None = None) -> None:
+    """Compile (or load) the Numba kernels once, in the parent, before the workers start.
+
+    On a cold cache (the first run after an install or an edit of the kernels) the compile
+    takes tens of seconds: ``prog`` then gets a line before and one with its time after."""
     try:  # lazy: see _prepare_worker
         from ..engine import bem as solver
     except ImportError as exc:
         raise SweepRuntimeError(f"cannot import the solver ({exc})") from None
-    solver.warm_up()
+    cold = not solver.kernels_cached()
+    if cold and prog is not None:
+        prog.message("compiling kernels (first run only) ...")
+    seconds = solver.warm_up()
+    if cold and prog is not None:
+        prog.message(f"compiling kernels (first run only): done in {seconds:.1f} s")
 
 
 def run_chunk(scenes, numerics, trajectories: bool = False,

@@ -21,7 +21,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import re
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -220,6 +223,30 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
         return "inner" if a[-1] < pb.tip_range[0] else "outer"
     finish(res, status, res.trajectory, dr, min_travel, pb.scales, advice=ADVICE_GRADED)
     return None
+
+
+def kernels_cached() -> bool:
+    """Whether every Numba kernel module has a cache index at least as new as its source, so
+    that :func:`warm_up` loads the kernels rather than compiling them (about 40 s on a cold
+    cache). A guess from file names and times (``$NUMBA_CACHE_DIR`` or the kernels'
+    ``__pycache__``), used only to tell the user what a silent first start is doing."""
+    from .. import kernels
+
+    src_dir = Path(kernels.__file__).resolve().parent
+    env = os.environ.get("NUMBA_CACHE_DIR", "").strip()
+    root = Path(env) if env else src_dir / "__pycache__"
+    if not root.is_dir():
+        return False
+    for src in src_dir.glob("*.py"):
+        try:
+            if not re.search(r"^@njit", src.read_text(encoding="utf-8"), re.M):
+                continue
+            stamps = [p.stat().st_mtime for p in root.rglob(f"{src.stem}.*.nbi")]
+            if not stamps or max(stamps) < src.stat().st_mtime:
+                return False
+        except OSError:
+            return False
+    return True
 
 
 def warm_up() -> float:

@@ -215,9 +215,14 @@ def test_progress_bar_and_log_lines():
     p.update({"scene_id": "abc", "status": "ok", "pull_off": 1.23456789, "wall_s": 0.5})
     p.update({"scene_id": "def", "status": "failed", "pull_off": math.nan, "wall_s": 0.25,
               "reason": "why"})
+    p.update({"scene_id": "ghi", "status": "ok", "pull_off": 2.0, "wall_s": 0.5, "n": 0.8,
+              "k": 0.5, "mu": 3.24, "a0": math.nan, "delta0": 1.5, "rate": 1e6,
+              "material": "sls", "model": "bem"})
     lines = buf.getvalue().splitlines()
     assert lines == ["[1/3] abc ok pull_off=1.2346 wall=0.5s",
-                     "[2/3] def failed pull_off=nan wall=0.25s reason: why"]
+                     "[2/3] def failed pull_off=nan wall=0.25s reason: why",
+                     "[3/3] ghi ok n=0.8 k=0.5 mu=3.24 delta0=1.5 rate=1e+06 material=sls "
+                     "pull_off=2 wall=0.5s"]
 
 
 def test_real_solver_sequential_and_parallel_agree(tmp_path):
