@@ -43,8 +43,10 @@ demo: $(STAMP)
 	$(BIN)/sweep run configs/demo.yaml
 	$(BIN)/sweep info results/demo.h5
 	$(BIN)/sweep plot results/demo.h5 --out results/demo.png
-	@echo "results: results/demo.h5 (read with: python -c 'import sweep; print(sweep.load(\"results/demo.h5\"))')"
+	@echo "results: results/demo.h5 (read with: .venv/bin/python -c 'import sweep; print(sweep.load(\"results/demo.h5\"))')"
 	@echo "figure:  results/demo.png"
+	@echo "the sweep command is in .venv/bin, not on PATH: run .venv/bin/sweep --help, or"
+	@echo "         source .venv/bin/activate   (then: sweep --help; python -c 'import sweep')"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not slow" tests
