@@ -409,12 +409,21 @@ def info_cmd(results, slowest, as_si, csv_out):
         df = si_table(results)
         if csv_out:
             df.to_csv(csv_out, index=False)
-        click.echo("scene_id          model  status  speed[um/s]  mu       l0[nm]  "
-                   "pull_off[mN]  jkr_pull_off[mN]  crack_speed[um/s]")
-        for r in df.sort_values(["model_used", "si_speed"]).to_dict("records"):
+        # the SI inputs that vary over the file (besides the speed) get a column each
+        varied = [c for c in df.columns if c.startswith("si_") and c != "si_speed"
+                  and df[c].nunique(dropna=True) > 1]
+        heads = [f"{c[3:]}[{_si_unit(c[3:])}]" if _si_unit(c[3:]) else c[3:] for c in varied]
+        click.echo("scene_id          requested  used   status  "
+                   + "".join(f"{h:<11} " for h in heads)
+                   + "speed[um/s]  mu       l0[nm]  pull_off[mN]  jkr_pull_off[mN]  "
+                     "crack_speed[um/s]")
+        for r in df.sort_values(["model_used", *varied, "si_speed"]).to_dict("records"):
             cs = r["crack_speed_m_s"]
-            click.echo(f"{r['scene_id']}  {r['model_used']:<5}  {r['status']:<6}  "
-                       f"{r['si_speed'] * 1e6:<11.4g}  {r['mu']:<7.4g}  {r['l0_m'] * 1e9:<6.4g}  "
+            click.echo(f"{r['scene_id']}  {r['model'] or '?':<9}  {r['model_used'] or '-':<5}  "
+                       f"{r['status']:<6}  "
+                       + "".join(f"{r[c]:<11.4g} " for c in varied)
+                       + f"{r['si_speed'] * 1e6:<11.4g}  {r['mu']:<7.4g}  "
+                       f"{r['l0_m'] * 1e9:<6.4g}  "
                        f"{(r['pull_off_N'] or math.nan) * 1e3:<12.5g}  "
                        f"{r['jkr_pull_off_N'] * 1e3:<16.5g}  "
                        f"{(cs if cs is not None else math.nan) * 1e6:.4g}")
@@ -424,6 +433,13 @@ def info_cmd(results, slowest, as_si, csv_out):
     except FileNotFoundError:
         raise InputError(f"no results at {results}") from None
     click.echo(text)
+
+
+def _si_unit(name: str) -> str:
+    from .campaign.si import SI_AXES
+
+    info = SI_AXES.get(name)
+    return info.unit if info is not None else ""
 
 
 # == DMA fitting (fit-dma) ==

@@ -1,7 +1,8 @@
 """Figures of a sweep's results (matplotlib, the optional ``plot`` extra).
 
 ``plot_sweep(path, out)`` draws what a user checks first after a run: the pull-off force
-against the unloading rate (one line per (n, k, a0) group) and, when the sweep stored
+against the unloading rate (one line per (n, k, a0) group; failed scenes as red crosses, at
+the bottom edge when they have no pull-off) and, when the sweep stored
 trajectories, the load against the contact radius P(a) with the JKR curve for reference.
 """
 from __future__ import annotations
@@ -27,6 +28,28 @@ def pyplot():
     except ImportError:  # pragma: no cover - the extra is installed by make demo/test
         raise InputError("plot needs matplotlib: pip install 'visco-sweep[plot]'") from None
     return plt
+
+
+def mark_failed(ax, df) -> int:
+    """Mark the failed scenes of ``df`` on the pull-off-against-rate axes ``ax``: a red cross
+    at their pull-off when they have one, else at the bottom of the axes at their rate (they
+    are never dropped silently). Returns how many were marked."""
+    failed = df[df["status"] != "ok"]
+    if not len(failed):
+        return 0
+    rate = failed["rate"].astype(float).to_numpy()
+    po = failed["pull_off"].astype(float).to_numpy()
+    has = np.isfinite(po) & np.isfinite(rate)
+    label = f"failed ({len(failed)})"
+    if has.any():
+        ax.plot(rate[has], po[has], "x", color="red", ms=7, mew=1.5, ls="none", label=label)
+        label = None
+    if (~has).any():
+        # no pull-off: at the bottom edge, x in data units (the rate), y in axes units
+        ax.plot(rate[~has], np.full((~has).sum(), 0.03), "x", color="red", ms=7, mew=1.5,
+                ls="none", transform=ax.get_xaxis_transform(), clip_on=False,
+                label=label or "_failed_no_pull_off")
+    return len(failed)
 
 
 def plot_sweep(path, out=None) -> Path:
@@ -63,6 +86,7 @@ def plot_sweep(path, out=None) -> Path:
         key = key if isinstance(key, tuple) else (key,)
         label = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in zip(keys, key))
         ax.plot(g["rate"], g["pull_off"], "o-", label=label or None)
+    mark_failed(ax, df)
     ax.axhline(1.5, color="0.6", ls=":", lw=1, label="JKR elastic, 1.5")
     ax.set_xscale("log")
     ax.set_xlabel(AXIS_INFO["rate"].label)

@@ -381,7 +381,8 @@ def si_table(results) -> pd.DataFrame:
     """The rows of a results file written by a ``units: si`` config, in both systems.
 
     The SI inputs of each scene come from the config the file records (``config_text``),
-    expanded again: columns ``scene_id``, ``model_used``, ``status``, the SI inputs
+    expanded again: columns ``scene_id``, ``model`` (requested), ``model_used``, ``status``,
+    the SI inputs
     (``si_R``, ``si_speed``, ...), ``mu``, ``k``, ``rate``, ``l0_m``, ``a_ref_m``,
     ``d_ref_m``, ``load_ref_N``, ``jkr_pull_off_N``, ``pull_off_N``, ``a_pulloff_m``,
     ``crack_speed_m_s``, ... and the dimensionless ``pull_off``. InputError if the file was
@@ -403,7 +404,8 @@ def si_table(results) -> pd.DataFrame:
         si = by_id.get(row["scene_id"])
         if si is None:
             continue
-        rows.append({"scene_id": row["scene_id"], "model_used": row.get("model_used"),
+        rows.append({"scene_id": row["scene_id"], "model": row.get("model"),
+                     "model_used": row.get("model_used"),
                      "status": row.get("status"), "pull_off": row.get("pull_off"),
                      **si_row(si, row)})
     return pd.DataFrame(rows)

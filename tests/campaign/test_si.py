@@ -188,6 +188,22 @@ def test_si_config_runs_and_gives_rows_back_in_si(tmp_path, capsys):
     assert main(["info", str(tmp_path / "si.h5"), "--si"]) == 0
     out = capsys.readouterr().out.splitlines()
     assert len(out) == 5 and "pull_off[mN]" in out[0]
+    assert out[0].split()[1:4] == ["requested", "used", "status"]
+    # requested and used model side by side: an `auto` row says which model ran it
+    assert {tuple(ln.split()[1:3]) for ln in out[1:]} == {("crack", "crack"), ("pb", "pb")}
+    # a varied SI input (n here) gets its own column; fixed inputs do not
+    p.write_text(p.read_text().replace("n: 0.8", "n: [0.6, 0.8]")
+                 .replace("model: [crack, pb]", "model: auto").replace("si.h5", "si2.h5"))
+    assert main(["run", str(p), "-j", "1", "--progress", "none"]) == 0
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "si2.h5"), "--si"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].split()[1:5] == ["requested", "used", "status", "n"]
+    assert "E0[Pa]" not in out[0]
+    rows = [ln.split() for ln in out[1:]]
+    assert len(rows) == 4 and {r[1] for r in rows} == {"auto"}
+    assert {r[2] for r in rows} <= {"bem", "crack", "pb"}
+    assert sorted({float(r[4]) for r in rows}) == [0.6, 0.8]
     # a file of a dimensionless config: one line, exit 2
     q = tmp_path / "d.yaml"
     q.write_text(f"name: d\ngrid: {{n: 0.8, a0: 3.0, rate: 1, model: pb}}\noutput: {tmp_path / 'd.h5'}\n")
