@@ -453,14 +453,18 @@ def _si_unit(name: str) -> str:
               help="Arms of the generalized Maxwell comparison fit (0: none).")
 @click.option("--plot", "plot_out", default=None, metavar="OUT.png",
               help="Plot data and both fits (the paper's Fig. EE; needs matplotlib).")
+@click.option("--noise", "noise", type=str, default="0.01", show_default=True,
+              help="Relative rms noise of E' and E'' (0.03 = 3 %); the Kramers-Kronig "
+                   "tolerance grows with it.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (SI units).")
-def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
+def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json):
     """Fit the MPL constants (and a generalized Maxwell model) to DMA data.
 
     FILE.csv holds a master curve (omega_rad_s,E_storage_Pa,E_loss_Pa) or a temperature
     sweep (T_C,f_Hz,E_storage_Pa,E_loss_Pa), shifted to --tref with the WLF equation.
     """
-    from .analysis.dma import fit_maxwell, fit_mpl, kramers_kronig_check, plot_dma, read_dma_csv
+    from .analysis.dma import (KK_FLOOR, KK_NOISE_FACTOR, fit_maxwell, fit_mpl,
+                               kramers_kronig_check, plot_dma, read_dma_csv)
 
     c = parse_floats("wlf", wlf)
     if len(c) != 3:
@@ -472,7 +476,8 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
     data = read_dma_csv(csv_file, T_ref=as_float("tref", tref), wlf=tuple(c))
     mpl = fit_mpl(data)
     mx = fit_maxwell(data, n_arms) if n_arms > 0 else None
-    kk = kramers_kronig_check(data)
+    kk = kramers_kronig_check(data, noise=check_range("noise", as_float("noise", noise),
+                                                      0.0, 0.5))
     if plot_out is not None:
         plot_dma(data, mpl, mx, plot_out)
     if as_json:
@@ -491,19 +496,30 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, as_json):
                   if data.kind == "temperature" else ""))
     click.echo("MPL retardation fit (value +- one standard error):")
     for name, unit in (("E0", "Pa"), ("Einf", "Pa"), ("n", ""), ("tau0", "s")):
-        click.echo(f"  {name:<5} = {getattr(mpl, name):.6g} +- {mpl.stderr[name]:.2g} {unit}")
+        if name in mpl.at_bound:
+            click.echo(f"  {name:<5} = {getattr(mpl, name):.6g} {unit}  at its "
+                       f"{mpl.at_bound[name]}: NOT DETERMINED by the data (a bound, not an "
+                       f"estimate; no interval)")
+        else:
+            poor = ("  (poorly determined: one standard error is more than a factor e)"
+                    if name != "n" and mpl.rel_stderr[name] > 1.0 else "")
+            click.echo(f"  {name:<5} = {getattr(mpl, name):.6g} +- {mpl.stderr[name]:.2g} "
+                       f"{unit}{poor}")
     q = mpl.quality
+    bound = (f"; {len(mpl.at_bound)} constant(s) at a bound ({', '.join(mpl.at_bound)}): "
+             f"widen the frequency range to reach the plateau" if mpl.at_bound else "")
     click.echo(f"  k = E0/Einf = {mpl.k:.4g}; rms relative residual E' {q['rms_rel_storage']:.3g},"
-               f" E'' {q['rms_rel_loss']:.3g}; converged {mpl.success}")
+               f" E'' {q['rms_rel_loss']:.3g}; converged {mpl.success}{bound}")
     if mx is not None:
         q = mx.quality
         click.echo(f"Generalized Maxwell, {n_arms} arms ({q['active_arms']} non-zero): "
                    f"E0 = {mx.E0:.6g} Pa, Einf = {mx.Einf:.6g} Pa; rms relative residual "
                    f"E' {q['rms_rel_storage']:.3g}, E'' {q['rms_rel_loss']:.3g}")
-    click.echo(f"Kramers-Kronig: E'' implied by E' differs by {kk.rms_rel:.3g} rms "
-               f"({kk.max_rel:.3g} max) over {kk.interior_points} interior points: "
-               f"{'consistent' if kk.consistent else 'NOT consistent'} "
-               f"(threshold {kk.threshold:g})")
+    click.echo(f"Kramers-Kronig: E'' implied by E' differs by {kk.rms_modulus:.3g} of |E*| "
+               f"rms over {kk.interior_points} interior points ({kk.rms_rel:.3g} rms relative "
+               f"to E'', large where the loss tangent is small); tolerance {kk.threshold:.3g} = {KK_FLOOR:g} + {KK_NOISE_FACTOR:g} x "
+               f"the stated noise {kk.noise:g} (--noise): "
+               f"{'consistent' if kk.consistent else 'NOT consistent'}")
     if plot_out is not None:
         click.echo(f"plot: {plot_out}")
 

@@ -31,7 +31,8 @@ Fits (conventions of :mod:`sweep.materials`: ``E0`` RELAXED, ``Einf`` GLASSY mod
   residuals of ``E'`` and ``E''``.
 * :func:`kramers_kronig_check` -- a linear Kramers-Kronig test: a dense Wiechert model
   (always causal, hence KK-consistent) is fitted to ``E'`` ALONE and its ``E''`` is compared
-  with the measured loss modulus. Large residuals mean the data (or the shift) violate KK.
+  with the measured loss modulus, relative to ``|E*|``; above the stated tolerance (which
+  grows with the data's stated noise) the data (or the shift) violate KK.
 
 pyvisco (the DMA Prony-identification library) was considered for the Maxwell comparison and
 not added: version 2.1.3 requires a notebook/GUI stack (jupyterlab, voila, ipywidgets, ipympl,
@@ -52,7 +53,7 @@ from ..errors import InputError, check_int, check_range
 from ..materials import MPLRetardation, Prony
 
 __all__ = [
-    "WLF_PAPER", "DMAData", "MPLFit", "MaxwellFit", "KKCheck",
+    "WLF_PAPER", "DMAData", "MPLFit", "MaxwellFit", "KKCheck", "KK_FLOOR", "KK_NOISE_FACTOR",
     "wlf_log_shift", "read_dma_csv", "fit_mpl", "fit_maxwell", "kramers_kronig_check",
     "plot_dma",
 ]
@@ -273,6 +274,11 @@ class MPLFit:
     success : bool
         The optimizer's convergence flag.
     message : str
+    at_bound : dict
+        The constants that ended on a bound of the fit, each with which one (e.g.
+        ``{"Einf": "upper bound 100 x max E'"}``): the data do not constrain them, so the
+        value is the bound, not an estimate, and their ``stderr`` is NaN (no interval); the
+        other constants' errors are those with these held fixed.
     """
 
     E0: float
@@ -284,6 +290,7 @@ class MPLFit:
     quality: dict
     success: bool
     message: str = ""
+    at_bound: dict = field(default_factory=dict)
 
     @property
     def k(self) -> float:
@@ -296,8 +303,12 @@ class MPLFit:
 
     def to_dict(self) -> dict:
         return {"E0": self.E0, "Einf": self.Einf, "n": self.n, "tau0": self.tau0, "k": self.k,
-                "stderr": self.stderr, "rel_stderr": self.rel_stderr, "quality": self.quality,
-                "success": self.success, "message": self.message}
+                "stderr": {k: (None if not math.isfinite(v) else v)
+                           for k, v in self.stderr.items()},
+                "rel_stderr": {k: (None if not math.isfinite(v) else v)
+                               for k, v in self.rel_stderr.items()},
+                "quality": self.quality, "success": self.success, "message": self.message,
+                "at_bound": dict(self.at_bound)}
 
 
 _N_BOUNDS = (1e-3, 5.0)
@@ -330,7 +341,9 @@ def fit_mpl(data) -> MPLFit:
     MPLFit
         Constants in SI with standard errors and fit quality. The relaxed modulus is bounded
         to ``[min E'/100, 2 min E']`` and the glassy one to ``[max E'/2, 100 max E']``; data
-        that do not reach a plateau show it as a large standard error, not as a failure.
+        that do not reach a plateau show it as a large standard error or, when the constant
+        ends on its bound, in ``at_bound`` (its value is then the bound and its standard
+        error NaN), not as a failure.
     """
     data = _as_data(data)
     w = data.omega
@@ -359,14 +372,29 @@ def fit_mpl(data) -> MPLFit:
             sol = s
     p = sol.x
     m, npar = sol.fun.size, p.size
-    dof = max(m - npar, 1)
+    # a constant on a bound is not estimated by the data: flag it, give it no interval, and
+    # compute the others' errors with it held fixed
+    names = ("E0", "Einf", "n", "tau0")
+    what = {"E0": ("min E'/100", "2 x min E'"), "Einf": ("max E'/2", "100 x max E'"),
+            "n": (f"{_N_BOUNDS[0]:g}", f"{_N_BOUNDS[1]:g}"),
+            "tau0": ("1e-3/max omega", "1e3/min omega")}
+    at_bound = {}
+    for i, name in enumerate(names):
+        tol = 1e-6 * max(1.0, upper[i] - lower[i])
+        if sol.active_mask[i] < 0 or p[i] - lower[i] <= tol:
+            at_bound[name] = f"lower bound {what[name][0]}"
+        elif sol.active_mask[i] > 0 or upper[i] - p[i] <= tol:
+            at_bound[name] = f"upper bound {what[name][1]}"
+    free = [i for i, name in enumerate(names) if name not in at_bound]
+    dof = max(m - len(free), 1)
     s2 = 2.0 * sol.cost / dof
-    J = sol.jac
+    J = sol.jac[:, free]
+    sd = np.full(npar, np.nan)
     try:
         cov = s2 * np.linalg.pinv(J.T @ J)
-        sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        sd[free] = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     except np.linalg.LinAlgError:  # pragma: no cover
-        sd = np.full(npar, np.nan)
+        pass
     E0, Einf, n, tau0 = math.exp(p[0]), math.exp(p[1]), float(p[2]), math.exp(p[3])
     # log-parameter errors -> absolute (first order): d(e^x) = e^x dx
     stderr = {"E0": E0 * sd[0], "Einf": Einf * sd[1], "n": float(sd[2]), "tau0": tau0 * sd[3]}
@@ -376,7 +404,8 @@ def fit_mpl(data) -> MPLFit:
     quality = _quality(data, E_model)
     quality.update(rms_log=float(math.sqrt(2.0 * sol.cost / m)), dof=int(dof))
     return MPLFit(E0=E0, Einf=Einf, n=n, tau0=tau0, stderr=stderr, rel_stderr=rel,
-                  quality=quality, success=bool(sol.success), message=str(sol.message))
+                  quality=quality, success=bool(sol.success), message=str(sol.message),
+                  at_bound=at_bound)
 
 
 # ============================================================================ Maxwell
@@ -479,11 +508,20 @@ class KKCheck:
         ``E''`` [Pa] implied by ``E'`` through a causal (Wiechert) model, at the data's omega.
     rms_rel, max_rel : float
         rms and max of ``E''_predicted / E''_data - 1`` over the interior points (the first and
-        last decade excluded: there the prediction depends on the unmeasured ends).
+        last decade excluded: there the prediction depends on the unmeasured ends). Shown for
+        information: where the loss tangent is small, a relative noise of ``E'`` is a much
+        larger relative error of the ``E''`` it implies.
+    rms_modulus : float
+        rms of ``(E''_predicted - E''_data) / |E*|`` over the interior points: the statistic
+        the decision uses (a noise of relative size s in ``E'`` and ``E''`` moves it by about
+        s, whatever the loss tangent).
+    noise : float
+        The relative rms noise of ``E'`` and ``E''`` the data were stated to have.
     threshold : float
-        Largest rms accepted as consistent.
+        The tolerance: largest ``rms_modulus`` accepted as consistent,
+        ``KK_FLOOR + KK_NOISE_FACTOR * noise`` unless given.
     consistent : bool
-        ``rms_rel <= threshold``.
+        ``rms_modulus <= threshold``.
     """
 
     loss_predicted: np.ndarray
@@ -492,29 +530,70 @@ class KKCheck:
     threshold: float
     consistent: bool
     interior_points: int
+    rms_modulus: float = math.nan
+    noise: float = math.nan
 
     def to_dict(self) -> dict:
-        return {"rms_rel": self.rms_rel, "max_rel": self.max_rel, "threshold": self.threshold,
-                "consistent": self.consistent, "interior_points": self.interior_points}
+        return {"rms_rel": self.rms_rel, "max_rel": self.max_rel,
+                "rms_modulus": self.rms_modulus, "noise": self.noise,
+                "threshold": self.threshold, "consistent": self.consistent,
+                "interior_points": self.interior_points}
 
 
-def kramers_kronig_check(data, threshold: float = 0.1, per_decade: float = 4.0) -> KKCheck:
+#: The KK tolerance on ``rms_modulus`` for noise-free data (the Wiechert representation and
+#: the smoothing of E' leave at most 0.006 on MPL master curves of 6 to 21 decades) ...
+KK_FLOOR = 0.02
+#: ... plus this many times the stated relative noise (over 5 noise draws on MPL curves of
+#: 6 to 21 decades with 1, 3 and 5 % noise, rms_modulus stayed below 1.3 x the noise).
+KK_NOISE_FACTOR = 1.5
+#: Width (standard deviation, decades) of the local quadratic smoothing of log E' before the
+#: causal model is fitted to it: noise would otherwise be differentiated into E''.
+KK_SMOOTH_DECADES = 0.5
+
+
+def _smooth_log(lw, ly, x, width):
+    """Local quadratic regression (Gaussian weights of standard deviation ``width``) of
+    ``ly`` against ``lw``, evaluated at ``x``; where fewer than 5 points lie within about a
+    width (sparse data), the monotone cubic interpolant instead."""
+    spline = PchipInterpolator(lw, ly)
+    out = np.empty_like(x)
+    for i, xi in enumerate(x):
+        wts = np.exp(-0.5 * ((lw - xi) / width) ** 2)
+        if (wts > 0.3).sum() < 5:
+            out[i] = spline(xi)
+            continue
+        sw = np.sqrt(wts)
+        A = np.vstack([np.ones_like(lw), lw - xi, (lw - xi) ** 2]).T * sw[:, None]
+        out[i] = np.linalg.lstsq(A, ly * sw, rcond=None)[0][0]
+    return out
+
+
+def kramers_kronig_check(data, threshold: float | None = None, per_decade: float = 4.0,
+                         noise: float = 0.01) -> KKCheck:
     """Linear Kramers-Kronig test of a measured complex modulus (module docstring).
 
-    A Wiechert model with ``per_decade`` arms per decade, times spanning the data's decades
-    widened by one decade each side, is fitted by NNLS to ``E'`` alone; since any such model
+    ``log E'`` is smoothed (local quadratic, :data:`KK_SMOOTH_DECADES`) and resampled; a
+    Wiechert model with ``per_decade`` arms per decade, times spanning the data's decades
+    widened by one decade each side, is fitted by NNLS to it alone; since any such model
     satisfies the KK relations, its loss modulus is the ``E''`` that KK implies (up to the
-    unmeasured ends, hence the interior-only statistics).
+    unmeasured ends, hence the interior-only statistics). The data are consistent when the
+    rms of ``(E''_implied - E''_data) / |E*|`` is at most the tolerance
+    ``KK_FLOOR + KK_NOISE_FACTOR * noise``.
 
     Parameters
     ----------
     data : DMAData or (omega, E_storage, E_loss)
-    threshold : float
-        rms relative loss residual accepted as consistent (> 0).
+    threshold : float, optional
+        The tolerance on ``rms_modulus`` (> 0); default from ``noise`` as above.
     per_decade : float
         Arms per decade (in [1, 20]).
+    noise : float
+        Relative rms noise of ``E'`` and ``E''`` (in [0, 0.5]; 0.01 = 1 %).
     """
     data = _as_data(data)
+    noise = check_range("noise", noise, 0.0, 0.5)
+    if threshold is None:
+        threshold = KK_FLOOR + KK_NOISE_FACTOR * noise
     threshold = check_range("threshold", threshold, lo=0.0, lo_open=True)
     per_decade = check_range("per_decade", per_decade, 1.0, 20.0)
     w = data.omega
@@ -525,10 +604,10 @@ def kramers_kronig_check(data, threshold: float = 0.1, per_decade: float = 4.0) 
     # undetermined
     lw = np.log(w)
     keep = np.concatenate([[True], np.diff(lw) > 0])
-    spline = PchipInterpolator(lw[keep], np.log(data.E_storage[keep]))
     wr = np.union1d(w, np.logspace(math.log10(w.min()), math.log10(w.max()),
                                    max(int(math.log10(w.max() / w.min()) * 2 * per_decade), 2)))
-    E1r = np.exp(spline(np.log(wr)))
+    E1r = np.exp(_smooth_log(lw[keep], np.log(data.E_storage[keep]), np.log(wr),
+                             KK_SMOOTH_DECADES * math.log(10.0)))
     E0, Ei = _nnls_maxwell(wr, times, E1r, np.ones_like(wr), loss=False)
     fit = MaxwellFit(E0=float(E0), moduli=Ei, times=times)
     pred = fit.complex_modulus(w).imag
@@ -537,9 +616,12 @@ def kramers_kronig_check(data, threshold: float = 0.1, per_decade: float = 4.0) 
         inner = np.ones_like(w, dtype=bool)
     r = pred[inner] / data.E_loss[inner] - 1.0
     rms = float(np.sqrt(np.mean(r**2)))
+    rm = (pred[inner] - data.E_loss[inner]) / np.hypot(data.E_storage[inner],
+                                                       data.E_loss[inner])
+    rms_mod = float(np.sqrt(np.mean(rm**2)))
     return KKCheck(loss_predicted=pred, rms_rel=rms, max_rel=float(np.max(np.abs(r))),
-                   threshold=threshold, consistent=bool(rms <= threshold),
-                   interior_points=int(inner.sum()))
+                   threshold=threshold, consistent=bool(rms_mod <= threshold),
+                   interior_points=int(inner.sum()), rms_modulus=rms_mod, noise=noise)
 
 
 # ============================================================================ plot

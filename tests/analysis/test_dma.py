@@ -238,3 +238,68 @@ def test_array_input_is_sorted_and_checked():
         fit_mpl((w, E.real, np.where(np.arange(9) == 2, np.nan, E.imag)))
     with pytest.raises(InputError, match="equal lengths"):
         fit_maxwell((w, E.real, E.imag[:-1]))
+
+
+def _hand_made(tmp_path, noise=0.03, seed=3, distort=None, decades=(-3, 1)):
+    """A hand-made master curve, as a user would make one: the PDMS MPL over a few decades
+    (by default below the transition, never near the glassy plateau) with ``noise`` relative
+    noise; ``distort`` multiplies E'' above the middle of the window."""
+    w = np.logspace(*decades, 31)
+    E = MPLRetardation(**TRUE).complex_modulus(w)
+    rng = np.random.default_rng(seed)
+    E1 = E.real * (1.0 + noise * rng.standard_normal(w.size))
+    E2 = E.imag * (1.0 + noise * rng.standard_normal(w.size))
+    if distort is not None:
+        E2 = E2 * np.where(w > 10.0 ** (0.5 * sum(decades)), distort, 1.0)
+    p = tmp_path / "hand.csv"
+    p.write_text("omega_rad_s,E_storage_Pa,E_loss_Pa\n" + "".join(
+        f"{float(a)!r},{float(b)!r},{float(c)!r}\n" for a, b, c in zip(w, E1, E2)))
+    return p
+
+
+def test_a_constant_at_its_bound_is_flagged_not_given_an_interval(tmp_path, capsys):
+    p = _hand_made(tmp_path)
+    fit = fit_mpl(read_dma_csv(p))
+    # 4 decades below the transition: E' never nears Einf = 3.1 GPa, Einf ends on its bound
+    assert "Einf" in fit.at_bound and fit.at_bound["Einf"].startswith("upper bound")
+    assert math.isnan(fit.stderr["Einf"]) and math.isnan(fit.rel_stderr["Einf"])
+    assert "E0" not in fit.at_bound and math.isfinite(fit.stderr["E0"])
+    assert main(["fit-dma", str(p), "--maxwell", "0", "--noise", "0.03"]) == 0
+    out = capsys.readouterr().out
+    einf = next(ln for ln in out.splitlines() if ln.strip().startswith("Einf"))
+    assert "at its upper bound 100 x max E': NOT DETERMINED" in einf and "+-" not in einf
+    assert "constant(s) at a bound (Einf)" in out
+    assert main(["fit-dma", str(p), "--maxwell", "0", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["mpl"]["stderr"]["Einf"] is None and "Einf" in d["mpl"]["at_bound"]
+    # a curve over the whole transition: nothing at a bound
+    assert fit_mpl(DMAData(*_wide())).at_bound == {}
+
+
+def _wide():
+    w = np.logspace(-2, 19, 60)
+    E = MPLRetardation(**TRUE).complex_modulus(w)
+    return w, E.real, E.imag
+
+
+@pytest.mark.parametrize("seed", [3, 4, 5])
+def test_kramers_kronig_passes_data_within_the_stated_noise(tmp_path, capsys, seed):
+    # five decades through the start of the transition (loss tangent 4e-4 .. 0.35)
+    p = _hand_made(tmp_path, noise=0.03, seed=seed, decades=(-1, 4))
+    kk = kramers_kronig_check(read_dma_csv(p), noise=0.03)
+    assert kk.threshold == pytest.approx(0.02 + 1.5 * 0.03)
+    assert kk.consistent, kk.to_dict()
+    assert main(["fit-dma", str(p), "--maxwell", "0", "--noise", "0.03"]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines()
+                if ln.startswith("Kramers-Kronig"))
+    assert "tolerance 0.065 = 0.02 + 1.5 x the stated noise 0.03" in line
+    assert line.endswith(": consistent")
+    # the same curve with its loss modulus doubled over the upper half is not consistent
+    bad = _hand_made(tmp_path, noise=0.03, seed=seed, distort=2.0, decades=(-1, 4))
+    assert not kramers_kronig_check(read_dma_csv(bad), noise=0.03).consistent
+
+
+def test_kk_noise_option_is_checked(tmp_path, capsys):
+    p = _hand_made(tmp_path)
+    assert main(["fit-dma", str(p), "--noise", "2"]) == 2
+    assert "noise must be in [0, 0.5]" in capsys.readouterr().err

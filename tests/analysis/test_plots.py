@@ -1,7 +1,7 @@
 """`sweep plot`: failed scenes are marked, never dropped silently."""
 from __future__ import annotations
 
-from sweep.analysis.plots import mark_failed, plot_sweep, pyplot
+from sweep.analysis.plots import mark_failed, pyplot
 from sweep.campaign.scheduler import run_sweep
 from sweep.campaign.store import load
 from sweep.cli import main
