@@ -23,6 +23,14 @@ complete file, never a half-written one; the main file is never modified in plac
 crash can damage it. After the final consolidation the ``.parts`` directory is removed and the
 sweep is a single self-contained HDF5 file.
 
+Growing. A config whose grid changed but whose units, numerics and trajectory flag did not
+(:meth:`ResultStore._grow_refusal` says why not otherwise) resumes onto the same file: scene
+ids depend only on the scene and the numerics, so the finished rows stay valid and only the
+new ids run. The first consolidation after such a start records the new config (hash, text),
+the union's size in ``n_scenes`` and the earlier configs in ``config_history``; until then the
+main file still carries the old config, which a resumed grow accepts in the same way, so a
+kill at any moment keeps every finished scene.
+
 Source of truth: the main file *plus* the journal. :func:`load` reads the journal first and
 then the main file and returns their union (one row per scene id), so it returns every scene
 that finished before a kill, even if the kill came before the next consolidation. Resuming a
@@ -47,8 +55,9 @@ File contents (plain arrays and text only; no pickles):
   ``finished_at`` (ISO 8601 UTC; ``finished_at`` is empty until every scene is done),
   ``n_scenes`` (size of the grid), ``n_finished``, ``complete``, ``trajectories``,
   ``scene_id_version`` (:data:`sweep.scene.SCENE_ID_VERSION`; absent in files written before
-  it was recorded, which are version 1). A file of a newer id version is refused for resuming
-  (one-line error, file untouched); it still loads.
+  it was recorded, which are version 1), and in a grown file ``config_history`` (JSON list of
+  the earlier configs' ``config_hash``, ``config_text``, ``until``). A file of a newer id
+  version is refused for resuming (one-line error, file untouched); it still loads.
 """
 from __future__ import annotations
 
