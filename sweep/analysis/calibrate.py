@@ -67,13 +67,25 @@ import os
 import sys
 import time
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
+import pandas as pd
+import yaml
+from joblib import Parallel, delayed, parallel_config
+from scipy import stats
+from scipy.optimize import least_squares
+from scipy.stats import qmc
 
+from ..campaign.config import UniqueKeyLoader
+from ..campaign.si import SI_AXES, SIScene, run_si
+from ..engine import bem
 from ..errors import InputError, check_choice, check_int, check_range
+from ..scene import Numerics
+from ..threads import THREAD_VARS, limit_env, limit_loaded_pools
+from .plots import pyplot
 
 __all__ = ["Parameter", "Calibration", "load_calibration", "calibration_from_dict",
            "calibrate", "synthesize", "write_outputs", "SceneEvaluator", "FIT_FIELDS"]
@@ -194,16 +206,12 @@ def _bounds(name, spec, lims) -> Parameter:
 
 
 def _limits(name) -> tuple:
-    from ..campaign.si import SI_AXES
-
     a = SI_AXES[name]
     lo, hi = a.limits
     return lo, hi, a.lo_open
 
 
 def _read_data(path: Path) -> tuple:
-    import pandas as pd
-
     where = f"data {str(path)!r}"
     if not path.is_file():
         raise InputError(f"data: no such file {str(path)!r}")
@@ -240,10 +248,6 @@ def load_calibration(path) -> Calibration:
 
 
 def _read_yaml(p: Path) -> dict:
-    import yaml
-
-    from ..campaign.config import _UniqueKeyLoader
-
     try:
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -251,7 +255,7 @@ def _read_yaml(p: Path) -> dict:
     except (IsADirectoryError, UnicodeDecodeError, OSError) as exc:
         raise InputError(f"calibration: cannot read {str(p)!r} ({_one_line(exc)})") from None
     try:
-        data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 -- a SafeLoader subclass
+        data = yaml.load(text, Loader=UniqueKeyLoader)  # noqa: S506 -- a SafeLoader subclass
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}" if mark else ""
@@ -271,9 +275,6 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
     measurements : tuple, optional
         ``(speed_m_s, pull_off_N, sigma_N or None)`` instead of reading ``data``.
     """
-    from ..campaign.si import SIScene
-    from ..scene import Numerics
-
     if not isinstance(data, dict):
         raise InputError(f"{source}: must be a mapping with keys name, data, fixed, fit, ...")
     for key in data:
@@ -409,8 +410,6 @@ def _prepare_worker() -> None:
     """Once per worker process: one BLAS/OpenMP/Numba thread (sweep.threads)."""
     global _WORKER_READY
     if not _WORKER_READY:
-        from ..threads import THREAD_VARS, limit_env, limit_loaded_pools
-
         limit_env(THREAD_VARS)
         limit_loaded_pools()
         _WORKER_READY = True
@@ -418,8 +417,6 @@ def _prepare_worker() -> None:
 
 def run_scene_si(fields: dict, model: str, numerics) -> tuple:
     """One SI scene -> ``(pull_off_N or nan, model_used, status, reason)``; never raises."""
-    from ..campaign.si import SIScene, run_si
-
     try:
         r = run_si(SIScene(**fields), model, numerics)
         po = r.get("pull_off_N")
@@ -517,8 +514,6 @@ class SceneEvaluator:
         for f in items:
             f[1]["material"] = cal.material
         if self.jobs == 1 or len(items) < 2:
-            from ..threads import limit_loaded_pools
-
             limits = limit_loaded_pools()
             try:
                 results = _run_batch(items, cal.model, cal.numerics, in_worker=False)
@@ -526,8 +521,6 @@ class SceneEvaluator:
                 if limits is not None:
                     limits.restore_original_limits()
         else:
-            from joblib import Parallel, delayed, parallel_config
-
             chunks = _chunks(items, self.jobs)
             n = min(self.jobs, len(chunks))
             with parallel_config(backend="loky", inner_max_num_threads=1):
@@ -595,8 +588,6 @@ class _Objective:
 
     def fit(self, u0, free=None, max_nfev=60):
         """Bounded least squares over ``u[free]`` (default all) from ``u0``; returns (u, ssr)."""
-        from scipy.optimize import least_squares
-
         u0 = np.clip(np.asarray(u0, dtype=float), 0.0, 1.0)
         free = list(range(len(u0))) if free is None else list(free)
         if not free:
@@ -616,8 +607,6 @@ class _Objective:
 
 
 def _threshold(cal: Calibration, dof: int) -> tuple:
-    from scipy import stats
-
     if cal.sigma_N is not None:
         return float(stats.chi2.ppf(cal.level, 1)), "chi2(1)"
     return float(stats.f.ppf(cal.level, 1, dof)), f"F(1, {dof})"
@@ -708,8 +697,6 @@ def calibrate(cal: Calibration, jobs: int | None = None,
         ``scenes_run``, ``cache_hits``, ``failed_scenes``, ``models_used``, ``wall_s``.
         See the module docstring for the method.
     """
-    from scipy.stats import qmc
-
     t0 = time.perf_counter()
     say = progress or (lambda s: None)
 
@@ -720,8 +707,6 @@ def calibrate(cal: Calibration, jobs: int | None = None,
     obj = _Objective(cal, ev)
     p, N = len(cal.params), len(cal.pull_off_N)
     if cal.model in ("bem", "auto"):
-        from ..engine import bem
-
         bem.warm_up()
     log(f"calibrate {cal.name}: {p} free parameters ({', '.join(cal.names)}), {N} points at "
         f"{len(ev.speeds)} speeds, model {cal.model}, {ev.jobs} job(s)")
@@ -897,8 +882,6 @@ def summary_lines(result: dict) -> list:
 def write_outputs(result: dict, out_dir) -> list:
     """Write ``calibration.json``, ``fit.png`` (data, fitted curve, band; log axes) and
     ``profile_<name>.png`` per parameter into ``out_dir``; returns the paths."""
-    from .plots import _pyplot
-
     out = Path(out_dir)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -906,7 +889,7 @@ def write_outputs(result: dict, out_dir) -> list:
         raise InputError(f"out: cannot create {str(out)!r} ({exc.strerror or exc})") from None
     paths = [out / "calibration.json"]
     paths[0].write_text(to_json(result) + "\n")
-    plt = _pyplot()
+    plt = pyplot()
     d, c = result["data"], result["curve"]
     fig, ax = plt.subplots(figsize=(6.0, 4.5))
     ax.fill_between(c["speed_m_s"], np.array(c["band_lo_N"], float) * 1e3,
