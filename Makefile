@@ -11,7 +11,7 @@ export NUMBA_NUM_THREADS ?= 1
 
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
         tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem \
-        agreement agreement-high-mu extremes tip-convergence elastic-table
+        agreement agreement-high-mu extremes tip-convergence elastic-table calibrate-demo
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
@@ -28,6 +28,7 @@ help:
 	@echo "make extremes [QUICK=1] - stability at the extremes of (n, k, rate, a0, mu)"
 	@echo "make tip-convergence - tip-following BEM: pull-off vs spacing and window, mu = 30, 100 (k = 0.5) and 30 (k = 0.1, rate 10^2.5)"
 	@echo "make elastic-table - elastic pull-off vs mu (0.01 ... 100), quasi-static branch"
+	@echo "make calibrate-demo - fit a synthetic PDMS-like pull-off curve (results/calibrate/)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -153,6 +154,11 @@ agreement: $(STAMP)
 # agreement merges its rows into results/agreement/agreement.md
 agreement-high-mu: $(STAMP)
 	$(BIN)/python -m sweep.bench.agreement --mus 15 --no-a0-scan --out results/agreement/agreement_mu15.json
+
+# issue 23: `sweep calibrate` on synthetic PDMS-like data with a known answer; the CSV was
+# written by the command in the header of configs/calibrate/pdms-lens.yaml
+calibrate-demo: $(STAMP)
+	$(BIN)/sweep calibrate configs/calibrate/pdms-lens.yaml --out results/calibrate
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache .coverage

@@ -675,5 +675,43 @@ def entry() -> None:
     sys.exit(main())
 
 
+# == calibrate (issue 23): the engine inside a fit to measured pull-off against speed ==
+@cli.command("calibrate")
+@click.argument("config", metavar="FILE.yaml")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print one JSON object: estimates, intervals, flags, fit, scenes, wall time.")
+@click.option("--out", "out_dir", default=None, metavar="DIR",
+              help="Write calibration.json, fit.png and profile_<parameter>.png into DIR.")
+@click.option("-j", "--jobs", type=int, default=None,
+              help="Worker processes for the scenes (default: all cores; 1: this process).")
+@click.option("--quiet", is_flag=True, help="No progress lines on stderr.")
+def calibrate_cmd(config, as_json, out_dir, jobs, quiet):
+    """Fit the free SI parameters of FILE.yaml to measured pull-off force against speed
+    (profile-likelihood 95 % intervals; see sweep.analysis.calibrate and the README)."""
+    from .analysis.calibrate import (calibrate, load_calibration, summary_lines, to_json,
+                                     write_outputs)
+    from .errors import check_int
+
+    if jobs is not None:
+        check_int("jobs", jobs, 1, 4096)
+    cal = load_calibration(config)
+    if out_dir is not None:
+        try:
+            Path(out_dir).mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"out: cannot create {out_dir!r} ({exc.strerror or exc})") \
+                from None
+    progress = None if quiet else (lambda line: click.echo(line, err=True))
+    result = calibrate(cal, jobs=jobs, progress=progress)
+    paths = write_outputs(result, out_dir) if out_dir is not None else []
+    if as_json:
+        click.echo(to_json(result, indent=None))
+        return
+    for line in summary_lines(result):
+        click.echo(line)
+    for p in paths:
+        click.echo(f"wrote {p}")
+
+
 if __name__ == "__main__":  # pragma: no cover
     entry()

@@ -1,0 +1,247 @@
+"""sweep.analysis.calibrate on synthetic measurements with a known answer, and `sweep calibrate`.
+
+The fits use the crack-front model (model crack: one Persson-Brener table per (n, k), then
+about 20 ms a scene) on 4 speeds, with the free parameters chosen among those that leave
+the table unchanged (dg, tau0, h0), so the whole module runs a few thousand scenes.
+"""
+import json
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from sweep.analysis import calibrate as cb
+from sweep.campaign.si import SIScene, run_si
+from sweep.cli import main
+from sweep.errors import InputError
+
+FIXED = {"R": 0.0103, "E0": 1.0e6, "nu": 0.5, "preload": 1.5e-3, "n": 0.22, "Einf": 3.0e9}
+TRUTH = {"dg": 0.15, "tau0": 0.02, "h0": 3.08e-8}
+SPEEDS = np.logspace(-6, -2, 4)       # m/s
+
+
+def _problem(tmp_path, fit, fixed, data=None, **extra):
+    """Write a calibration YAML (and its CSV if ``data`` is given); returns the YAML path."""
+    cfg = {"name": "t", "data": "d.csv", "fixed": fixed, "fit": fit, "model": "crack", **extra}
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    if data is not None:
+        cols = list(data)
+        lines = [",".join(cols)] + [",".join(f"{data[c][i]!r}" for c in cols)
+                                    for i in range(len(data[cols[0]]))]
+        (tmp_path / "d.csv").write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _synthetic(fit, fixed, truth, seed, sigma, repeats=1, noise=0.05):
+    cal = cb.calibration_from_dict({"name": "s", "fixed": fixed, "fit": fit, "model": "crack"},
+                                   measurements=([1.0] * 9, [1.0] * 9, None))
+    d = cb.synthesize(cal, truth, SPEEDS, repeats=repeats, noise=noise, seed=seed,
+                      sigma=sigma)
+    return {k: [float(x) for x in v] for k, v in d.items()}
+
+
+# ------------------------------------------------------------------ fits with a known answer
+@pytest.fixture(scope="module")
+def identifiable(tmp_path_factory):
+    """dg and tau0 free (n, Einf, h0 fixed), sigma given, from a deliberately bad start."""
+    tmp = tmp_path_factory.mktemp("ident")
+    fit = {"dg": [0.03, 1.0], "tau0": [1.0e-4, 10.0]}
+    fixed = {**FIXED, "h0": TRUTH["h0"]}
+    truth = {k: TRUTH[k] for k in fit}
+    data = _synthetic(fit, fixed, truth, seed=2, sigma=True, repeats=2)
+    path = _problem(tmp, fit, fixed, data, search={"points": 8, "starts": 1},
+                    profile={"points": 5}, start={"dg": 1.0, "tau0": 1.0e-4}, truth=truth)
+    cal = cb.load_calibration(path)
+    return cal, cb.calibrate(cal, jobs=1, curve_points=5)
+
+
+@pytest.fixture(scope="module")
+def degenerate(tmp_path_factory):
+    """tau0 and h0 free (dg fixed): the crack-front model sees only tau0/h0^2 (through
+    l0 ~ h0^2), so h0 is not determined by pull-off against speed."""
+    tmp = tmp_path_factory.mktemp("degen")
+    fit = {"tau0": [1.0e-6, 1.0e2], "h0": [1.0e-8, 1.0e-7]}
+    fixed = {**FIXED, "dg": TRUTH["dg"]}
+    truth = {k: TRUTH[k] for k in fit}
+    data = _synthetic(fit, fixed, truth, seed=3, sigma=False, repeats=2)
+    path = _problem(tmp, fit, fixed, data, search={"points": 8, "starts": 1},
+                    profile={"points": 5}, truth=truth)
+    cal = cb.load_calibration(path)
+    return cal, cb.calibrate(cal, jobs=1, curve_points=5)
+
+
+def test_truth_inside_the_intervals_from_a_bad_start(identifiable):
+    cal, res = identifiable
+    # the bad start is the first local fit; it starts 3+ orders of magnitude above the end
+    first = res["search"]["local_fits"][0]
+    assert first["start"]["dg"] == pytest.approx(1.0)
+    assert first["start"]["tau0"] == pytest.approx(1e-4)
+    assert first["ssr"] < 1e-3 * first["ssr_start"]
+    for name in ("dg", "tau0"):
+        p = res["parameters"][name]
+        lo, hi = p["interval"]
+        assert lo < p["estimate"] < hi
+        assert lo <= p["truth"] <= hi, (name, p)
+        assert p["identifiable"] and p["status"] == "identifiable"
+        assert p["bounds"][0] < lo and hi < p["bounds"][1]          # closed inside the box
+    # with sigmas the statistic is chi-square(1), and the fit is consistent with the noise
+    assert res["fit"]["statistic"] == "chi2(1)"
+    assert res["fit"]["threshold"] == pytest.approx(3.8415, abs=1e-3)
+    assert res["fit"]["chi2"] < 3.0 * res["fit"]["dof"]
+    # dg and tau0 trade off: a larger dg with a shorter tau0 gives the same curve
+    corr = np.array(res["correlation"]["matrix"])
+    assert corr[0, 1] < -0.5 and corr[0, 0] == pytest.approx(1.0)
+
+
+def test_profile_statistic_is_zero_at_the_estimate_and_crosses_at_the_ends(identifiable):
+    cal, res = identifiable
+    thr = res["fit"]["threshold"]
+    for name, pr in res["profiles"].items():
+        p = res["parameters"][name]
+        vals, stat = np.array(pr["values"]), np.array(pr["statistic"])
+        assert stat[np.argmin(abs(vals - p["estimate"]))] == pytest.approx(0.0, abs=1e-6)
+        assert stat.max() > thr                        # the walk went past the threshold
+        lo, hi = p["interval"]
+        inside = (vals > lo * 1.0001) & (vals < hi * 0.9999)
+        assert np.all(stat[inside] <= thr * 1.05)
+
+
+def test_fitted_values_are_the_engine_at_the_estimate(identifiable):
+    """The reported fitted pull-offs equal run_si at the estimate (an independent call)."""
+    cal, res = identifiable
+    est = {k: v["estimate"] for k, v in res["parameters"].items()}
+    for i in (0, len(cal.speed_m_s) - 1):
+        si = SIScene(**cal.fixed, **est, speed=float(cal.speed_m_s[i]))
+        ref = run_si(si, "crack")["pull_off_N"]
+        assert res["data"]["fitted_N"][i] == pytest.approx(ref, rel=1e-6)
+    # the band holds the fitted curve
+    c = res["curve"]
+    assert np.all(np.array(c["band_lo_N"]) <= np.array(c["pull_off_N"]) * (1 + 1e-12))
+    assert np.all(np.array(c["band_hi_N"]) >= np.array(c["pull_off_N"]) * (1 - 1e-12))
+    assert res["scenes_run"] > 0 and res["cache_hits"] > 0 and res["failed_scenes"] == 0
+
+
+def test_unidentifiable_parameter_is_flagged(degenerate):
+    cal, res = degenerate
+    h0 = res["parameters"]["h0"]
+    assert not h0["identifiable"] and h0["status"] == "not identifiable"
+    assert h0["interval"] == pytest.approx(h0["bounds"])
+    # without sigmas: log residuals, F(1, N - p) threshold
+    assert res["fit"]["statistic"] == f"F(1, {res['fit']['dof']})"
+    assert res["fit"]["rms_log_residual"] < 0.15
+    # tau0 is pinned only through h0's bounds, and its interval holds the truth
+    tau = res["parameters"]["tau0"]
+    assert tau["interval"][0] <= tau["truth"] <= tau["interval"][1]
+    # the flat direction is tau0 ~ h0^2: the two are fully correlated
+    assert abs(res["correlation"]["matrix"][0][1]) > 0.99
+
+
+# ------------------------------------------------------------------ pieces
+def test_parameter_unit_coordinates_round_trip():
+    log = cb.Parameter("tau0", 1e-4, 10.0, log=True)
+    lin = cb.Parameter("n", 0.1, 1.5, log=False)
+    assert log.value(0.5) == pytest.approx(math.sqrt(1e-4 * 10.0))
+    assert lin.value(0.5) == pytest.approx(0.8)
+    for p, x in ((log, 3.3e-2), (lin, 0.37)):
+        assert p.value(p.unit(x)) == pytest.approx(x, rel=1e-12)
+
+
+def test_bounds_spanning_a_decade_are_log_scaled(tmp_path):
+    path = _problem(tmp_path, {"dg": [0.01, 1.0], "n": [0.1, 0.5], "tau0": [1e-3, 1e-2, "linear"]},
+                    {k: v for k, v in {**FIXED, "h0": 3e-8}.items() if k != "n"},
+                    {"speed_m_s": [1e-6, 1e-5, 1e-4, 1e-3], "pull_off_N": [1.0] * 4})
+    cal = cb.load_calibration(path)
+    assert [p.log for p in cal.params] == [True, False, False]
+
+
+def test_cache_reuses_scenes_and_matches_run_si(tmp_path):
+    path = _problem(tmp_path, {"dg": [0.05, 0.5]}, {**FIXED, "h0": 3.08e-8, "tau0": 0.02},
+                    {"speed_m_s": [1e-6, 1e-4, 1e-4], "pull_off_N": [0.01, 0.02, 0.021]})
+    cal = cb.load_calibration(path)
+    ev = cb.SceneEvaluator(cal, jobs=1)
+    u = [[0.3], [0.7]]
+    first = ev.predict(u)
+    assert first.shape == (2, 2) and ev.scenes_run == 4        # 2 distinct speeds
+    again = ev.predict(u)
+    assert ev.scenes_run == 4 and np.array_equal(first, again)
+    dg = cal.params[0].value(0.3)
+    ref = run_si(SIScene(**cal.fixed, dg=dg, speed=1e-4), "crack")["pull_off_N"]
+    assert first[0, 1] == pytest.approx(ref, rel=1e-8)
+
+
+def test_synthesize_without_noise_is_the_engine():
+    fit = {"dg": [0.05, 0.5]}
+    fixed = {**FIXED, "h0": 3.08e-8, "tau0": 0.02}
+    d = _synthetic(fit, fixed, {"dg": 0.2}, seed=0, sigma=True, noise=0.0)
+    si = SIScene(**fixed, dg=0.2, speed=float(SPEEDS[1]))
+    assert d["pull_off_N"][1] == pytest.approx(run_si(si, "crack")["pull_off_N"], rel=1e-12)
+    assert d["sigma_N"] == [0.0] * len(SPEEDS)
+
+
+# ------------------------------------------------------------------ bad files: one line, exit 2
+GOOD_FIT = {"dg": [0.05, 0.5], "tau0": [1e-3, 1.0]}
+GOOD_FIXED = {**FIXED, "h0": 3.08e-8}
+GOOD_DATA = {"speed_m_s": [1e-6, 1e-5, 1e-4], "pull_off_N": [0.01, 0.02, 0.03]}
+
+
+@pytest.mark.parametrize("change, words", [
+    ({"data": {"speed_m_s": [1e-6, 1e-5, 1e-4], "force": [1.0, 2.0, 3.0]}},
+     "missing column pull_off_N"),
+    ({"data": {"speed_m_s": [1e-6, -1e-5, 1e-4], "pull_off_N": [0.01, 0.02, 0.03]}},
+     "speed_m_s must be a number > 0 (row 2"),
+    ({"fit": {"dg": [0.5, 0.05], "tau0": [1e-3, 1.0]}}, "fit.dg: bounds reversed"),
+    ({"fixed": {**GOOD_FIXED, "dg": 0.1}}, "dg: both fixed and fitted"),
+    ({"data": {"speed_m_s": [1e-6], "pull_off_N": [0.01]}}, "1 points for 2 free parameters"),
+    ({"fit": {"dg": [0.05, 0.5], "tau": [1e-3, 1.0]}}, "fit.tau: unknown SI field"),
+    ({"fit": {**GOOD_FIT, "nu": [0.1, 0.7]}, "fixed": {k: v for k, v in GOOD_FIXED.items()
+                                                     if k != "nu"}},
+     "fit.nu upper bound must be in [0, 0.5]"),
+    ({"fixed": {k: v for k, v in GOOD_FIXED.items() if k != "R"}}, "R: missing"),
+    ({"fit": {**GOOD_FIT, "Einf": [1e5, 1e9]}, "fixed": {k: v for k, v in GOOD_FIXED.items()
+                                                              if k != "Einf"}},
+     "fit.Einf: lower bound must be >= E0"),
+    ({"model": "fem"}, "model must be one of bem, crack, pb, auto"),
+])
+def test_bad_files_one_line_exit_2(tmp_path, capsys, change, words):
+    fit = change.get("fit", GOOD_FIT)
+    fixed = change.get("fixed", GOOD_FIXED)
+    extra = {"model": change["model"]} if "model" in change else {}
+    path = _problem(tmp_path, fit, fixed, change.get("data", GOOD_DATA), **extra)
+    assert main(["calibrate", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and "\n" not in err
+    assert words in err, err
+
+
+def test_missing_data_file_is_one_line(tmp_path, capsys):
+    path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED)          # no CSV written
+    assert main(["calibrate", str(path)]) == 2
+    assert "data: no such file" in capsys.readouterr().err
+
+
+def test_sigma_must_be_positive(tmp_path):
+    path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED, {**GOOD_DATA, "sigma_N": [1e-3, 0.0, 1e-3]})
+    with pytest.raises(InputError, match="sigma_N must be a number > 0"):
+        cb.load_calibration(path)
+
+
+# ------------------------------------------------------------------ the command end to end
+def test_cli_json_and_out(tmp_path, capsys):
+    fixed = {**FIXED, "h0": 3.08e-8, "tau0": 0.02}
+    data = _synthetic({"dg": [0.05, 0.5]}, fixed, {"dg": 0.2}, seed=5, sigma=False)
+    path = _problem(tmp_path, {"dg": [0.05, 0.5]}, fixed, data,
+                    search={"points": 4, "starts": 1}, profile={"points": 4})
+    out = tmp_path / "out"
+    assert main(["calibrate", str(path), "--json", "--out", str(out), "-j", "1"]) == 0
+    captured = capsys.readouterr()
+    res = json.loads(captured.out)
+    assert "search: 4 Sobol points" in captured.err                 # progress on stderr
+    dg = res["parameters"]["dg"]
+    assert dg["interval"][0] <= 0.2 <= dg["interval"][1] and dg["identifiable"]
+    assert res["scenes_run"] > 0 and res["wall_s"] > 0
+    assert set(res["fit"]) >= {"rms_log_residual", "dof", "threshold"}
+    for name in ("calibration.json", "fit.png", "profile_dg.png"):
+        assert (out / name).stat().st_size > 1000
+    assert json.loads((out / "calibration.json").read_text())["parameters"]["dg"] == dg
