@@ -423,7 +423,10 @@ class Result:
 
     Attributes
     ----------
-    status : {"ok", "failed"}
+    status : {"ok", "failed", "error"}
+        "failed": a numerical or physical failure the engine reports with a reason;
+        "error": an internal error (a bug, e.g. a TypeError) that ``sweep run`` caught and
+        logged with its traceback in ``<out>.errors.log``.
     reason : str
         Empty when ``ok``; otherwise why the run failed (Newton failure, step limit, ...).
     pull_off : float

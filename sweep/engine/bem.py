@@ -14,8 +14,9 @@ Orchestration only; each concept has its module:
    pull-off change against the same scene on a mesh of half the resolution; a result whose
    indicator exceeds the tolerance is not ``ok``.
 
-A numerical failure never raises: the ``Result`` has ``status="failed"`` and a reason.
-Invalid input raises :class:`sweep.errors.InputError` when the Scene/Numerics are built.
+A numerical failure never raises: the ``Result`` has ``status="failed"`` and a reason. A
+programming error (:func:`sweep.errors.is_internal_error`: TypeError, IndexError, ...) is
+not a result: it raises (``sweep run`` records it as status "error"). Invalid input raises :class:`sweep.errors.InputError` when the Scene/Numerics are built.
 """
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ import numpy as np
 from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP_LIMIT,
                              MeshArrays, Physics, Records, RunState, StepControl, invalidate,
                              unload)
+from ..errors import NUMERICAL_ERRORS, is_internal_error
 from ..scene import Numerics, Result, Scene
 from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
@@ -96,7 +98,9 @@ def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Re
         except Refused as exc:
             res.reason = str(exc)
             return res
-        except Exception as exc:  # noqa: BLE001 - a sweep must survive any single failure
+        except NUMERICAL_ERRORS as exc:   # a bug (TypeError, ...) is not a result: it raises
+            if is_internal_error(exc):
+                raise
             res.status = "failed"
             res.reason = f"{type(exc).__name__}: {exc}"
             return res

@@ -30,7 +30,7 @@ import math
 import time
 
 from .. import units
-from ..errors import check_choice, check_positive
+from ..errors import NUMERICAL_ERRORS, check_choice, check_positive, is_internal_error
 from ..scene import Numerics, Result, Scene
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem
@@ -168,7 +168,13 @@ def simulate_model(scene, model: str = "bem", numerics=None):
         model = "elastic"
     elif model == "auto":
         model = choose_model(scene, numerics)
-    res = MODELS[model](scene, numerics)
+    try:
+        res = MODELS[model](scene, numerics)
+    except NUMERICAL_ERRORS as exc:   # a numerical failure is a result; a bug (TypeError, ...)
+        if is_internal_error(exc):     # raises: sweep run records it as status "error"
+            raise
+        res = Result(scene=scene, numerics=numerics, status="failed",
+                     reason=f"{type(exc).__name__}: {exc}")
     res.model_used = model
     return res
 
@@ -194,7 +200,8 @@ def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
     -------
     Result
         ``model_used`` says which model ran; a numerical failure is ``status="failed"``
-        with a reason, never an exception.
+        with a reason, never an exception. A programming error (TypeError, IndexError, ...:
+        :func:`sweep.errors.is_internal_error`) raises: a bug is not a result.
     """
     if not isinstance(scene, Scene):
         raise TypeError("scene must be a sweep.Scene")
