@@ -27,6 +27,8 @@ from .errors import InputError, check_choice, check_int, check_range
 
 MATERIALS = ("mpl", "sls")
 MESHES = ("uniform", "graded")
+#: nodes of a uniform mesh whose ``Numerics.nodes`` is None (:attr:`Numerics.uniform_nodes`)
+UNIFORM_NODES = 500
 STOPS = ("pulloff", "separation")
 #: Models a scene can ask for (sweep.engine.models maps each to its simulate function).
 MODEL_NAMES = ("bem", "crack", "pb", "elastic", "auto")
@@ -236,7 +238,7 @@ class Numerics:
     ----------
     nodes : int or None
         Number of mesh nodes N (node 0 at r = 0), in [20, 5000]. Uniform mesh: ``None``
-        means 500. Graded mesh: ``None`` (default of the presets) sizes the mesh from
+        means 500 (:attr:`uniform_nodes`). Graded mesh: ``None`` (default of the presets) sizes the mesh from
         ``band_resolution``; a number gives the graded mesh of that many nodes (its fine
         spacing follows).
     mesh : {"uniform", "graded"}
@@ -339,6 +341,13 @@ class Numerics:
             raise InputError(f"exact must be true or false (got {self.exact!r})")
         set_("exact", bool(self.exact))
         set_("zone_nodes", check_range("zone_nodes", self.zone_nodes, 0.0, 100.0))
+
+    @property
+    def uniform_nodes(self) -> int:
+        """Nodes of the uniform mesh: ``nodes``, or :data:`UNIFORM_NODES` when unset (the one
+        place that resolves ``nodes=None`` on a uniform mesh, e.g. numerics given by fields
+        without a preset)."""
+        return self.nodes if self.nodes is not None else UNIFORM_NODES
 
     @classmethod
     def preset(cls, name: str = "balanced", **overrides) -> "Numerics":

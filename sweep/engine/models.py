@@ -137,7 +137,7 @@ def bem_nodes_needed(scene, numerics=None) -> int:
 
 def bem_node_budget(numerics) -> int:
     """The most nodes ``numerics`` lets the BEM use: ``nodes`` (uniform) or ``max_nodes``."""
-    return numerics.nodes if numerics.mesh == "uniform" else numerics.max_nodes
+    return numerics.uniform_nodes if numerics.mesh == "uniform" else numerics.max_nodes
 
 
 def choose_model(scene, numerics=None) -> str:

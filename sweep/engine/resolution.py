@@ -35,8 +35,9 @@ def resolution_error(spacing: float, length: float) -> float:
 def coarser(numerics: Numerics) -> Numerics:
     """The numerics of the error indicator's cheaper solve: half the mesh resolution
     (half the band resolution, or half the nodes), no coarse-mesh refusal."""
-    if numerics.nodes is not None:
-        return dataclasses.replace(numerics, nodes=max(numerics.nodes // 2, 20), zone_nodes=0.0)
+    if numerics.nodes is not None or numerics.mesh == "uniform":
+        return dataclasses.replace(numerics, nodes=max(numerics.uniform_nodes // 2, 20),
+                                   zone_nodes=0.0)
     return dataclasses.replace(numerics, band_resolution=max(numerics.band_resolution / 2, 2.0),
                                zone_nodes=0.0)
 
