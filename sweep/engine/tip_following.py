@@ -506,7 +506,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
 
     run = UnloadingState.start(pb, h_init, delta0, el.cache, el.stats.copy())
     meshes, nodes = 1, pb.mesh.nodes
-    remeshed_at = []
+    remeshed_at, marks = [], []   # first records on new meshes: to check, and all of them
     rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
     while True:
         probing, n_before, t_chunk = run.n <= 1, run.n, time.perf_counter()
@@ -536,6 +536,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                 return res
             transfer(run, pb, new)
             remeshed_at.append(run.n)
+            marks.append(run.n)
             pb, meshes, nodes = new, meshes + 1, max(nodes, new.mesh.nodes)
         elif status == STATUS_STEP_LIMIT and run.n <= numerics.max_steps:
             pass
@@ -558,7 +559,8 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         res.reason = f"more than {MAX_MESHES} meshes (a = {a[-1]:.4g})"
         return res
     finish(res, status, res.trajectory, pb.mesh.spacing,
-           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING)
+           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING,
+           remeshed=marks)
     if res.ok:
         note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
         res.reason = f"{res.reason}; {note}" if res.reason else note
