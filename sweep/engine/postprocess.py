@@ -114,9 +114,12 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     i += lo
     passed = stop_reached(P, a, len(P), i, 0, min_travel)
     if status == STATUS_TIME_BUDGET:
+        num = res.numerics
+        coarser = ("fewer nodes" if num.mesh == "uniform" or num.nodes is not None
+                   else "lower band_resolution")
         res.reason = (f"time budget: {res.numerics.time_budget_s:g} s spent after {len(t) - 1} "
                       f"steps (a = {a[-1]:.4g}, pull-off not reached); give it more "
-                      f"(numerics time_budget_s) or cheaper numerics (preset fast, fewer nodes)")
+                      f"(numerics time_budget_s) or cheaper numerics (preset fast, {coarser})")
         return
     if status == STATUS_DOMAIN:
         res.reason = "contact reached the mesh edge: increase numerics.domain"

@@ -43,7 +43,7 @@ from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER
 from ..kernels.interface import lj_traction
 
 from ..scene import Numerics, Result, Scene
-from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, unload_chunk
+from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, no_contact_reason, unload_chunk
 from .initial import ElasticSolver, relaxed_state
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Refused, derive, jkr_radius, material_of, prepare
@@ -498,7 +498,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     res.spacing, res.domain_used = pb.mesh.spacing, pb.mesh.domain
     res.prony_terms, res.prony_error = int(pb.prony_weights.size), pb.prony_error
     if a_init <= 0.0:
-        res.reason = "no contact in the initial state (delta0 below the jump-in)"
+        res.reason = no_contact_reason(scene, a_init)
         return res
     if a_init >= pb.mesh.r[-2]:
         res.reason = f"initial contact radius {a_init:.4g} reaches the mesh edge"
