@@ -78,11 +78,13 @@ class Scene:
     k : float
         Ratio of relaxed to glassy modulus E0/Einf, in (0, 1]; ``k = 1`` is elastic.
     mu : float
-        Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.01, 1000]: the hereditary BEM
+        Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.01, 1e6]: the hereditary BEM
         takes [0.01, 100] (sweep.engine.problem.BEM_MU_RANGE; above about 8 on a mesh that follows
         the crack tip, :mod:`sweep.engine.tip_following`), the elastic branch is validated up to
-        100, the crack-front and pb models (large contacts against l0, e.g. the paper's
-        PDMS at mu = 103) take the whole range.
+        100, the crack-front model (the mu -> infinity limit: large contacts against l0, e.g.
+        the paper's PDMS at mu = 103, or mu in the thousands from a physical h0 of a few
+        angstroms) and the pb model take the whole range; "auto" sends a scene beyond the
+        BEM's range to the crack-front model and says so in the row's reason.
     rate : float
         Dimensionless unloading rate r-hat = r tau0 / h0, in (0, 1e12].
     a0 : float, optional
@@ -109,8 +111,10 @@ class Scene:
                     limits=(0.0, 1.0), lo_open=True, label="$k$", order=3)
     mu: float = axis(3.24, help="Tabor parameter (the hereditary BEM 0.01-100, on a "
                      "tip-following mesh where its fixed crack band exceeds max_nodes; "
-                     "elastic scenes (k = 1) up to 100; the crack-front and pb models "
-                     "the whole range)", limits=(0.01, 1000.0), label=r"$\mu$", order=4)
+                     "elastic scenes (k = 1) up to 100; the crack-front model, the mu -> "
+                     "infinity limit, and the pb model the whole range: auto sends a scene "
+                     "beyond the BEM's range to the crack-front model)", limits=(0.01, 1e6),
+                     label=r"$\mu$", order=4)
     rate: float = axis(help="unloading rate r-hat = r tau0 / h0", limits=(0.0, 1e12),
                        lo_open=True, label=r"unloading rate $\hat r = r\tau_0/h_0$", order=7,
                        plot_group=False)

@@ -44,3 +44,28 @@ def test_every_model_runs_with_numerics_without_preset(model, kw, expect):
 def test_choose_model_with_uniform_numerics():
     assert models.choose_model(Scene(**VISCO), NUM) == "bem"
     assert models.choose_model(Scene(**HIGH_MU), NUM) == "crack"
+
+
+# -- beyond the BEM's Tabor range, auto runs the crack-front model (issue 21 item 3) --------
+@pytest.mark.parametrize("mu", [150.0, 2154.0, 1e5])
+def test_auto_beyond_the_bem_range_runs_the_crack_front_model(mu):
+    """mu = 2154 is PDMS-like with a physical h0 = 0.5 nm: once refused by the Scene
+    ("mu must be in [0.01, 1000]"), now the crack-front model's, with its error stated."""
+    from sweep.engine.problem import BEM_MU_RANGE
+
+    scene = Scene(n=0.8, k=0.1, mu=mu, a0=3.0, rate=316.0, model="auto")
+    assert models.choose_model(scene) == "crack"
+    res = models.simulate(scene)
+    assert res.model_used == "crack" and res.ok
+    assert math.isfinite(res.pull_off) and 1.0 < res.pull_off < 20.0
+    assert res.reason.startswith(f"crack-front model (the mu -> infinity limit): mu = {mu:g} "
+                                 f"is beyond the BEM's range [0.01, {BEM_MU_RANGE[1]:g}]")
+    assert "-0.9 % at mu = 10" in res.reason and "+2.6 % at mu = 15" in res.reason
+    # the BEM itself refuses it with its reason (a failed row, not an exception)
+    bem = models.simulate(Scene(n=0.8, k=0.1, mu=mu, a0=3.0, rate=316.0, model="bem"))
+    assert bem.status == "failed" and bem.reason
+
+
+def test_auto_within_the_bem_range_keeps_an_empty_reason():
+    res = models.simulate(Scene(**VISCO, model="auto"), Numerics.preset("fast"))
+    assert res.model_used == "bem" and res.ok and res.reason == ""
