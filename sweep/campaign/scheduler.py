@@ -477,7 +477,9 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
         _close_dask(client, cluster)
         raise
 
-    todo = [(sid, scene) for sid, scene in tasks if sid not in done]
+    # a scene that hit an internal error (a bug, not a result) runs again on resume
+    retry = {row["scene_id"] for row in store.rows if row.get("status") == "error"}
+    todo = [(sid, scene) for sid, scene in tasks if sid not in done or sid in retry]
     skipped = len(tasks) - len(todo)
     prog = Progress(progress, total=len(tasks), already=skipped, stream=stream)
     if backend == "loky":

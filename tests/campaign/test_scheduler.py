@@ -380,3 +380,16 @@ def test_dispatch_chunks_keep_start_groups_together_and_balance():
     # fewer chunks than scenes: small groups travel together
     assert len(chunks) < len(todo)
     assert scheduler.dispatch_chunks([], num, 2) == []
+
+
+def test_resume_runs_the_scenes_that_hit_an_internal_error_again(tmp_path):
+    """After the bug is fixed, the same command reruns only the "error" scenes; their rows
+    are replaced, the log of the first run is kept."""
+    out = tmp_path / "r.h5"
+    first = run_sweep(cfg(), jobs=1, out=out, simulate=raising_simulate, progress="none")
+    assert first.errors == 2
+    again = run_sweep(cfg(), jobs=1, out=out, simulate=fake_simulate, progress="none")
+    assert (again.ran, again.skipped, again.errors) == (2, 2, 0)
+    df = load(out)
+    assert len(df) == 4 and set(df.status) <= {"ok", "failed"}
+    assert (tmp_path / "r.h5.errors.log").read_text().count("ZeroDivisionError: boom") == 2
