@@ -2,7 +2,9 @@
 
 Every command validates its input through :mod:`sweep.errors`; an invalid
 value prints one line ``error: <parameter> must be ... (got ...)`` on stderr
-and exits with code 2 (runtime failures exit 1). No traceback is shown.
+and exits with code 2 (runtime failures exit 1). No traceback is shown. ``sweep run`` exits
+with code 3 after a sweep in which scenes hit an internal error (status "error", a bug: their
+tracebacks are in ``<out>.errors.log``).
 
 Start-up: this module imports click and the vocabulary only (errors, scene: numpy); each
 command imports its machinery (numba, scipy, h5py, pandas ...) in its body, when it runs, and
@@ -25,6 +27,9 @@ from click.core import ParameterSource
 from .errors import (InputError, as_float, check_array, check_choice, check_int, check_positive,
                      check_range)
 from .scene import AXES, PRESETS, Numerics, Scene
+
+#: exit code of ``sweep run`` when scenes hit an internal error (the sweep itself finished)
+EXIT_INTERNAL_ERROR = 3
 
 
 def parse_floats(name: str, text: str) -> list[float]:
@@ -388,6 +393,9 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
                    f"{exc.output}; to resume, run: {shlex.join(again)}", err=True)
         raise SystemExit(130) from None
     click.echo(report.line())
+    if report.errors:   # a bug is not a result: the sweep finished, but says so and fails
+        click.echo(f"error: {report.error_line()}", err=True)
+        raise SystemExit(EXIT_INTERNAL_ERROR)
 
 
 @cli.command("info")

@@ -97,3 +97,24 @@ def check_array(name: str, values, lo=None, hi=None, lo_open=False, hi_open=Fals
     for x in arr.ravel():
         check_range(name, x, lo, hi, lo_open, hi_open)
     return arr
+
+
+#: exceptions that are numerical or physical failures of a scene (a singular matrix, an
+#: overflow, a failed convergence reported as RuntimeError, a model refusing a scene, no memory
+#: for the mesh): the engine turns them into a failed Result with the message as reason
+NUMERICAL_ERRORS = (InputError, ArithmeticError, np.linalg.LinAlgError, MemoryError, RuntimeError)
+#: RuntimeError subclasses that are programming errors
+_BUG_RUNTIME_ERRORS = (NotImplementedError, RecursionError)
+
+
+def is_internal_error(exc: BaseException) -> bool:
+    """Whether ``exc`` raised inside a scene is a programming error (TypeError, IndexError,
+    KeyError, AttributeError, ValueError, ...): not a result but a bug, which the engine lets
+    propagate and ``sweep run`` records as status "error" with its traceback.
+
+    Numerical and physical failures (:data:`NUMERICAL_ERRORS`) are results: a failed row
+    with the exception as reason.
+    """
+    if isinstance(exc, _BUG_RUNTIME_ERRORS):
+        return True
+    return not isinstance(exc, NUMERICAL_ERRORS)

@@ -27,6 +27,8 @@ from .errors import InputError, check_choice, check_int, check_range
 
 MATERIALS = ("mpl", "sls")
 MESHES = ("uniform", "graded")
+#: nodes of a uniform mesh whose ``Numerics.nodes`` is None (:attr:`Numerics.uniform_nodes`)
+UNIFORM_NODES = 500
 STOPS = ("pulloff", "separation")
 #: Models a scene can ask for (sweep.engine.models maps each to its simulate function).
 MODEL_NAMES = ("bem", "crack", "pb", "elastic", "auto")
@@ -76,11 +78,13 @@ class Scene:
     k : float
         Ratio of relaxed to glassy modulus E0/Einf, in (0, 1]; ``k = 1`` is elastic.
     mu : float
-        Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.01, 1000]: the hereditary BEM
+        Tabor parameter (R dg^2 / (E0*^2 h0^3))^(1/3), in [0.01, 1e6]: the hereditary BEM
         takes [0.01, 100] (sweep.engine.problem.BEM_MU_RANGE; above about 8 on a mesh that follows
         the crack tip, :mod:`sweep.engine.tip_following`), the elastic branch is validated up to
-        100, the crack-front and pb models (large contacts against l0, e.g. the paper's
-        PDMS at mu = 103) take the whole range.
+        100, the crack-front model (the mu -> infinity limit: large contacts against l0, e.g.
+        the paper's PDMS at mu = 103, or mu in the thousands from a physical h0 of a few
+        angstroms) and the pb model take the whole range; "auto" sends a scene beyond the
+        BEM's range to the crack-front model and says so in the row's reason.
     rate : float
         Dimensionless unloading rate r-hat = r tau0 / h0, in (0, 1e12].
     a0 : float, optional
@@ -107,8 +111,10 @@ class Scene:
                     limits=(0.0, 1.0), lo_open=True, label="$k$", order=3)
     mu: float = axis(3.24, help="Tabor parameter (the hereditary BEM 0.01-100, on a "
                      "tip-following mesh where its fixed crack band exceeds max_nodes; "
-                     "elastic scenes (k = 1) up to 100; the crack-front and pb models "
-                     "the whole range)", limits=(0.01, 1000.0), label=r"$\mu$", order=4)
+                     "elastic scenes (k = 1) up to 100; the crack-front model, the mu -> "
+                     "infinity limit, and the pb model the whole range: auto sends a scene "
+                     "beyond the BEM's range to the crack-front model)", limits=(0.01, 1e6),
+                     label=r"$\mu$", order=4)
     rate: float = axis(help="unloading rate r-hat = r tau0 / h0", limits=(0.0, 1e12),
                        lo_open=True, label=r"unloading rate $\hat r = r\tau_0/h_0$", order=7,
                        plot_group=False)
@@ -236,7 +242,7 @@ class Numerics:
     ----------
     nodes : int or None
         Number of mesh nodes N (node 0 at r = 0), in [20, 5000]. Uniform mesh: ``None``
-        means 500. Graded mesh: ``None`` (default of the presets) sizes the mesh from
+        means 500 (:attr:`uniform_nodes`). Graded mesh: ``None`` (default of the presets) sizes the mesh from
         ``band_resolution``; a number gives the graded mesh of that many nodes (its fine
         spacing follows).
     mesh : {"uniform", "graded"}
@@ -340,6 +346,13 @@ class Numerics:
         set_("exact", bool(self.exact))
         set_("zone_nodes", check_range("zone_nodes", self.zone_nodes, 0.0, 100.0))
 
+    @property
+    def uniform_nodes(self) -> int:
+        """Nodes of the uniform mesh: ``nodes``, or :data:`UNIFORM_NODES` when unset (the one
+        place that resolves ``nodes=None`` on a uniform mesh, e.g. numerics given by fields
+        without a preset)."""
+        return self.nodes if self.nodes is not None else UNIFORM_NODES
+
     @classmethod
     def preset(cls, name: str = "balanced", **overrides) -> "Numerics":
         """Numerics of a named preset ("fast", "balanced", "accurate"), with overrides."""
@@ -423,7 +436,10 @@ class Result:
 
     Attributes
     ----------
-    status : {"ok", "failed"}
+    status : {"ok", "failed", "error"}
+        "failed": a numerical or physical failure the engine reports with a reason;
+        "error": an internal error (a bug, e.g. a TypeError) that ``sweep run`` caught and
+        logged with its traceback in ``<out>.errors.log``.
     reason : str
         Empty when ``ok``; otherwise why the run failed (Newton failure, step limit, ...).
     pull_off : float

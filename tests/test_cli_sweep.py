@@ -170,8 +170,8 @@ BAD_CONFIGS = {
     "malformed": ("name: x\ngrid: {n: [0.4, 1.6\n", "not valid YAML at line"),
     "types": ("name: x\ngrid: {n: abc, rate: [1], a0: 2}\nstore: {trajectories: 3}\n",
               "2 problems: grid.n must be a number (got 'abc'); store.trajectories"),
-    "range": ("name: x\ngrid: {n: 0.8, rate: 1, a0: 2, mu: 5000}\n",
-              "grid.mu must be in [0.01, 1000] (got 5000)"),
+    "range": ("name: x\ngrid: {n: 0.8, rate: 1, a0: 2, mu: 2e6}\n",
+              "grid.mu must be in [0.01, 1e+06] (got 2e+06)"),
     "unknown": ("name: x\ngrid: {n: 0.8, rate: 1, a0: 2, speed: 3}\n",
                 "grid.speed: unknown axis (allowed:"),
     "code": ("name: !!python/object/apply:os.getcwd []\ngrid: {n: 0.8, rate: 1, a0: 2}\n",
@@ -535,3 +535,30 @@ def test_sigint_to_the_process_group_keeps_scenes(tmp_path):
     assert m, text
     assert int(m.group(1)) == len(load(tmp_path / "kill.h5")) >= 2
     assert "Traceback" not in text
+
+
+def test_run_exits_nonzero_after_an_internal_error(tmp_path, monkeypatch, capsys):
+    """`sweep run` finishes the sweep, stores every scene, prints the count of internal errors
+    with the log's path and exits 3 (a bug is not a result)."""
+    import sweep.engine.models as models
+
+    real = models.simulate
+
+    def buggy(scene, numerics=None):
+        if scene.n > 1 and scene.rate > 50:
+            raise IndexError("index 7 is out of bounds")
+        return real(scene, numerics)
+
+    monkeypatch.setattr(models, "simulate", buggy)
+    monkeypatch.chdir(tmp_path)
+    cfg = write(tmp_path / "tiny.yaml", TINY)
+    assert main(["run", str(cfg), "-j", "1", "--progress", "none"]) == 3
+    cap = capsys.readouterr()
+    out = tmp_path / "out" / "tiny.h5"
+    assert "tiny: 4 scenes (4 ran" in cap.out
+    assert f"1 scene hit an internal error (a bug, not a result; status \"error\"), see " \
+           f"{out}.errors.log" in cap.err
+    df = load(out)
+    assert len(df) == 4 and list(df.status).count("error") == 1
+    log = (tmp_path / "out" / "tiny.h5.errors.log").read_text()
+    assert "IndexError: index 7 is out of bounds" in log and "in buggy" in log

@@ -35,6 +35,7 @@ import socket
 import sys
 import tempfile
 import time
+import traceback
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -87,6 +88,10 @@ class SweepReport:
     jobs: int
     backup: Path | None = None
     failed_ids: list = field(default_factory=list)
+    #: scenes that hit an internal error (status "error": a bug, not a result), not in failed
+    errors: int = 0
+    error_ids: list = field(default_factory=list)
+    error_log: Path | None = None
 
     def line(self) -> str:
         text = (f"{self.name}: {self.total} scenes ({self.ran} ran, {self.skipped} already "
@@ -94,6 +99,13 @@ class SweepReport:
         if self.backup is not None:
             text += f" (previous results moved to {self.backup})"
         return text
+
+    def error_line(self) -> str:
+        """The end-of-sweep line about internal errors ("" when there were none)."""
+        if not self.errors:
+            return ""
+        return (f"{self.errors} scene{'s' if self.errors > 1 else ''} hit an internal error "
+                f"(a bug, not a result; status \"error\"), see {self.error_log}")
 
 
 # ----------------------------------------------------------------------------- workers
@@ -126,8 +138,10 @@ def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | 
               in_worker: bool = True):
     """Worker task: simulate one scene; return ``(row, trajectory or None)``, plain data.
 
-    Never raises for a failing scene: an exception becomes ``status="failed"`` with the
-    exception as reason (the solver itself already reports numerical failures that way).
+    Never raises for a failing scene. The engine reports numerical failures as
+    ``status="failed"`` with a reason; an exception that escapes it is a bug (TypeError, ...)
+    and becomes ``status="error"`` with the exception as reason and its traceback in the row's
+    :data:`TRACEBACK_KEY` (the parent writes it to the error log and drops it from the row).
     ``in_worker=False`` (the sequential path in the parent) leaves the thread limits alone.
     """
     if in_worker:
@@ -136,11 +150,14 @@ def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | 
         from ..engine.models import simulate   # the front door: dispatches on scene.model
     t0 = time.perf_counter()
     c0 = time.process_time()
+    tb = None
     try:
         res = simulate(scene, numerics)
-    except Exception as exc:  # a bug in one scene must not stop the sweep
-        res = Result(scene=scene, numerics=numerics, status="failed",
-                     reason=_one_line(f"exception {type(exc).__name__}: {exc}"))
+    except Exception as exc:  # a bug in one scene must not stop the sweep, nor pass for a result
+        tb = traceback.format_exc()
+        res = Result(scene=scene, numerics=numerics, status="error",
+                     reason=_one_line(f"internal error {type(exc).__name__}: {exc}"))
+        res.model_used = getattr(scene, "model", "")
     task_wall = time.perf_counter() - t0
     task_cpu = time.process_time() - c0
     row = res.to_row()
@@ -155,7 +172,30 @@ def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | 
     traj = None
     if trajectories and res.trajectory:
         traj = {str(k): np.asarray(v, dtype=np.float64) for k, v in res.trajectory.items()}
-    return plain_row(row), traj
+    row = plain_row(row)
+    if tb is not None:
+        row[TRACEBACK_KEY] = tb
+    return row, traj
+
+
+#: key of the traceback an internal error adds to a worker's row (never stored in the table)
+TRACEBACK_KEY = "_traceback"
+
+
+def error_log_path(path: Path) -> Path:
+    """The log of internal errors beside the results file ``path``: ``<path>.errors.log``."""
+    return Path(path).with_name(Path(path).name + ".errors.log")
+
+
+def log_internal_error(log: Path, row: dict, tb: str) -> None:
+    """Append one internal error (time, scene id, model, scene, traceback) to ``log``."""
+    scene = {k: row.get(k) for k in ("n", "k", "mu", "a0", "delta0", "rate", "material",
+                                     "model", "stop") if k in row}
+    text = (f"=== {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())} scene {row['scene_id']} "
+            f"model {row.get('model_used') or row.get('model', '')}\n"
+            f"scene: {scene}\n{tb.rstrip()}\n\n")
+    with open(log, "a", encoding="utf-8") as fh:
+        fh.write(text)
 
 
 def template_row(config: SweepConfig) -> dict:
@@ -475,7 +515,9 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
         _close_dask(client, cluster)
         raise
 
-    todo = [(sid, scene) for sid, scene in tasks if sid not in done]
+    # a scene that hit an internal error (a bug, not a result) runs again on resume
+    retry = {row["scene_id"] for row in store.rows if row.get("status") == "error"}
+    todo = [(sid, scene) for sid, scene in tasks if sid not in done or sid in retry]
     skipped = len(tasks) - len(todo)
     prog = Progress(progress, total=len(tasks), already=skipped, stream=stream)
     if backend == "loky":
@@ -496,8 +538,9 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
                      f"finished scenes are kept and only new ones run ({len(done)} in the "
                      f"file, {store.meta['n_scenes']} in the grown grid)")
 
-    ran = failed = 0
-    failed_ids = []
+    ran = failed = errors = 0
+    failed_ids, error_ids = [], []
+    error_log = error_log_path(path)
     completed = False
     try:
         if todo:
@@ -508,9 +551,14 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
             results = _results(chunks, cfg, backend, n_jobs, client, simulate)
             try:
                 for row, traj in results:
+                    tb = row.pop(TRACEBACK_KEY, None)
                     store.append(row, traj)
                     ran += 1
-                    if row.get("status") != "ok":
+                    if row.get("status") == "error":
+                        errors += 1
+                        error_ids.append(row["scene_id"])
+                        log_internal_error(error_log, row, tb or "(no traceback)\n")
+                    elif row.get("status") != "ok":
                         failed += 1
                         failed_ids.append(row["scene_id"])
                     prog.update(row)
@@ -541,9 +589,12 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
     if completed:
         prog.close()
         store.finish()
-    return SweepReport(output=path, name=cfg.name, total=len(tasks), skipped=skipped, ran=ran,
-                       failed=failed, wall_s=time.monotonic() - t_start, backend=backend,
-                       jobs=n_jobs, backup=store.backup, failed_ids=failed_ids)
+    report = SweepReport(output=path, name=cfg.name, total=len(tasks), skipped=skipped, ran=ran,
+                         failed=failed, wall_s=time.monotonic() - t_start, backend=backend,
+                         jobs=n_jobs, backup=store.backup, failed_ids=failed_ids,
+                         errors=errors, error_ids=error_ids,
+                         error_log=error_log if errors else None)
+    return report
 
 
 def _finish_store(store: ResultStore) -> None:

@@ -14,8 +14,9 @@ Orchestration only; each concept has its module:
    pull-off change against the same scene on a mesh of half the resolution; a result whose
    indicator exceeds the tolerance is not ``ok``.
 
-A numerical failure never raises: the ``Result`` has ``status="failed"`` and a reason.
-Invalid input raises :class:`sweep.errors.InputError` when the Scene/Numerics are built.
+A numerical failure never raises: the ``Result`` has ``status="failed"`` and a reason. A
+programming error (:func:`sweep.errors.is_internal_error`: TypeError, IndexError, ...) is
+not a result: it raises (``sweep run`` records it as status "error"). Invalid input raises :class:`sweep.errors.InputError` when the Scene/Numerics are built.
 """
 from __future__ import annotations
 
@@ -31,12 +32,13 @@ import numpy as np
 from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP_LIMIT,
                              MeshArrays, Physics, Records, RunState, StepControl, invalidate,
                              unload)
+from ..errors import NUMERICAL_ERRORS, is_internal_error
 from ..scene import Numerics, Result, Scene
 from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Problem, Refused, derive, material_of, prepare
-from .resolution import estimate_error
+from .resolution import estimate_error, refine_advice
 
 #: Newton iterations per solve: a good step converges in 2-5 (quadratic predictor); a solve
 #: that needs more is better retried with a smaller step or taken for a fold
@@ -99,7 +101,9 @@ def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Re
         except Refused as exc:
             res.reason = str(exc)
             return res
-        except Exception as exc:  # noqa: BLE001 - a sweep must survive any single failure
+        except NUMERICAL_ERRORS as exc:   # a bug (TypeError, ...) is not a result: it raises
+            if is_internal_error(exc):
+                raise
             res.status = "failed"
             res.reason = f"{type(exc).__name__}: {exc}"
             return res
@@ -111,8 +115,6 @@ def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Re
     return res
 
 
-#: what to change when the graded mesh finds no equilibrium before the pull-off
-ADVICE_GRADED = "increase nodes or reduce domain"
 #: the unloading kernel runs in chunks of this many steps; the wall-time budget is checked
 #: between chunks (a resumed chunk restarts the step predictor: a few Newton iterations)
 CHUNK_STEPS = 2000
@@ -192,7 +194,7 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
                       f"(domain {mesh.domain:.4g})")
         return
     if res.a0_result <= 0.0:
-        res.reason = "no contact in the initial state (delta0 below the jump-in)"
+        res.reason = no_contact_reason(scene, res.a0_result)
         return
 
     stats = el.stats.copy()
@@ -221,7 +223,8 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
         res.reason = (f"the crack tip left the fine band {pb.mesh.band[0]:.3g}..{pb.mesh.band[1]:.3g}"
                       f" of the graded mesh (a = {a[-1]:.4g})")
         return "inner" if a[-1] < pb.tip_range[0] else "outer"
-    finish(res, status, res.trajectory, dr, min_travel, pb.scales, advice=ADVICE_GRADED)
+    finish(res, status, res.trajectory, dr, min_travel, pb.scales,
+           advice=refine_advice(numerics))
     return None
 
 
@@ -247,6 +250,16 @@ def kernels_cached() -> bool:
         except OSError:
             return False
     return True
+
+
+def no_contact_reason(scene: Scene, radius: float) -> str:
+    """Why a run has no initial contact, for the initial state the scene gave."""
+    if scene.a0 is not None:
+        return (f"no contact in the initial state: the relaxed state solved for a0 = "
+                f"{scene.a0:g} has contact radius {radius:.3g} (no stable contact of that "
+                f"radius was found)")
+    return (f"no contact in the initial state (delta0 = {scene.delta0:g} is below the "
+            f"jump-in)")
 
 
 def warm_up() -> float:

@@ -291,7 +291,7 @@ def scene_mesh(numerics, l0: float, a0_estimate: float, domain: float,
     the one that gives ``numerics.nodes`` nodes.
     """
     if numerics.mesh == "uniform":
-        return uniform_mesh(numerics.nodes if numerics.nodes is not None else 500, domain)
+        return uniform_mesh(numerics.uniform_nodes, domain)
     if band is None:
         band = crack_band(a0_estimate, l0, pull_off_only)
     if numerics.nodes is not None:

@@ -17,7 +17,8 @@ elastic  the quasi-static elastic branch (:func:`sweep.engine.quasistatic.simula
          hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100; "bem" and
          "auto" scenes that are elastic and quasi-static run it (:func:`wants_quasistatic`)
 auto     the cheapest model the scene allows (:func:`choose_model`): the BEM where the mesh that
-         resolves l0 fits the numerics' node count, the crack-front model otherwise
+         resolves l0 fits the numerics' node count, the crack-front model otherwise and beyond
+         the BEM's Tabor range (mu > 100: its reason says so, with its measured difference)
 =======  ======================================================================================
 
 Every simulate function takes ``(scene, numerics=None)`` and returns a :class:`sweep.Result`;
@@ -30,13 +31,13 @@ import math
 import time
 
 from .. import units
-from ..errors import check_choice, check_positive
+from ..errors import NUMERICAL_ERRORS, check_choice, check_positive, is_internal_error
 from ..scene import Numerics, Result, Scene
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem
 from .crack_front import simulate_crack
 from .mesh import scene_mesh
-from .problem import derive
+from .problem import BEM_MU_RANGE, derive
 from .quasistatic import simulate_elastic
 from .tip_following import simulate_tip_following
 
@@ -137,13 +138,34 @@ def bem_nodes_needed(scene, numerics=None) -> int:
 
 def bem_node_budget(numerics) -> int:
     """The most nodes ``numerics`` lets the BEM use: ``nodes`` (uniform) or ``max_nodes``."""
-    return numerics.nodes if numerics.mesh == "uniform" else numerics.max_nodes
+    return numerics.uniform_nodes if numerics.mesh == "uniform" else numerics.max_nodes
 
 
 def choose_model(scene, numerics=None) -> str:
-    """The model "auto" picks: "bem" if its mesh fits the node budget, else "crack"."""
+    """The model "auto" picks: "crack" beyond the BEM's Tabor range (:data:`BEM_MU_RANGE`:
+    the crack-front model is the mu -> infinity limit), else "bem" if its mesh fits the node
+    budget, else "crack"."""
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if not BEM_MU_RANGE[0] <= scene.mu <= BEM_MU_RANGE[1]:
+        return "crack"
     return "bem" if bem_nodes_needed(scene, numerics) <= bem_node_budget(numerics) else "crack"
+
+
+#: the crack-front model's pull-off against the BEM's at the largest mu measured
+#: (results/agreement/agreement.md, ``make agreement``: n = 0.8, k = 0.1, a0 = 3,
+#: rate 10^2.5): (mu, crack / BEM - 1)
+CRACK_VS_BEM = ((10.0, -0.009), (15.0, 0.026))
+
+
+def beyond_bem_note(scene) -> str:
+    """The reason an "auto" row run by the crack-front model beyond the BEM's Tabor range
+    carries: which model ran, why, and its measured difference from the BEM."""
+    lo, hi = BEM_MU_RANGE
+    measured = " and ".join(f"{d * 100:+.1f} % at mu = {mu:g}" for mu, d in CRACK_VS_BEM)
+    return (f"crack-front model (the mu -> infinity limit): mu = {scene.mu:g} is beyond the "
+            f"BEM's range [{lo:g}, {hi:g}]; against the BEM its pull-off differed by "
+            f"{measured} (n = 0.8, k = 0.1, a0 = 3, rate 316; results/agreement), not "
+            f"measured at larger mu")
 
 
 #: model name -> simulate(scene, numerics=None) -> Result
@@ -164,12 +186,23 @@ def simulate_model(scene, model: str = "bem", numerics=None):
     ``model_used`` says which ran."""
     check_choice("model", model, (*MODELS, "auto"))
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    note = ""
     if model in ("bem", "auto") and wants_quasistatic(scene, numerics):
         model = "elastic"
     elif model == "auto":
         model = choose_model(scene, numerics)
-    res = MODELS[model](scene, numerics)
+        if model == "crack" and scene.mu > BEM_MU_RANGE[1]:
+            note = beyond_bem_note(scene)
+    try:
+        res = MODELS[model](scene, numerics)
+    except NUMERICAL_ERRORS as exc:   # a numerical failure is a result; a bug (TypeError, ...)
+        if is_internal_error(exc):     # raises: sweep run records it as status "error"
+            raise
+        res = Result(scene=scene, numerics=numerics, status="failed",
+                     reason=f"{type(exc).__name__}: {exc}")
     res.model_used = model
+    if note:
+        res.reason = f"{res.reason}; {note}" if res.reason else note
     return res
 
 
@@ -194,7 +227,8 @@ def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
     -------
     Result
         ``model_used`` says which model ran; a numerical failure is ``status="failed"``
-        with a reason, never an exception.
+        with a reason, never an exception. A programming error (TypeError, IndexError, ...:
+        :func:`sweep.errors.is_internal_error`) raises: a bug is not a result.
     """
     if not isinstance(scene, Scene):
         raise TypeError("scene must be a sweep.Scene")

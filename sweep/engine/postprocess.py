@@ -69,10 +69,28 @@ def crack_speed_at(t, a, t_star, spacing, window_nodes=3.0, min_points=5):
     return -coef[1] / scale
 
 
+def one_mesh_span(i: int, n: int, remeshed=()) -> tuple[int, int]:
+    """The records ``lo:hi`` computed on the same mesh as record ``i`` of ``n``, where
+    ``remeshed`` lists the first record of each new mesh (a re-meshing of the tip-following
+    mesh lies between records m - 1 and m)."""
+    lo = max((int(m) for m in remeshed if m <= i), default=0)
+    hi = min((int(m) for m in remeshed if m > i), default=n)
+    return lo, hi
+
+
 def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float, scales,
-           advice: str) -> None:
+           advice: str, remeshed=()) -> None:
     """Fill ``res`` from a finished unloading, in place: ``ok`` with the pull-off, the state
     and crack speed at the pull-off instant, or a failure with its reason.
+
+    Quantities read at the pull-off instant never straddle a re-meshing: the parabola through
+    the samples around the load minimum and the crack-speed fit use only the records computed
+    on the mesh of the minimum's record (:func:`one_mesh_span`); the state transfer makes the
+    load and the tip radius step a little (within the continuity guard), and a difference
+    quotient across such a step is no crack speed. Where the minimum is the first or last
+    record of its mesh, the reason says so and how far the load stepped there. An ``ok``
+    result never has a negative crack speed at pull-off (the contact advancing at the load
+    minimum): that is a failure with its reason.
 
     Parameters
     ----------
@@ -86,14 +104,22 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         loading speed for ``rhat_pb``).
     advice : what to change when no equilibrium was found before the pull-off (it depends
         on the mesh that ran).
+    remeshed : indices of the first record on each new mesh (the tip-following mesh), empty
+        for a run on one mesh.
     """
     t, delta, P, a, a_inner = (trajectory[k] for k in ("t", "delta", "P", "a", "a_inner"))
-    i, t_star, P_star = refine_minimum(t, P)
+    i = int(np.argmin(P))
+    lo, hi = one_mesh_span(i, len(P), remeshed)
+    i, t_star, P_star = refine_minimum(t[lo:hi], P[lo:hi])
+    i += lo
     passed = stop_reached(P, a, len(P), i, 0, min_travel)
     if status == STATUS_TIME_BUDGET:
+        num = res.numerics
+        coarser = ("fewer nodes" if num.mesh == "uniform" or num.nodes is not None
+                   else "lower band_resolution")
         res.reason = (f"time budget: {res.numerics.time_budget_s:g} s spent after {len(t) - 1} "
                       f"steps (a = {a[-1]:.4g}, pull-off not reached); give it more "
-                      f"(numerics time_budget_s) or cheaper numerics (preset fast, fewer nodes)")
+                      f"(numerics time_budget_s) or cheaper numerics (preset fast, {coarser})")
         return
     if status == STATUS_DOMAIN:
         res.reason = "contact reached the mesh edge: increase numerics.domain"
@@ -109,14 +135,32 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     if P_star >= 0:
         res.reason = "no tensile load reached"
         return
+    span = slice(lo, hi)
+    speed = float(crack_speed_at(t[span], a[span], t_star, spacing))
+    if speed < 0:
+        res.reason = (f"negative crack speed at the pull-off ({speed:.4g} a_ref/tau0, the "
+                      f"contact advancing at the load minimum P = {P_star:.6g}, a = "
+                      f"{float(np.interp(t_star, t[span], a[span])):.4g}): the state at the "
+                      f"pull-off is not resolved (a finer mesh or a smaller step may resolve "
+                      f"it)")
+        return
     res.status = "ok"
+    notes = []
     if status == STATUS_NEWTON_FAILED:
-        res.reason = "stopped at the jump-off instability after pull-off"
+        notes.append("stopped at the jump-off instability after pull-off")
+    edge = [m for m in (lo, hi) if 0 < m < len(P) and i in (m - 1, m)]
+    if edge:
+        m = edge[0]
+        notes.append(f"load minimum at a re-meshing (the load stepped by "
+                     f"{abs(P[m] - P[m - 1]) / abs(P_star):.2g} |P| there): pull-off and state "
+                     f"read on the {'new' if i == m else 'old'} mesh only")
+    if notes:
+        res.reason = "; ".join(notes)
     res.pull_off = -P_star
     res.t_pulloff = t_star
-    res.delta_pulloff = float(np.interp(t_star, t, delta))
-    res.a_pulloff = float(np.interp(t_star, t, a))
-    res.a_inner_pulloff = float(np.interp(t_star, t, a_inner))
-    res.crack_speed = float(crack_speed_at(t, a, t_star, spacing))
+    res.delta_pulloff = float(np.interp(t_star, t[span], delta[span]))
+    res.a_pulloff = float(np.interp(t_star, t[span], a[span]))
+    res.a_inner_pulloff = float(np.interp(t_star, t[span], a_inner[span]))
+    res.crack_speed = speed
     res.vhat = res.crack_speed / scales.process_zone
     res.rhat_pb = scales.loading_speed

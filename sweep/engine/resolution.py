@@ -20,6 +20,18 @@ RESOLUTION_ERROR_K = 0.3
 CHECK_FRACTION = 0.25
 
 
+def refine_advice(numerics: Numerics) -> str:
+    """How to refine the BEM mesh that ``numerics`` gives (what a failure message advises):
+    the node count of a uniform mesh or of a graded mesh of given nodes, else the band
+    resolution of the graded and tip-following meshes (fine spacing l0 / band_resolution)."""
+    if numerics.mesh == "uniform":
+        return "raise nodes (the uniform spacing is domain / (nodes - 1)) or reduce domain"
+    if numerics.nodes is not None:
+        return ("raise nodes (the graded mesh's fine spacing follows), or leave nodes unset to "
+                "size the mesh from band_resolution")
+    return "raise band_resolution (the fine spacing is the tip zone / band_resolution)"
+
+
 def resolution_error(spacing: float, length: float) -> float:
     """Pull-off error expected from the crack-band resolution: RESOLUTION_ERROR_K
     (spacing/length)^2, with ``spacing`` the fine node spacing and ``length`` the zone it
@@ -35,8 +47,9 @@ def resolution_error(spacing: float, length: float) -> float:
 def coarser(numerics: Numerics) -> Numerics:
     """The numerics of the error indicator's cheaper solve: half the mesh resolution
     (half the band resolution, or half the nodes), no coarse-mesh refusal."""
-    if numerics.nodes is not None:
-        return dataclasses.replace(numerics, nodes=max(numerics.nodes // 2, 20), zone_nodes=0.0)
+    if numerics.nodes is not None or numerics.mesh == "uniform":
+        return dataclasses.replace(numerics, nodes=max(numerics.uniform_nodes // 2, 20),
+                                   zone_nodes=0.0)
     return dataclasses.replace(numerics, band_resolution=max(numerics.band_resolution / 2, 2.0),
                                zone_nodes=0.0)
 
@@ -49,14 +62,14 @@ def check_resolution(res: Result, coarse: Result) -> None:
         res.error_estimate = math.inf
         res.status = "failed"
         res.reason = (f"unresolved: the check on a mesh of half the resolution failed "
-                      f"({coarse.reason}); refine the mesh (band_resolution or nodes)")
+                      f"({coarse.reason}); {refine_advice(res.numerics)}")
         return
     res.error_estimate = abs(res.pull_off - coarse.pull_off) / res.pull_off
     if res.error_estimate > tol:
         res.status = "failed"
         res.reason = (f"unresolved: the pull-off moves by {res.error_estimate:.2g} (> pull_off_rtol "
                       f"= {tol:g}) on a mesh of half the resolution ({coarse.pull_off:.5g} vs "
-                      f"{res.pull_off:.5g}); refine the mesh (band_resolution or nodes)")
+                      f"{res.pull_off:.5g}); {refine_advice(res.numerics)}")
 
 
 def estimate_error(res: Result, length: float, solve: Callable[[Numerics], Result]) -> None:

@@ -43,7 +43,7 @@ from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER
 from ..kernels.interface import lj_traction
 
 from ..scene import Numerics, Result, Scene
-from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, unload_chunk
+from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, no_contact_reason, unload_chunk
 from .initial import ElasticSolver, relaxed_state
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Refused, derive, jkr_radius, material_of, prepare
@@ -498,7 +498,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     res.spacing, res.domain_used = pb.mesh.spacing, pb.mesh.domain
     res.prony_terms, res.prony_error = int(pb.prony_weights.size), pb.prony_error
     if a_init <= 0.0:
-        res.reason = "no contact in the initial state (delta0 below the jump-in)"
+        res.reason = no_contact_reason(scene, a_init)
         return res
     if a_init >= pb.mesh.r[-2]:
         res.reason = f"initial contact radius {a_init:.4g} reaches the mesh edge"
@@ -506,7 +506,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
 
     run = UnloadingState.start(pb, h_init, delta0, el.cache, el.stats.copy())
     meshes, nodes = 1, pb.mesh.nodes
-    remeshed_at = []
+    remeshed_at, marks = [], []   # first records on new meshes: to check, and all of them
     rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
     while True:
         probing, n_before, t_chunk = run.n <= 1, run.n, time.perf_counter()
@@ -536,6 +536,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                 return res
             transfer(run, pb, new)
             remeshed_at.append(run.n)
+            marks.append(run.n)
             pb, meshes, nodes = new, meshes + 1, max(nodes, new.mesh.nodes)
         elif status == STATUS_STEP_LIMIT and run.n <= numerics.max_steps:
             pass
@@ -558,7 +559,8 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         res.reason = f"more than {MAX_MESHES} meshes (a = {a[-1]:.4g})"
         return res
     finish(res, status, res.trajectory, pb.mesh.spacing,
-           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING)
+           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING,
+           remeshed=marks)
     if res.ok:
         note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
         res.reason = f"{res.reason}; {note}" if res.reason else note

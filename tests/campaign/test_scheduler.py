@@ -106,15 +106,52 @@ def test_interrupted_sweep_resumes_without_rerunning(tmp_path):
     assert sorted(load(out).scene_id) == sorted(sid for sid, _ in c.tasks())
 
 
-def test_exception_in_a_scene_is_a_failed_row(tmp_path):
+def test_exception_in_a_scene_is_an_internal_error(tmp_path):
+    """A bug is not a result: an exception escaping simulate is status "error" (not counted
+    as failed), logged with its traceback beside the results; the other scenes are stored."""
     out = tmp_path / "r.h5"
     rep = run_sweep(cfg(), jobs=2, out=out, simulate=raising_simulate, progress="none")
     df = load(out)
-    assert rep.failed == 2 and len(df) == 4
+    assert (rep.failed, rep.errors, len(df)) == (0, 2, 4)
     bad = df[df.n > 1]
-    assert (bad.status == "failed").all()
-    assert all(r == "exception ZeroDivisionError: boom second line" for r in bad.reason)
+    assert (bad.status == "error").all() and (df[df.n < 1].status == "ok").all()
+    assert all(r == "internal error ZeroDivisionError: boom second line" for r in bad.reason)
     assert (bad.wall_s > 0).all()
+    assert "_traceback" not in df.columns
+    assert sorted(rep.error_ids) == sorted(bad.scene_id)
+    assert rep.error_log == tmp_path / "r.h5.errors.log"
+    log = rep.error_log.read_text()
+    for sid in bad.scene_id:
+        assert f"scene {sid} model bem" in log
+    assert log.count("Traceback (most recent call last)") == 2
+    assert "ZeroDivisionError: boom" in log and "raising_simulate" in log
+    assert rep.error_line() == f"2 scenes hit an internal error (a bug, not a result; " \
+                               f"status \"error\"), see {rep.error_log}"
+
+
+def typeerror_simulate(scene, numerics):
+    """The real front door, with a bug in one scene's path (n > 1 at rate 100)."""
+    if scene.n > 1 and scene.rate > 50:
+        return None + 1
+    return fake_simulate(scene, numerics)
+
+
+def test_typeerror_in_one_scene_sequential(tmp_path):
+    out = tmp_path / "r.h5"
+    rep = run_sweep(cfg(), jobs=1, out=out, simulate=typeerror_simulate, progress="none")
+    df = load(out).set_index("n")
+    assert (rep.ran, rep.failed, rep.errors) == (4, 0, 1)
+    err = df[df.status == "error"]
+    assert len(err) == 1 and err.reason.iloc[0].startswith("internal error TypeError: ")
+    assert (df[df.status == "ok"].pull_off > 0).all() and (df.status == "ok").sum() == 3
+    assert "TypeError" in (tmp_path / "r.h5.errors.log").read_text()
+
+
+def test_no_error_log_without_errors(tmp_path):
+    rep = run_sweep(cfg(), jobs=1, out=tmp_path / "r.h5", simulate=fake_simulate,
+                    progress="none")
+    assert rep.errors == 0 and rep.error_log is None and rep.error_line() == ""
+    assert not (tmp_path / "r.h5.errors.log").exists()
 
 
 def test_one_thread_per_worker(tmp_path, monkeypatch):
@@ -348,3 +385,16 @@ def test_dispatch_chunks_keep_start_groups_together_and_balance():
     # fewer chunks than scenes: small groups travel together
     assert len(chunks) < len(todo)
     assert scheduler.dispatch_chunks([], num, 2) == []
+
+
+def test_resume_runs_the_scenes_that_hit_an_internal_error_again(tmp_path):
+    """After the bug is fixed, the same command reruns only the "error" scenes; their rows
+    are replaced, the log of the first run is kept."""
+    out = tmp_path / "r.h5"
+    first = run_sweep(cfg(), jobs=1, out=out, simulate=raising_simulate, progress="none")
+    assert first.errors == 2
+    again = run_sweep(cfg(), jobs=1, out=out, simulate=fake_simulate, progress="none")
+    assert (again.ran, again.skipped, again.errors) == (2, 2, 0)
+    df = load(out)
+    assert len(df) == 4 and set(df.status) <= {"ok", "failed"}
+    assert (tmp_path / "r.h5.errors.log").read_text().count("ZeroDivisionError: boom") == 2

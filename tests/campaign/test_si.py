@@ -233,3 +233,18 @@ def test_shipped_pdms_config_runs_and_matches_make_pdms(tmp_path):
         ends = d.si_speed.to_numpy()[[0, -1]] * 1e6
         want = pdms.model_pull_off(name, ends)["pull_off_mN"]
         assert d.pull_off_N.to_numpy()[[0, -1]] * 1e3 == pytest.approx(want, rel=1e-5)
+
+
+def test_angstrom_h0_runs_the_crack_front_model_in_a_sweep_config():
+    """Issue 21: PDMS with a physical h0 = 0.5 nm gives mu = 6340; the config was refused
+    ("mu must be in [0.01, 1000]"); with model auto it is the crack-front model's scene."""
+    from sweep.campaign.config import config_from_dict
+    from sweep.engine.models import simulate
+
+    cfg = config_from_dict({"name": "p", "units": "si", "grid": {
+        "model": "auto", "R": 5.19e-3, "E0": 1.458e6, "Einf": 3.089e9, "nu": 0.5, "n": 0.2207,
+        "tau0": 0.01876, "dg": 0.1523, "h0": 0.5e-9, "preload": 1.5e-3, "speed": [1e-4]}})
+    [(_, scene)] = cfg.tasks()
+    assert 6000 < scene.mu < 7000
+    res = simulate(scene, cfg.numerics)
+    assert res.model_used == "crack" and res.ok and "beyond the BEM's range" in res.reason

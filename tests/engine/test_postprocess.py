@@ -21,3 +21,80 @@ def test_a_jump_of_the_load_gives_the_sampled_minimum_not_a_wild_vertex():
     P = np.array([-3.8870, -3.8880, -3.8890, -2.7700, -2.7690])
     i, ts, Ps = refine_minimum(t, P)
     assert (i, ts, Ps) == (2, 2.0, -3.8890)
+
+
+# -- quantities at the pull-off never straddle a re-meshing (issue 21) ----------------------
+from types import SimpleNamespace  # noqa: E402
+
+from sweep.engine.postprocess import finish, one_mesh_span  # noqa: E402
+from sweep.kernels.solve import STATUS_DONE  # noqa: E402
+from sweep.scene import Numerics, Result, Scene  # noqa: E402
+
+SPACING = 3e-4
+SCALES = SimpleNamespace(process_zone=0.01, loading_speed=1.0)
+
+
+def remeshed_trajectory(m=40, n=80, dP=-0.11, da=0.0029, speed=3.0e4, dt=4.8e-9):
+    """A trajectory like the issue's scene (n=1.916, mu=18.98, sls, balanced): the crack tip
+    recedes at ``speed``; the load falls until record ``m``, where the tip-following mesh
+    changes, the load steps by ``dP`` (-0.11: 0.11 % |P|) and the tip radius by ``da``
+    (+2.9e-3, 10 node spacings) and then rises: the load minimum is the first record of the
+    new mesh."""
+    k = np.arange(n)
+    t = k * dt
+    a = 2.62 - speed * t + np.where(k < m, 0.0, da)
+    P = np.where(k < m, -95.2712 + 3e-6 * (m - 1 - k) ** 2,
+                 -95.2712 + dP + 3e-4 * (k - m) + 1e-6 * (k - m) ** 2)
+    return {"t": t, "delta": -t, "P": P, "a": a, "a_inner": a - 0.1}
+
+
+def run_finish(traj, remeshed=()):
+    res = Result(scene=Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0),
+                 numerics=Numerics.preset("balanced"))
+    finish(res, STATUS_DONE, traj, SPACING, 0.0, SCALES, advice="refine", remeshed=remeshed)
+    return res
+
+
+def test_one_mesh_span():
+    assert one_mesh_span(5, 20) == (0, 20)
+    assert one_mesh_span(5, 20, [3, 9, 15]) == (3, 9)
+    assert one_mesh_span(9, 20, [3, 9, 15]) == (9, 15)
+    assert one_mesh_span(8, 20, [3, 9, 15]) == (3, 9)
+    assert one_mesh_span(16, 20, [3, 9, 15]) == (15, 20)
+
+
+def test_load_minimum_on_a_remeshing_is_read_on_one_mesh():
+    traj = remeshed_trajectory()
+    m = 40
+    assert int(np.argmin(traj["P"])) == m
+    # read across the re-meshing (as before the fix): the crack-speed fit takes the step of
+    # the state transfer for motion, the contact "advances"; the guard makes that a failure
+    across = run_finish(traj)
+    assert across.status == "failed" and across.reason.startswith("negative crack speed")
+    # read on the new mesh only: the sampled minimum, the speed of the receding tip
+    res = run_finish(traj, remeshed=[10, m, 70])
+    assert res.ok and res.pull_off == pytest.approx(95.3812, abs=1e-12)
+    assert res.t_pulloff == traj["t"][m] and res.a_pulloff == traj["a"][m]
+    assert res.crack_speed == pytest.approx(3.0e4, rel=1e-6)
+    assert "load minimum at a re-meshing" in res.reason and "new mesh only" in res.reason
+    assert "stepped by 0.0012 |P|" in res.reason
+
+
+def test_remeshing_away_from_the_minimum_changes_nothing():
+    """A re-meshing far from the minimum (outside the parabola's and the fit's samples)
+    leaves every quantity bitwise as on one mesh."""
+    traj = remeshed_trajectory(m=40, da=0.0, dP=0.0)
+    P = traj["P"]
+    P[:] = (np.arange(80) - 50.3) ** 2 * 1e-3 - 95.0        # a smooth minimum at record 50
+    one, split = run_finish(traj), run_finish(traj, remeshed=[20, 70])
+    assert one.ok and split.ok and one.reason == split.reason == ""
+    for name in ("pull_off", "t_pulloff", "a_pulloff", "delta_pulloff", "crack_speed"):
+        assert getattr(one, name) == getattr(split, name)
+
+
+def test_ok_result_never_has_a_negative_crack_speed():
+    traj = remeshed_trajectory(da=0.0)
+    traj["a"] = 2.0 + 3.0e4 * traj["t"]                    # the contact advancing
+    res = run_finish(traj)
+    assert res.status == "failed" and np.isnan(res.pull_off)
+    assert res.reason.startswith("negative crack speed at the pull-off (-3e+04 a_ref/tau0")

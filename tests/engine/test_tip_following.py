@@ -228,3 +228,17 @@ def test_a_scene_beyond_max_steps_is_refused_before_it_starts():
                                     Numerics.preset("balanced"))
     assert res.status == "failed" and res.reason.startswith("too many steps")
     assert res.steps == 0 and "max_steps = 200000" in res.reason
+
+
+def test_pull_off_on_a_remeshing_is_read_on_one_mesh():
+    """Issue 21: this scene's load minimum falls exactly on a re-meshing (the load steps from
+    -95.271 to -95.380 and the tip radius from 2.61618 to 2.61909 there). Read across it, the
+    crack speed was -9562 on an ok row; read on the new mesh only it is the receding tip's
+    (the fast preset, whose minimum lies inside one mesh, gives 2.9e4)."""
+    sc = Scene(n=1.916369, k=0.009105, mu=18.975121, a0=2.880697, rate=80813.747088,
+               material="sls")
+    res = models.simulate(sc, Numerics.preset("balanced", time_budget_s=0.0))
+    assert res.model_used == "bem" and res.ok, res.reason
+    assert "load minimum at a re-meshing" in res.reason and "tip-following mesh" in res.reason
+    assert res.crack_speed == pytest.approx(3.07e4, rel=0.01)
+    assert res.pull_off == pytest.approx(95.380, rel=1e-4)
