@@ -81,6 +81,7 @@ from scipy.stats import qmc
 
 from ..campaign.config import UniqueKeyLoader
 from ..campaign.si import SI_AXES, SIScene, run_si
+from ..campaign.store import to_jsonable
 from ..engine import bem
 from ..errors import InputError, check_choice, check_int, check_range
 from ..scene import Numerics
@@ -844,23 +845,9 @@ def calibrate(cal: Calibration, jobs: int | None = None,
 
 
 # ----------------------------------------------------------------------------- output
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, np.generic):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
-
-
 def to_json(result: dict, indent: int | None = 1) -> str:
     """``result`` as JSON text (NaN and inf as null)."""
-    return json.dumps(_jsonable(result), indent=indent)
+    return json.dumps(to_jsonable(result), indent=indent)
 
 
 def summary_lines(result: dict) -> list:
