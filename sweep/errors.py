@@ -118,3 +118,16 @@ def is_internal_error(exc: BaseException) -> bool:
     if isinstance(exc, _BUG_RUNTIME_ERRORS):
         return True
     return not isinstance(exc, NUMERICAL_ERRORS)
+
+
+#: how a failed result's reason begins when the scene has no answer for a physical reason
+#: (not a resolution, node-count or budget limit that another model could lift): the
+#: relaxed initial state has no contact of the asked radius, or the contact of that radius
+#: is not stable under fixed grip (the crack-front model below about 0.5 a_ref)
+PHYSICAL_REFUSALS = ("no contact in the initial state", "no stable contact")
+
+
+def is_physical_refusal(reason: str) -> bool:
+    """Whether a failed result's ``reason`` is a physical refusal (:data:`PHYSICAL_REFUSALS`):
+    the scene's physics has no answer, as opposed to a numerical failure."""
+    return any(reason.startswith(p) for p in PHYSICAL_REFUSALS)
