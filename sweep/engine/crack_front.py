@@ -64,7 +64,17 @@ from ..theory import (A_PULL_OFF_FORCE, jkr_contact_radius, jkr_indentation, pb_
 
 __all__ = ["GentSchultzLaw", "PerssonBrenerLaw", "CrackFrontSolution", "unload",
            "energy_release_rate", "crack_front_load", "pb_law_for_scene", "simulate_crack",
-           "constant_gamma_pull_off"]
+           "constant_gamma_pull_off", "FIXED_GRIP_A_MIN"]
+
+#: 1/k - 1 at or below which the crack-front model is the elastic JKR contact at the constant
+#: Gamma = dg / sqrt(k), the geometric middle of Gamma(v) in [dg, dg/k]: its pull-off is then
+#: within 1/sqrt(k) - 1 (at most 2.5 %, its ``error_estimate``) of any rate's, while the
+#: integration of a law that steep stalls (k = 0.998 at rate 1e9) or steps over the load
+#: minimum (k = 0.98 at rate 1e-4, a0 = 15: 1.452 for at least 1.5)
+NEARLY_ELASTIC = 0.05
+#: smallest initial contact radius (a_ref) of the crack-front model: below it a JKR contact
+#: is not stable under fixed grip (the model's physical limit, not a numerical one)
+FIXED_GRIP_A_MIN = 0.5
 
 
 # ============================================================================ elastic field
@@ -277,14 +287,18 @@ def initial_state(a0=None, delta0=None):
         raise InputError("a0/delta0: give exactly one of a0 (initial contact radius) "
                          "and delta0 (initial indentation)")
     if a0 is not None:
-        a0 = check_range("a0", a0, lo=0.5)
+        a0 = check_range("a0", a0, lo=FIXED_GRIP_A_MIN)
         return a0, float(jkr_indentation(a0))
     delta0 = check_range("delta0", delta0, lo=-0.75)
     return float(jkr_contact_radius(indentation=delta0)), delta0
 
 
+class _OverBudget(RuntimeError):
+    """The integration of :func:`unload` ran over its wall-time budget."""
+
+
 def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
-           a_end=0.02) -> CrackFrontSolution:
+           a_end=0.02, time_budget_s=0.0) -> CrackFrontSolution:
     r"""Unload a relaxed JKR contact at constant speed with the crack-front model.
 
     Parameters
@@ -305,6 +319,8 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
         Relative tolerance of the Radau integrator (absolute tolerance ``rtol * a0`` on a).
     a_end : float
         Fraction of ``a0`` at which a "separation" run stops, in (0, 1).
+    time_budget_s : float
+        Wall-time budget of the integration, s (0: none); a run over it is ``failed``.
 
     Returns
     -------
@@ -327,7 +343,12 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     def delta_of(t):
         return delta0 + ddot * t
 
+    deadline = time.perf_counter() + time_budget_s if time_budget_s > 0 else math.inf
+
     def rhs(t, y):
+        if time.perf_counter() > deadline:
+            raise _OverBudget(f"time budget: {time_budget_s:g} s spent in the integrator at "
+                              f"a = {y[0]:.4g} (numerics time_budget_s)")
         a = max(y[0], 1e-300)
         g = (a * a - delta_of(t)) ** 2 / (2.0 * a)
         v, _ = law.speed(g)
@@ -345,8 +366,13 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
         a = y[0]
         return 2.0 * rhs(t, y)[0] * (delta_of(t) - a * a) + 2.0 * a * ddot
 
-    dPdt.terminal = stop == "pulloff"
-    dPdt.direction = 1.0
+    def tensile_minimum(t, y):
+        # dP/dt where the load is tensile, -1 where it is compressive: a load minimum in
+        # compression (a transient of a nearly elastic law) is not the pull-off
+        return dPdt(t, y) if crack_front_load(y[0], delta_of(t)) < 0.0 else -1.0
+
+    tensile_minimum.terminal = stop == "pulloff"
+    tensile_minimum.direction = 1.0
 
     def vanished(t, y):
         return y[0] - a_end * a0
@@ -358,8 +384,11 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     span = (abs(delta0) + 2.0 * a0 * a0 + 10.0) / abs(ddot)
     try:
         out = solve_ivp(rhs, (t1, t1 + span), [a0], method="Radau", jac=jac,
-                        events=[dPdt, vanished], rtol=rtol, atol=rtol * a0,
+                        events=[tensile_minimum, vanished], rtol=rtol, atol=rtol * a0,
                         dense_output=False, first_step=min(1e-6 * span, 1e-3 / max(rate, 1.0)))
+    except _OverBudget as exc:
+        sol.reason = str(exc)
+        return sol
     except NUMERICAL_ERRORS as exc:   # reported; a bug (TypeError, ...) raises
         if is_internal_error(exc):
             raise
@@ -406,10 +435,17 @@ def simulate_crack(scene, numerics=None):
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t_start = time.perf_counter()
     res = Result(scene=scene, numerics=numerics)
+    if scene.a0 is not None and scene.a0 < FIXED_GRIP_A_MIN:
+        res.reason = (f"no stable contact of radius a0 = {scene.a0:g}: below "
+                      f"{FIXED_GRIP_A_MIN:g} a_ref a JKR contact is not stable under fixed grip "
+                      f"(the crack-front model, the mu -> infinity limit, starts at or above it)")
+        return res
+    if 1.0 / scene.k - 1.0 <= NEARLY_ELASTIC * (1.0 + 1e-12):
+        return _elastic_crack(scene, res, t_start)
     try:
         law = pb_law_for_scene(scene.n, scene.k, scene.mu, scene.material)
         s = unload(law, rate=scene.rate, mu=scene.mu, a0=scene.a0, delta0=scene.delta0,
-                   stop=scene.stop)
+                   stop=scene.stop, time_budget_s=numerics.time_budget_s)
     except NUMERICAL_ERRORS as exc:   # reported; a bug (TypeError, ...) raises
         if is_internal_error(exc):
             raise
@@ -429,5 +465,31 @@ def simulate_crack(scene, numerics=None):
     if tr:
         res.trajectory = {"t": tr["t"], "delta": tr["delta"], "P": tr["P"], "a": tr["a"],
                           "a_inner": np.full(tr["a"].shape, np.nan)}
+    res.wall_s = time.perf_counter() - t_start
+    return res
+
+
+def _elastic_crack(scene, res, t_start):
+    """A (nearly) elastic scene, 1/k - 1 <= :data:`NEARLY_ELASTIC`, with the crack-front
+    model: the JKR contact opened at the constant Gamma = c dg, c = 1/sqrt(k), under fixed
+    grip (:func:`constant_gamma_pull_off`); the crack speed at the pull-off radius follows
+    from the indentation speed, v = rate h0 / (d delta/d a) (none where a0 is below the
+    load-control pull-off radius: there the tension is largest at the start)."""
+    c = 1.0 / math.sqrt(scene.k)
+    a0 = scene.a0 if scene.a0 is not None else float(jkr_contact_radius(indentation=scene.delta0))
+    a_load = A_PULL_OFF_FORCE * c ** (1.0 / 3.0)        # the load-control pull-off radius
+    a_po = a_load if a0 >= a_load else a0
+    res.status, res.pull_off = "ok", constant_gamma_pull_off(a0, c)
+    res.a0_result, res.delta0_result = a0, float(jkr_indentation(a0))
+    res.a_pulloff = a_po
+    res.delta_pulloff = a_po * a_po - math.sqrt(2.0 * c * a_po)    # g(a, delta) = c
+    speed = scene.rate * units.h0_hat(scene.mu)
+    res.t_pulloff = max(res.delta0_result - res.delta_pulloff, 0.0) / speed
+    slope = 2.0 * a_po - math.sqrt(c / (2.0 * a_po))                # d delta / d a at g = c
+    res.crack_speed = speed / slope if a0 >= a_load else math.nan
+    res.vhat = float(units.vhat_from_crack_speed(res.crack_speed, scene.mu))
+    res.rhat_pb = float(units.rhat_pb(scene.rate, scene.mu))
+    res.prony_terms, res.prony_error = 0, 0.0
+    res.error_estimate = c - 1.0            # Gamma(v) within [dg, dg/k]: |c k^(-1/2) - 1|
     res.wall_s = time.perf_counter() - t_start
     return res

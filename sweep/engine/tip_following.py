@@ -305,9 +305,10 @@ def branch_state(scene: Scene, band_resolution: float = 16.0, domain: float | No
                 return None
     _, d_up, ok_up = br.solve(1.001 * a0, h_b, d)
     if ok_up and d_up < d:
-        raise Refused(f"a0 = {a0:g} lies below the fold of the relaxed elastic branch at mu = "
-                      f"{scene.mu:g} (the indentation decreases as the radius grows): no "
-                      f"stable relaxed state there; give a larger a0 (JKR: a0 > 0.5) or delta0")
+        raise Refused(f"no stable contact of radius a0 = {a0:g}: it lies below the fold of "
+                      f"the relaxed elastic branch at mu = {scene.mu:g} (the indentation "
+                      f"decreases as the radius grows); give a larger a0 (JKR: a0 > 0.5) or "
+                      f"delta0")
     return a0 * br.x, h_b, d
 
 
@@ -437,7 +438,7 @@ def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
     numerics : Numerics, optional
         Default ``Numerics.preset("balanced")``; the fine spacing is the tip zone / band_resolution
         (or, with ``nodes`` set, the mesh of that many nodes), the rest as for
-        :func:`sweep.engine.bem.simulate` (steps, tolerances, time budget, error indicator).
+        :func:`sweep.engine.bem.simulate` (steps, tolerances, time budget, error estimate).
     ahead, behind : float
         The window, in tip zones (see :func:`tip_window`).
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from sweep import Scene
+from sweep import Numerics, Scene
 from sweep.engine.crack_front import (
     GentSchultzLaw, constant_gamma_pull_off, crack_front_load, energy_release_rate,
     pb_law_for_scene, simulate_crack, unload,
@@ -129,3 +129,35 @@ def test_bad_input():
         unload(GentSchultzLaw(1.0, XI), rate=1.0, mu=3.0)
     with pytest.raises(InputError, match="v0 must be > 0"):
         GentSchultzLaw(0.0, XI)
+
+
+# -- the extremes: never an ok row with a compressive "pull-off" (issue 21 item 5) ------------
+@pytest.mark.parametrize("kw", [
+    dict(n=0.05, k=0.999, mu=10.0, a0=15.0, rate=1e-4),    # was ok with pull-off -1203
+    dict(n=2.5, k=0.999, mu=100.0, a0=15.0, rate=1e9),     # was ok with pull-off -4336
+    dict(n=0.05, k=0.98, mu=10.0, a0=15.0, rate=1e-4),     # stepped over the minimum: 1.452
+    dict(n=0.05, k=0.9, mu=10.0, a0=15.0, rate=1e9),
+    dict(n=2.5, k=0.9, mu=100.0, a0=15.0, rate=1e-4),
+])
+def test_pull_off_is_tensile_and_within_the_jkr_bounds(kw):
+    """From a large contact the pull-off lies between the JKR values of the relaxed and the
+    glassy work of adhesion, 1.5 and 1.5/k (to the event's 1e-3); a nearly elastic law
+    (1/k - 1 <= NEARLY_ELASTIC) is the closed form at Gamma = dg/sqrt(k), whose error
+    estimate is its bound, 1/sqrt(k) - 1."""
+    from sweep.engine.crack_front import NEARLY_ELASTIC
+
+    res = simulate_crack(Scene(**kw), Numerics.preset("balanced", time_budget_s=30.0))
+    assert res.ok, res.reason
+    assert 1.5 * (1 - 1e-3) <= res.pull_off <= 1.5 / kw["k"] * (1 + 1e-3), res.pull_off
+    if 1 / kw["k"] - 1 <= NEARLY_ELASTIC:
+        assert res.pull_off == pytest.approx(1.5 / math.sqrt(kw["k"]), rel=1e-12)
+        assert res.error_estimate == pytest.approx(1 / math.sqrt(kw["k"]) - 1, rel=1e-12)
+
+
+def test_the_integrator_keeps_the_time_budget():
+    from sweep.engine.crack_front import PerssonBrenerLaw, unload
+    from sweep.units import l0_hat
+
+    law = PerssonBrenerLaw(2.5, 0.93, l0_hat(100.0), "mpl")
+    sol = unload(law, rate=1e9, mu=100.0, a0=3.0, time_budget_s=1e-6)
+    assert sol.status == "failed" and sol.reason.startswith("time budget")
