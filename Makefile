@@ -11,7 +11,8 @@ export NUMBA_NUM_THREADS ?= 1
 
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
         tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem \
-        agreement agreement-high-mu extremes tip-convergence elastic-table calibrate-demo
+        agreement agreement-high-mu extremes tip-convergence elastic-table calibrate-demo \
+        model-errors error-coverage random-sample
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
@@ -29,6 +30,9 @@ help:
 	@echo "make tip-convergence - tip-following BEM: pull-off vs spacing and window, mu = 30, 100 (k = 0.5) and 30 (k = 0.1, rate 10^2.5)"
 	@echo "make elastic-table - elastic pull-off vs mu (0.01 ... 100), quasi-static branch"
 	@echo "make calibrate-demo - fit a synthetic PDMS-like pull-off curve (results/calibrate/)"
+	@echo "make model-errors - crack-front model and PB estimate vs the BEM over mu (the table auto reads)"
+	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem (results/random/)"
+	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -159,6 +163,24 @@ agreement-high-mu: $(STAMP)
 # written by the command in the header of configs/calibrate/pdms-lens.yaml
 calibrate-demo: $(STAMP)
 	$(BIN)/sweep calibrate configs/calibrate/pdms-lens.yaml --out results/calibrate
+
+# issue 21: the crack-front model's and the PB estimate's error against the BEM at each mu,
+# written into the package (sweep/engine/model_errors.json) for the model chooser
+model-errors: $(STAMP)
+	$(BIN)/python -m sweep.bench.model_errors
+
+# issue 21: coverage and looseness of the per-row error estimate against a much finer run,
+# per preset, on a seeded random sample (QUICK=1: 6 scenes)
+error-coverage: $(STAMP)
+	$(BIN)/python -m sweep.bench.error_coverage $(if $(filter 1,$(QUICK)),--scenes 6 --out results/quick/error_coverage)
+
+# issue 21: a random sample across the declared ranges through `sweep run`, model auto and the
+# default bem (configs/random/, written by `python -m sweep.bench.random_sample configs`);
+# the summary counts ok / physically refused / failed / internal errors and draws the map
+random-sample: $(STAMP)
+	-$(BIN)/sweep run configs/random/auto.yaml -j 2
+	-$(BIN)/sweep run configs/random/bem.yaml -j 2
+	$(BIN)/python -m sweep.bench.random_sample summary
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache .coverage

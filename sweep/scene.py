@@ -128,9 +128,12 @@ class Scene:
                          choices=MATERIALS, order=0)
     stop: str = axis("pulloff", help="stop after the pull-off, or follow the curve to "
                      "separation", choices=STOPS, order=1, plot_group=False)
-    model: str = axis("bem", help="model that runs the scene (sweep.engine.models): the BEM, the "
-                      "crack-front model, the closed-form PB estimate, the quasi-static "
-                      "elastic branch, or auto",
+    model: str = axis("bem", help="model that runs the scene (sweep.engine.models) and the "
+                      "ranges it accepts: bem, the BEM (mu 0.01-100); crack, the crack-front "
+                      "model, the mu -> infinity limit (any mu, a0 >= 0.5); pb, the "
+                      "closed-form PB estimate (every scene); elastic, the quasi-static "
+                      "elastic branch (k = 1, mu 0.01-100); auto, the cheapest whose measured "
+                      "error meets pull_off_rtol (every scene)",
                       choices=MODEL_NAMES, order=-1)
 
     def __post_init__(self):
@@ -260,13 +263,13 @@ class Numerics:
         Largest graded mesh accepted; a scene whose crack band needs more nodes (large a0
         at a large Tabor parameter) is refused with the count it needs.
     pull_off_rtol : float
-        Tolerance of the error indicator ``Result.error_estimate``: the pull-off error
-        expected from the crack-band resolution, 0.3 (spacing/l0)^2 (a bound of the measured
-        convergence); where it exceeds a quarter of this tolerance the scene is solved a
-        second time on a mesh of half the resolution (half the band resolution, or half the
-        nodes) and the pull-off change is the indicator. A result whose indicator exceeds
-        the tolerance is not ``ok`` (``failed``, reason "unresolved: ..."). 0 skips the
-        indicator (then ``error_estimate`` is NaN).
+        Tolerance of the error estimate ``Result.error_estimate``: the pull-off change
+        against a solve at half the resolution in space and time (half the band resolution
+        or nodes, twice the step; sqrt 2 where that mesh cannot hold the initial contact)
+        over (factor - 1), plus the Prony fit's error (:mod:`sweep.engine.resolution`). A
+        result whose estimate exceeds the tolerance is not ``ok`` (``failed``, reason
+        "unresolved: ..."); "auto" also runs a cheaper model where its measured error meets
+        it. 0 skips the estimate and its second solve (then ``error_estimate`` is NaN).
     domain : float or None
         Mesh radius in a_ref units. ``None`` (default) chooses it from the scene: large
         enough that the gap at the mesh edge is ``tail_gap`` h0 at the start of unloading,
@@ -467,15 +470,19 @@ class Result:
     nodes_used : int
         Number of mesh nodes.
     error_estimate : float
-        Relative pull-off error indicator: 0.3 (spacing/l0)^2, or, where that is not well
-        below ``Numerics.pull_off_rtol``, |pull-off change| / pull-off against a solve on a
-        mesh of half the resolution (about three times this solve's error for a
-        second-order discretization). NaN when not checked.
+        Estimated relative pull-off error: for the BEM the change against a solve at half
+        the resolution in space and time over (factor - 1) plus the Prony fit's error (about
+        three times the error of a second-order discretization; :mod:`sweep.engine.resolution`),
+        for the crack-front model and the PB estimate their measured difference from the BEM
+        at the scene's mu (:func:`sweep.engine.models.measured_error`). NaN when not estimated.
     wall_s : float
         Wall-clock time of the run in seconds.
     model_used : str
         The model that ran ("bem", "crack", "pb"; "" when a model's simulate function was
         called directly rather than through :func:`sweep.engine.models.simulate`).
+    model_reason : str
+        Why that model ran, in a few words (the scene asked for it; or what "auto" weighed:
+        e.g. "auto: crack-front model, measured error 0.4 % <= pull_off_rtol 1 % at mu = 40").
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
     """
@@ -506,6 +513,7 @@ class Result:
     domain_used: float = math.nan
     wall_s: float = 0.0
     model_used: str = ""
+    model_reason: str = ""
     trajectory: dict = field(default_factory=dict)
 
     @property

@@ -39,3 +39,11 @@ def test_the_kernels_folder_is_installed_inside_sweep():
 def test_the_installed_kernels_are_the_source_folder():
     import sweep.kernels.solve
     assert Path(sweep.kernels.solve.__file__).resolve() == ROOT / "kernels" / "solve.py"
+
+
+def test_the_package_data_is_declared():
+    """Data files inside the package (the model chooser's measured errors) are installed."""
+    text = (ROOT / "pyproject.toml").read_text()
+    for path in (ROOT / "sweep").rglob("*.json"):
+        pkg = ".".join(path.parent.relative_to(ROOT).parts)
+        assert re.search(rf'^"{re.escape(pkg)}"\s*=\s*\[[^\]]*"{path.name}"', text, re.M), path

@@ -50,6 +50,7 @@ from ..kernels import solve as ks
 from ..kernels.interface import lj_traction_and_stiffness
 from ..kernels.jacobian import ZONE_IN, ZONE_OUT, crack_tip_index
 from ..scene import PRESETS, Numerics, Scene
+from .error_coverage import sample
 from .plain_solver import plain_unload
 from .tradeoff import (REFERENCE_OVERRIDES, REFERENCES, TRADEOFF_SCENES, VS_NUMPY_SCENES,
                        compute_reference, existing, load_references, reference_for,
@@ -884,6 +885,21 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
     return out
 
 
+def bench_model_choice(scenes: int = 2000, seed: int = 0) -> dict:
+    """Wall time of "auto"'s choice of a model (:func:`sweep.engine.models.model_choice`),
+    per scene, over a seeded sample across the declared ranges with the balanced preset
+    (every process cache warm: the second pass is timed)."""
+    num = Numerics.preset("balanced")
+    batch = [Scene(**d, model="auto") for d in sample(scenes, seed, bem_range=False)]
+    for sc in batch:
+        models.model_choice(sc, num)
+    t0 = time.perf_counter()
+    chosen = [models.model_choice(sc, num).model for sc in batch]
+    wall = time.perf_counter() - t0
+    return {"scenes": scenes, "ms_per_scene": 1e3 * wall / scenes,
+            "chosen": {m: chosen.count(m) for m in sorted(set(chosen))}}
+
+
 def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     """Every figure of ``results/bench.json`` (issue 9, item 7)."""
     plan = plan or BenchPlan()
@@ -918,6 +934,10 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     progress(f"scale: {scale['scenes']} scenes in about {scale['minutes_estimate']:.1f} min "
              f"(cold upper bound {scale['minutes_sample_rate']:.1f}; sample of "
              f"{scale['sample']}: {scale['status_counts']})")
+    choice = bench_model_choice()
+    report["model_choice_ms"] = choice["ms_per_scene"]
+    report["model_choice_detail"] = choice
+    progress(f"model_choice_ms: {choice['ms_per_scene']:.3f} ({choice['chosen']})")
     vs = bench_vs_numpy(plan, progress)
     report["vs_numpy"] = {name: {label: {"engine_s": e["wall_s"], "engine_err": e["err_pull_off"],
                                          "numpy_s": (e["plain_equal_or_worse"] or {}).get("wall_s"),
@@ -951,6 +971,9 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
                          "(set-up cached) cost scaled to the grid, plus one relaxed start "
                          "per start group and worker, over the sample's parallel speed-up; "
                          "scale_detail.minutes_sample_rate is the cold upper bound",
+        "model_choice_ms": "milliseconds per scene of model_choice (what model auto runs), "
+                           "balanced preset, over a seeded sample of 2000 scenes across the "
+                           "declared ranges (a second, warm pass)",
         "vs_numpy": "per scene and engine configuration: engine wall (best of repeat, caches "
                     "warm) and relative pull-off error vs the scene's converged reference; "
                     "the plain numpy solver's most accurate ladder run whose error is still "

@@ -19,8 +19,8 @@ quasistatic    the elastic, quasi-static branch (k = 1)
 crack_front    the crack-front model: a JKR contact whose edge opens with Gamma(v)
 postprocess    a finished unloading turned into a result: the pull-off, the state and the
                crack speed there (:func:`.postprocess.finish`)
-resolution     the error indicator: the resolution error model and the check on a mesh of
-               half the resolution
+resolution     the error estimate: the pull-off change against a solve at half the
+               resolution in space and time, plus the Prony fit's error
 models         the model registry and :func:`simulate`, the one entry for one scene
 =============  =================================================================================
 """

@@ -9,10 +9,9 @@ Orchestration only; each concept has its module:
    ``numerics.exact``, :mod:`sweep.engine.exact` (exact hereditary integral);
 4. :mod:`sweep.engine.postprocess`: pull-off |min P| (parabola through the samples around the
    minimum), the state there and the crack speed -da/dt;
-5. the error indicator: the error expected from the crack-band resolution (a bound of the
-   measured convergence) and, where that is not well below ``numerics.pull_off_rtol``, the
-   pull-off change against the same scene on a mesh of half the resolution; a result whose
-   indicator exceeds the tolerance is not ``ok``.
+5. the error estimate (:func:`sweep.engine.resolution.estimate_error`): the pull-off change
+   against the same scene at half the resolution in space and time, plus the Prony fit's
+   error; a result whose estimate exceeds ``numerics.pull_off_rtol`` is not ``ok``.
 
 A numerical failure never raises: the ``Result`` has ``status="failed"`` and a reason. A
 programming error (:func:`sweep.errors.is_internal_error`: TypeError, IndexError, ...) is
@@ -81,9 +80,7 @@ def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
     deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
     res = _attempt(scene, numerics, deadline)
     if not numerics.exact:
-        # the resolution error against the process zone l0 (the mesh is sized from the tip
-        # zone; the two differ below mu = 1.83, where this estimate is the smaller one)
-        estimate_error(res, derive(scene, numerics).process_zone,
+        estimate_error(res, derive(scene, numerics).tip_zone,
                        lambda coarse: _attempt(scene, coarse, deadline))
     res.wall_s = time.perf_counter() - t_start
     return res

@@ -16,9 +16,13 @@ pb       the paper's closed-form estimate (:func:`pb_estimate`): the crack speed
 elastic  the quasi-static elastic branch (:func:`sweep.engine.quasistatic.simulate_elastic`), no
          hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100; "bem" and
          "auto" scenes that are elastic and quasi-static run it (:func:`wants_quasistatic`)
-auto     the cheapest model the scene allows (:func:`choose_model`): the BEM where the mesh that
-         resolves l0 fits the numerics' node count, the crack-front model otherwise and beyond
-         the BEM's Tabor range (mu > 100: its reason says so, with its measured difference)
+auto     the cheapest model whose error meets ``numerics.pull_off_rtol`` (:func:`model_choice`):
+         the elastic branch for elastic quasi-static scenes; the PB estimate or the
+         crack-front model where their error against the BEM, measured over a random sample
+         (:func:`measured_error`, ``make model-errors``), fits; else the BEM (graded or
+         tip-following mesh), and the crack-front model where the BEM fails for a reason the
+         crack-front model lifts (the tip zone unresolvable) or beyond the BEM's Tabor range
+         (mu > 100, the crack-front model is its limit). ``model_reason`` says why
 =======  ======================================================================================
 
 Every simulate function takes ``(scene, numerics=None)`` and returns a :class:`sweep.Result`;
@@ -27,23 +31,30 @@ the store and the analysis do not care which ran.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import time
+from functools import lru_cache
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
 
 from .. import units
-from ..errors import NUMERICAL_ERRORS, check_choice, check_positive, is_internal_error
+from ..errors import (NUMERICAL_ERRORS, check_choice, check_positive, is_internal_error,
+                      is_physical_refusal)
 from ..scene import Numerics, Result, Scene
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem
-from .crack_front import simulate_crack
+from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
 from .mesh import scene_mesh
 from .problem import BEM_MU_RANGE, derive
 from .quasistatic import simulate_elastic
 from .tip_following import simulate_tip_following
 
 __all__ = ["MODELS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
-           "simulate_scene", "choose_model", "bem_nodes_needed", "bem_node_budget",
-           "wants_quasistatic", "wants_tip_following"]
+           "simulate_scene", "choose_model", "model_choice", "Choice", "measured_error",
+           "bem_nodes_needed", "bem_node_budget", "wants_quasistatic", "wants_tip_following"]
 
 
 def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171) -> dict:
@@ -141,31 +152,118 @@ def bem_node_budget(numerics) -> int:
     return numerics.uniform_nodes if numerics.mesh == "uniform" else numerics.max_nodes
 
 
-def choose_model(scene, numerics=None) -> str:
-    """The model "auto" picks: "crack" beyond the BEM's Tabor range (:data:`BEM_MU_RANGE`:
-    the crack-front model is the mu -> infinity limit), else "bem" if its mesh fits the node
-    budget, else "crack"."""
+#: the measurement of the cheaper models against the BEM (``make model-errors``,
+#: :mod:`sweep.bench.model_errors`): a random sample over mu, n, k, rate, a0 and the envelope
+#: of the differences fitted over mu and the amplification
+MODEL_ERRORS = Path(__file__).with_name("model_errors.json")
+#: the margin on the envelope (which passes through the largest measured difference): a
+#: scene between the measured ones may differ more than the sample's largest
+MEASURED_ERROR_MARGIN = 1.5
+#: models in order of cost, the cheapest first ("auto" takes the first whose error fits)
+BY_COST = ("pb", "crack", "bem")
+
+
+@lru_cache(maxsize=1)
+def _fits() -> dict:
+    doc = json.loads(MODEL_ERRORS.read_text())
+    return {name: doc[name]["fit"] for name in ("crack", "pb")}
+
+
+def amplification(pull_off: float) -> float:
+    """``max(P / 1.5, 1)``: a pull-off over the elastic JKR one, the second variable of the
+    measured error (:func:`measured_error`)."""
+    return max(pull_off / 1.5, 1.0)
+
+
+def measured_error(model: str, mu: float, amplification: float = 1.0) -> float:
+    """The relative pull-off error of the crack-front model ("crack") or the PB estimate
+    ("pb") against the BEM, from their measured differences (:data:`MODEL_ERRORS`): the
+    envelope ``exp(b0 + shift) mu^b_mu A^b_amp`` through the largest of them, times
+    :data:`MEASURED_ERROR_MARGIN`, at Tabor parameter ``mu`` and amplification ``A``
+    (:func:`amplification` of the model's pull-off; 1, the smallest, before it ran). Beyond
+    the largest measured mu it is held at that mu's value (the models are the mu -> infinity
+    limit: the difference falls as mu grows); NaN below the smallest measured mu (not
+    measured) and for other models."""
+    if model not in ("crack", "pb"):
+        return math.nan
+    f = _fits()[model]
+    lo, hi = f["mu_range"]
+    if mu < lo:
+        return math.nan
+    log_err = (f["b0"] + f["shift"] + f["b_mu"] * math.log(min(mu, hi))
+               + f["b_amp"] * math.log(max(amplification, 1.0)))
+    return MEASURED_ERROR_MARGIN * math.exp(log_err)
+
+
+class Choice(NamedTuple):
+    """A model for a scene, why, and its expected relative pull-off error (NaN: the model
+    states its own, e.g. the BEM's error estimate)."""
+    model: str
+    reason: str
+    error: float = math.nan
+
+
+#: the ranges each model accepts, beyond the Scene's declared limits (their union): the
+#: BEM and the elastic branch the Tabor range of the LJ interface they resolve, the elastic
+#: branch k = 1 only; the crack-front model, the mu -> infinity limit, any mu but contacts
+#: that are stable under fixed grip; the PB estimate every scene
+MODEL_RANGES = {"bem": {"mu": BEM_MU_RANGE},
+                "elastic": {"mu": BEM_MU_RANGE, "k": (1.0, 1.0)},
+                "crack": {"a0": (FIXED_GRIP_A_MIN, math.inf)},
+                "pb": {}}
+
+
+def _accepts(model: str, scene) -> bool:
+    """Whether ``model`` can answer ``scene`` at all (:data:`MODEL_RANGES`)."""
+    return all(getattr(scene, axis) is None or lo <= getattr(scene, axis) <= hi
+               for axis, (lo, hi) in MODEL_RANGES[model].items())
+
+
+def model_choice(scene, numerics=None) -> Choice:
+    """The model "auto" runs first for ``scene``: the quasi-static elastic branch for an
+    elastic quasi-static scene; beyond the BEM's Tabor range the crack-front model, its
+    mu -> infinity limit; else the cheapest model (:data:`BY_COST`) whose
+    :func:`measured_error` at the smallest amplification meets ``numerics.pull_off_rtol``,
+    else the BEM (graded or tip-following mesh). :func:`simulate_model` checks a cheaper
+    model's error again at the amplification it computed and runs the BEM where it misses."""
     numerics = Numerics.preset("balanced") if numerics is None else numerics
-    if not BEM_MU_RANGE[0] <= scene.mu <= BEM_MU_RANGE[1]:
-        return "crack"
-    return "bem" if bem_nodes_needed(scene, numerics) <= bem_node_budget(numerics) else "crack"
+    bem_ok = _accepts("bem", scene)
+    if wants_quasistatic(scene, numerics) and bem_ok:
+        return Choice("elastic", "auto: k = 1, quasi-static: the elastic branch")
+    if not bem_ok:
+        lo, hi = BEM_MU_RANGE
+        return Choice("crack", f"auto: crack-front model, the mu -> infinity limit: mu = "
+                               f"{scene.mu:g} is beyond the BEM's range [{lo:g}, {hi:g}] "
+                               f"(its error measured up to mu = {_fits()['crack']['mu_range'][1]:g})")
+    tol = numerics.pull_off_rtol
+    for model in BY_COST[:-1]:
+        err = measured_error(model, scene.mu)
+        if _accepts(model, scene) and err <= tol:
+            return Choice(model, f"auto: {NAMES[model]}, measured error at most {err:.2g} <= "
+                                 f"pull_off_rtol {tol:g} at mu = {scene.mu:g}", err)
+    mesh = "tip-following mesh" if wants_tip_following(scene, numerics) else "graded mesh"
+    return Choice("bem", f"auto: BEM on the {mesh} (no cheaper model within pull_off_rtol "
+                         f"{tol:g})")
 
 
-#: the crack-front model's pull-off against the BEM's at the largest mu measured
-#: (results/agreement/agreement.md, ``make agreement``: n = 0.8, k = 0.1, a0 = 3,
-#: rate 10^2.5): (mu, crack / BEM - 1)
-CRACK_VS_BEM = ((10.0, -0.009), (15.0, 0.026))
+def choose_model(scene, numerics=None) -> str:
+    """The name of the model "auto" runs for ``scene`` (:func:`model_choice`)."""
+    return model_choice(scene, numerics).model
 
 
-def beyond_bem_note(scene) -> str:
-    """The reason an "auto" row run by the crack-front model beyond the BEM's Tabor range
-    carries: which model ran, why, and its measured difference from the BEM."""
-    lo, hi = BEM_MU_RANGE
-    measured = " and ".join(f"{d * 100:+.1f} % at mu = {mu:g}" for mu, d in CRACK_VS_BEM)
-    return (f"crack-front model (the mu -> infinity limit): mu = {scene.mu:g} is beyond the "
-            f"BEM's range [{lo:g}, {hi:g}]; against the BEM its pull-off differed by "
-            f"{measured} (n = 0.8, k = 0.1, a0 = 3, rate 316; results/agreement), not "
-            f"measured at larger mu")
+#: what the reasons call each model
+NAMES = {"pb": "PB estimate", "crack": "crack-front model", "bem": "BEM",
+         "elastic": "elastic branch"}
+
+
+def _fallback(scene, numerics, failed) -> Choice | None:
+    """After the BEM failed an "auto" scene for a reason another model can lift (not a
+    physical refusal): the crack-front model, the physical limit where the BEM cannot
+    resolve the tip zone, with its measured error; None where it cannot answer either."""
+    if (is_physical_refusal(failed.reason) or not _accepts("crack", scene)
+            or math.isnan(measured_error("crack", scene.mu))):
+        return None
+    return Choice("crack", f"auto: crack-front model: the BEM failed ({failed.reason[:160]})")
 
 
 #: model name -> simulate(scene, numerics=None) -> Result
@@ -181,28 +279,57 @@ def wants_quasistatic(scene, numerics) -> bool:
             and numerics.domain is None and not numerics.exact)
 
 
-def simulate_model(scene, model: str = "bem", numerics=None):
-    """Run ``scene`` with the named model (one of :data:`MODELS` or "auto"); the result's
-    ``model_used`` says which ran."""
-    check_choice("model", model, (*MODELS, "auto"))
-    numerics = Numerics.preset("balanced") if numerics is None else numerics
-    note = ""
-    if model in ("bem", "auto") and wants_quasistatic(scene, numerics):
-        model = "elastic"
-    elif model == "auto":
-        model = choose_model(scene, numerics)
-        if model == "crack" and scene.mu > BEM_MU_RANGE[1]:
-            note = beyond_bem_note(scene)
+def _model_error(model: str, scene, res) -> float:
+    """A crack or pb row's error: :func:`measured_error` at its amplification, plus the error
+    the model states itself (the nearly elastic crack-front closed form's bound), if any."""
+    own = res.error_estimate if math.isfinite(res.error_estimate) else 0.0
+    return measured_error(model, scene.mu, amplification(res.pull_off)) + own
+
+
+def _run(model: str, scene, numerics) -> Result:
+    """``MODELS[model]``; a numerical failure is a failed result, a bug raises."""
     try:
-        res = MODELS[model](scene, numerics)
+        return MODELS[model](scene, numerics)
     except NUMERICAL_ERRORS as exc:   # a numerical failure is a result; a bug (TypeError, ...)
         if is_internal_error(exc):     # raises: sweep run records it as status "error"
             raise
-        res = Result(scene=scene, numerics=numerics, status="failed",
-                     reason=f"{type(exc).__name__}: {exc}")
-    res.model_used = model
-    if note:
-        res.reason = f"{res.reason}; {note}" if res.reason else note
+        return Result(scene=scene, numerics=numerics, status="failed",
+                      reason=f"{type(exc).__name__}: {exc}")
+
+
+def simulate_model(scene, model: str = "bem", numerics=None):
+    """Run ``scene`` with the named model (one of :data:`MODELS` or "auto"); the result's
+    ``model_used`` says which ran and ``model_reason`` why. An "auto" scene the BEM failed
+    for a reason another model can lift runs the crack-front model (:func:`_fallback`). A
+    "crack" or "pb" row's ``error_estimate`` is the model's :func:`measured_error`."""
+    check_choice("model", model, (*MODELS, "auto"))
+    numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if model == "auto":
+        choice = model_choice(scene, numerics)
+    elif model == "bem" and wants_quasistatic(scene, numerics):
+        choice = Choice("elastic", "bem: k = 1, quasi-static: the elastic branch")
+    else:
+        choice = Choice(model, f"{model}: asked for")
+    res = _run(choice.model, scene, numerics)
+    if res.ok and choice.model in ("crack", "pb"):
+        res.error_estimate = _model_error(choice.model, scene, res)
+    if model == "auto" and choice.model in ("crack", "pb") and scene.mu <= BEM_MU_RANGE[1] \
+            and not res.error_estimate <= numerics.pull_off_rtol:
+        miss = (f"auto: BEM: the {NAMES[choice.model]}'s measured error at its amplification "
+                f"{amplification(res.pull_off):.3g}, {res.error_estimate:.2g}, exceeds "
+                f"pull_off_rtol {numerics.pull_off_rtol:g}" if res.ok else
+                f"auto: BEM: the {NAMES[choice.model]} failed ({res.reason[:120]})")
+        choice, res = Choice("bem", miss), _run("bem", scene, numerics)
+    if model == "auto" and choice.model == "bem" and res.status == "failed":
+        fallback = _fallback(scene, numerics, res)
+        if fallback is not None:
+            choice, res = fallback, _run("crack", scene, numerics)
+            if res.ok:
+                res.error_estimate = _model_error("crack", scene, res)
+    res.model_used = choice.model
+    res.model_reason = choice.reason
+    if choice.model == "crack" and res.ok and model == "auto":
+        res.model_reason += f"; measured error {res.error_estimate:.2g}"
     return res
 
 

@@ -1,6 +1,6 @@
-"""The error indicator of a BEM result: the error expected from the crack band's resolution,
-and where that is not well below the tolerance, the pull-off change on a mesh of half the
-resolution (a result whose indicator exceeds ``numerics.pull_off_rtol`` is not ``ok``).
+"""The error estimate of a BEM result: the pull-off change on a mesh of half the resolution
+in space and time plus the Prony fit's error (a result whose estimate exceeds
+``numerics.pull_off_rtol`` is not ``ok``).
 
 Used alike by the graded mesh (:mod:`sweep.engine.bem`) and the tip-following mesh
 (:mod:`sweep.engine.tip_following`).
@@ -13,11 +13,9 @@ from typing import Callable
 
 from ..scene import Numerics, Result
 
-#: the resolution error model, K (spacing/length)^2 (see :func:`resolution_error`) ...
-RESOLUTION_ERROR_K = 0.3
-#: ... decides alone while below this fraction of numerics.pull_off_rtol; above it the
-#: scene is solved again at half the resolution and the pull-off change decides
-CHECK_FRACTION = 0.25
+#: the a-priori resolution error, K (spacing/tip zone)^2 (see :func:`resolution_error`),
+#: where the half-resolution check cannot run
+RESOLUTION_ERROR_K = 2.5
 
 
 def refine_advice(numerics: Numerics) -> str:
@@ -34,52 +32,64 @@ def refine_advice(numerics: Numerics) -> str:
 
 def resolution_error(spacing: float, length: float) -> float:
     """Pull-off error expected from the crack-band resolution: RESOLUTION_ERROR_K
-    (spacing/length)^2, with ``spacing`` the fine node spacing and ``length`` the zone it
-    resolves (both a_ref).
+    (spacing/length)^2, with ``spacing`` the fine node spacing and ``length`` the tip zone
+    it resolves (both a_ref).
 
-    The bound of the measured convergence (README, "Speed and accuracy"): on the reference
-    scenes A, D, F the pull-off error times (l0/spacing)^2 stays below 0.22 from 6 to 40
-    spacings per l0.
+    A bound of the measured convergence: over a random sample of scenes
+    (``make error-coverage``) the pull-off error times (tip zone/spacing)^2 reached 2.2 (a
+    narrow-band, fast scene at mu = 1.6); on the reference scenes A, D, F it stays below 0.22.
     """
     return RESOLUTION_ERROR_K * (spacing / length) ** 2
 
 
-def coarser(numerics: Numerics) -> Numerics:
-    """The numerics of the error indicator's cheaper solve: half the mesh resolution
-    (half the band resolution, or half the nodes), no coarse-mesh refusal."""
+def coarser(numerics: Numerics, factor: float = 2.0) -> Numerics:
+    """The numerics of the error estimate's cheaper solve: the resolution divided by
+    ``factor`` in space (the band resolution, or the nodes; the largest change of the contact
+    radius per step, in spacings, stays, so it grows with them in a_ref) and in time (the
+    largest indentation step times ``factor``), no coarse-mesh refusal, no check of its own."""
+    step = min(factor * numerics.step, 10.0)
     if numerics.nodes is not None or numerics.mesh == "uniform":
-        return dataclasses.replace(numerics, nodes=max(numerics.uniform_nodes // 2, 20),
-                                   zone_nodes=0.0)
-    return dataclasses.replace(numerics, band_resolution=max(numerics.band_resolution / 2, 2.0),
-                               zone_nodes=0.0)
+        return dataclasses.replace(numerics, nodes=max(int(numerics.uniform_nodes / factor), 20),
+                                   step=step, zone_nodes=0.0, pull_off_rtol=0.0)
+    return dataclasses.replace(numerics,
+                               band_resolution=max(numerics.band_resolution / factor, 2.0),
+                               step=step, zone_nodes=0.0, pull_off_rtol=0.0)
 
 
-def check_resolution(res: Result, coarse: Result) -> None:
-    """Set the error estimate of ``res`` from the half-resolution solve ``coarse``; not
-    ``ok`` when it exceeds the tolerance (or the cheaper solve failed)."""
-    tol = res.numerics.pull_off_rtol
-    if not coarse.ok:
-        res.error_estimate = math.inf
-        res.status = "failed"
-        res.reason = (f"unresolved: the check on a mesh of half the resolution failed "
-                      f"({coarse.reason}); {refine_advice(res.numerics)}")
-        return
-    res.error_estimate = abs(res.pull_off - coarse.pull_off) / res.pull_off
-    if res.error_estimate > tol:
-        res.status = "failed"
-        res.reason = (f"unresolved: the pull-off moves by {res.error_estimate:.2g} (> pull_off_rtol "
-                      f"= {tol:g}) on a mesh of half the resolution ({coarse.pull_off:.5g} vs "
-                      f"{res.pull_off:.5g}); {refine_advice(res.numerics)}")
+#: resolution ratios of the cheaper solve, tried in turn until one succeeds (a mesh of half
+#: the resolution may not hold a small initial contact that a finer one holds)
+COARSER_FACTORS = (2.0, math.sqrt(2.0))
 
 
 def estimate_error(res: Result, length: float, solve: Callable[[Numerics], Result]) -> None:
-    """The error indicator of an ``ok`` result, in place: :func:`resolution_error` of its
-    spacing against ``length`` (a_ref), and where that exceeds CHECK_FRACTION
-    pull_off_rtol, :func:`check_resolution` against ``solve(coarser(numerics))``.
-    Nothing is done when ``res`` failed or ``pull_off_rtol`` is 0."""
+    """The error estimate of an ``ok`` result, in place: the pull-off change against a solve
+    at ``1/f`` of the resolution in space and time (``solve(coarser(numerics, f))``, f = 2,
+    else sqrt 2: :data:`COARSER_FACTORS`) over ``f - 1``, plus the Prony fit's error (the
+    same in both solves, so absent from their difference). A discretization of order
+    ``p >= 1`` has an error of ``change / (f^p - 1) <= change / (f - 1)``: the estimate covers
+    first and second order alike. Where every cheaper solve fails, the a-priori bound
+    :func:`resolution_error` of the spacing against ``length`` (a_ref) stands in, and the
+    reason says so. A result whose estimate exceeds ``numerics.pull_off_rtol`` is not ``ok``
+    ("unresolved: ..."). Nothing is done when ``res`` failed or ``pull_off_rtol`` is 0."""
     tol = res.numerics.pull_off_rtol
     if not res.ok or tol <= 0:
         return
-    res.error_estimate = resolution_error(res.spacing, length)
-    if res.error_estimate > CHECK_FRACTION * tol:
-        check_resolution(res, solve(coarser(res.numerics)))
+    prony = res.prony_error if math.isfinite(res.prony_error) else 0.0
+    for factor in COARSER_FACTORS:
+        coarse = solve(coarser(res.numerics, factor))
+        if coarse.ok:
+            change = abs(res.pull_off - coarse.pull_off) / res.pull_off
+            res.error_estimate = change / (factor - 1.0) + prony
+            how = (f"the pull-off moves by {change:.2g} on a mesh of 1/{factor:.3g} the "
+                   f"resolution ({coarse.pull_off:.5g} vs {res.pull_off:.5g})")
+            break
+    else:
+        res.error_estimate = resolution_error(res.spacing, length) + prony
+        note = (f"error estimate a priori, {RESOLUTION_ERROR_K:g} (spacing/tip zone)^2: the "
+                f"check on a coarser mesh failed ({coarse.reason[:120]})")
+        res.reason = f"{res.reason}; {note}" if res.reason else note
+        how = f"the a-priori estimate {res.error_estimate:.2g}"
+    if res.error_estimate > tol:
+        res.status = "failed"
+        res.reason = (f"unresolved: {how}, above pull_off_rtol = {tol:g}; "
+                      f"{refine_advice(res.numerics)}")

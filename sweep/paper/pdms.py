@@ -503,7 +503,7 @@ def gs_over_bem(case=PDMS_CASE, bem=None, fits=None, ctx=None, pf=None) -> dict:
         out["check_attempts"] = (bem or {}).get("check_attempts", [])
         out["bem_wall_s_sum"] = (bem or {}).get("wall_s_sum")
         out["bem_error_definition"] = (
-            "sum of: the engine's resolution indicator 0.3 (spacing/l0)^2 of the point; the "
+            "sum of: the engine's error estimate of the point (Result.error_estimate); the "
             "error of the curve's mesh measured at one speed, |P(l0/s1) / P(l0/s2) - 1| / (1 - "
             "(s1/s2)^2) for fine spacings l0/s1 (the curve's) and l0/s2 (the check's), "
             "second-order convergence; the size of the mu carry-over factor (crack front at mu "

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from sweep.engine.bem import no_contact_reason
-from sweep.engine.resolution import check_resolution, refine_advice
+from sweep.engine.resolution import estimate_error, refine_advice
 from sweep.scene import Numerics, Result, Scene
 
 SCENE = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0)
@@ -22,7 +22,7 @@ def test_unresolved_message_fits_the_mesh():
                            (Numerics(nodes=300), "raise nodes")):
         res = Result(scene=SCENE, numerics=numerics, status="ok", pull_off=4.0)
         coarse = Result(scene=SCENE, numerics=numerics, status="ok", pull_off=3.0)
-        check_resolution(res, coarse)
+        estimate_error(res, 0.1, lambda num: coarse)
         assert res.status == "failed" and res.reason.endswith(refine_advice(numerics))
         assert knob in res.reason
         if knob == "raise nodes":

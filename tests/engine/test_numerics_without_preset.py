@@ -17,7 +17,7 @@ from sweep.scene import UNIFORM_NODES, Numerics, Scene
 NUM = Numerics.from_dict({"time_budget_s": 15})      # fields, no preset
 VISCO = dict(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0)
 ELASTIC = dict(n=0.8, k=1.0, mu=3.24, a0=2.0, rate=10.0)
-HIGH_MU = dict(n=0.5, k=0.01, mu=30.0, a0=3.0, rate=1e3)
+HIGH_MU = dict(n=0.5, k=0.01, mu=300.0, a0=3.0, rate=1e3)     # beyond the BEM: crack
 
 
 def test_uniform_nodes_resolves_none():
@@ -58,9 +58,13 @@ def test_auto_beyond_the_bem_range_runs_the_crack_front_model(mu):
     res = models.simulate(scene)
     assert res.model_used == "crack" and res.ok
     assert math.isfinite(res.pull_off) and 1.0 < res.pull_off < 20.0
-    assert res.reason.startswith(f"crack-front model (the mu -> infinity limit): mu = {mu:g} "
-                                 f"is beyond the BEM's range [0.01, {BEM_MU_RANGE[1]:g}]")
-    assert "-0.9 % at mu = 10" in res.reason and "+2.6 % at mu = 15" in res.reason
+    assert res.model_reason.startswith(
+        f"auto: crack-front model, the mu -> infinity limit: mu = {mu:g} is beyond the BEM's "
+        f"range [0.01, {BEM_MU_RANGE[1]:g}]")
+    # its error is the envelope of the measurement held at its largest mu, stated in the row
+    assert res.error_estimate == models.measured_error(
+        "crack", BEM_MU_RANGE[1], models.amplification(res.pull_off)) > 0
+    assert f"measured error {res.error_estimate:.2g}" in res.model_reason
     # the BEM itself refuses it with its reason (a failed row, not an exception)
     bem = models.simulate(Scene(n=0.8, k=0.1, mu=mu, a0=3.0, rate=316.0, model="bem"))
     assert bem.status == "failed" and bem.reason
@@ -69,3 +73,4 @@ def test_auto_beyond_the_bem_range_runs_the_crack_front_model(mu):
 def test_auto_within_the_bem_range_keeps_an_empty_reason():
     res = models.simulate(Scene(**VISCO, model="auto"), Numerics.preset("fast"))
     assert res.model_used == "bem" and res.ok and res.reason == ""
+    assert res.model_reason.startswith("auto: BEM on the graded mesh")

@@ -1,0 +1,169 @@
+r"""A seeded random sample across the declared ranges, run as a user runs it: ``sweep run``.
+
+``python -m sweep.bench.random_sample configs --count 60`` writes the sweep configurations
+``configs/random/auto.yaml`` and ``configs/random/bem.yaml`` (the same scenes, drawn
+log-uniformly across the Scene's declared ranges, model ``auto`` and the default ``bem``;
+balanced preset, 20 s time budget a scene). After ``sweep run`` of each (``make
+random-sample``), ``python -m sweep.bench.random_sample summary`` counts, per model, the
+scenes answered (``ok``), physically refused (:func:`sweep.errors.is_physical_refusal`),
+failed otherwise, and hit by an internal error, into ``results/random/summary.json``, and
+draws ``results/random/model_map.png``: which model answered each scene, over mu and the
+rate, beside the crack-front model's measured difference from the BEM
+(``sweep/engine/model_errors.json``).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import yaml
+
+from ..campaign.store import load
+from ..errors import is_physical_refusal
+from .error_coverage import sample
+
+ROOT = Path(__file__).resolve().parents[2]
+CONFIGS = ROOT / "configs" / "random"
+RESULTS = ROOT / "results" / "random"
+MODELS = ("auto", "bem")
+BUDGET_S = 20.0
+
+
+def sample_config(count: int, seed: int, model: str) -> dict:
+    """The sweep configuration of ``count`` random scenes (a grid of one-point blocks)."""
+    return {"name": f"random-{model}",
+            "description": f"{count} scenes drawn log-uniformly across the declared ranges "
+                           f"(seed {seed}), model {model}",
+            "grid": [dict(d, model=model) for d in sample(count, seed, bem_range=False)],
+            "numerics": {"preset": "balanced", "time_budget_s": BUDGET_S},
+            "output": f"results/random/{model}.h5"}
+
+
+def write_configs(count: int = 60, seed: int = 21) -> list[Path]:
+    CONFIGS.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for model in MODELS:
+        path = CONFIGS / f"{model}.yaml"
+        head = (f"# written by `python -m sweep.bench.random_sample configs --count {count} "
+                f"--seed {seed}`; run by `make random-sample`\n")
+        path.write_text(head + yaml.safe_dump(sample_config(count, seed, model),
+                                              sort_keys=False, width=100))
+        paths.append(path)
+    return paths
+
+
+def outcome(row) -> str:
+    """"ok", "refused" (a physical refusal), "failed" or "error" (a bug) for one stored row."""
+    if row["status"] in ("ok", "error"):
+        return row["status"]
+    return "refused" if is_physical_refusal(str(row["reason"])) else "failed"
+
+
+def summarize(results: Path = RESULTS) -> dict:
+    out = {}
+    for model in MODELS:
+        path = results / f"{model}.h5"
+        if not path.exists():
+            continue
+        df = load(path)
+        kinds = [outcome(r) for _, r in df.iterrows()]
+        out[model] = {"scenes": len(df), **{k: kinds.count(k) for k in
+                                             ("ok", "refused", "failed", "error")},
+                      "answered_or_refused": (kinds.count("ok") + kinds.count("refused"))
+                      / max(len(df), 1),
+                      "model_used": df.model_used.value_counts().to_dict(),
+                      "failures": [{"n": r.n, "k": r.k, "mu": r.mu, "a0": r.a0, "rate": r.rate,
+                                    "material": r.material, "reason": r.reason}
+                                   for (_, r), kind in zip(df.iterrows(), kinds)
+                                   if kind in ("failed", "error")],
+                      "sweep_wall_s": float(df.task_wall_s.sum())}
+    return out
+
+
+def plot_map(results: Path = RESULTS) -> Path | None:
+    """Left: the auto sample over (mu, rate), coloured by the model that answered (crosses:
+    failed, squares: refused). Right: the crack-front model's measured differences from the
+    BEM over mu, coloured by the amplification, and its envelope (measured_error) at
+    amplification 1, 10, 100."""
+    from ..analysis.plots import pyplot
+    from ..engine.models import MODEL_ERRORS, amplification, measured_error
+
+    path = results / "auto.h5"
+    if not path.exists():
+        return None
+    plt = pyplot()
+    df = load(path)
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.8))
+    colours = {"bem": "tab:blue", "crack": "tab:orange", "elastic": "tab:green", "pb": "tab:red"}
+    for model, colour in colours.items():
+        d = df[(df.model_used == model) & (df.status == "ok")]
+        if len(d):
+            ax.scatter(d.mu, d.rate, c=colour, s=22, label=f"{model} ({len(d)})")
+    kinds = [outcome(r) for _, r in df.iterrows()]
+    for kind, marker in (("refused", "s"), ("failed", "x"), ("error", "X")):
+        d = df[[k == kind for k in kinds]]
+        if len(d):
+            ax.scatter(d.mu, d.rate, c="k", marker=marker, s=30, label=f"{kind} ({len(d)})",
+                       facecolors="none" if marker == "s" else None)
+    ax.axvline(100.0, color="0.6", lw=0.8, ls="--")
+    ax.set(xscale="log", yscale="log", xlabel="Tabor parameter mu",
+           ylabel="unloading rate r tau0 / h0",
+           title=f"model: auto, balanced, {len(df)} random scenes")
+    ax.legend(fontsize=8, loc="lower left")
+    doc = json.loads(MODEL_ERRORS.read_text())
+    rows = [r for r in doc["rows"] if r["crack_vs_bem"] is not None]
+    sc = bx.scatter([r["scene"]["mu"] for r in rows], [abs(r["crack_vs_bem"]) for r in rows],
+                    c=[math.log10(amplification(r["crack_pull_off"])) for r in rows],
+                    cmap="viridis", s=24)
+    fig.colorbar(sc, ax=bx, label="log10 amplification P / 1.5")
+    lo, hi = doc["crack"]["fit"]["mu_range"]
+    mus = [lo * (1e4 / lo) ** (i / 80) for i in range(81)]
+    for amp, ls in ((1.0, "-"), (10.0, "--"), (100.0, ":")):
+        bx.plot(mus, [measured_error("crack", m, amp) for m in mus], "k", ls=ls, lw=1,
+                label=f"measured_error, amplification {amp:g}")
+    bx.axvline(hi, color="0.6", lw=0.8, ls="--")
+    bx.set(xscale="log", yscale="log", xlabel="Tabor parameter mu",
+           ylabel="|crack-front / BEM - 1|",
+           title="crack-front model vs the BEM (make model-errors)")
+    bx.legend(fontsize=8, loc="lower left")
+    fig.tight_layout()
+    out = results / "model_map.png"
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+    return out
+
+
+def _main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m sweep.bench.random_sample",
+                                description="a random sample across the declared ranges")
+    sub = p.add_subparsers(dest="command", required=True)
+    c = sub.add_parser("configs", help="write configs/random/{auto,bem}.yaml")
+    c.add_argument("--count", type=int, default=60)
+    c.add_argument("--seed", type=int, default=21)
+    sub.add_parser("summary", help="count the outcomes, draw the model map")
+    args = p.parse_args(argv)
+    if args.command == "configs":
+        for path in write_configs(args.count, args.seed):
+            print(path.relative_to(ROOT))
+        return 0
+    summary = summarize()
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    (RESULTS / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
+    for model, s in summary.items():
+        print(f"{model:5}: {s['scenes']} scenes: {s['ok']} ok, {s['refused']} physically "
+              f"refused, {s['failed']} failed, {s['error']} internal errors "
+              f"({100 * s['answered_or_refused']:.0f} % answered or refused); models used "
+              f"{s['model_used']}")
+        for f in s["failures"]:
+            print(f"    failed: mu={f['mu']:.4g} a0={f['a0']:.3g} n={f['n']:.3g} "
+                  f"k={f['k']:.3g} rate={f['rate']:.3g}: {f['reason'][:110]}")
+    out = plot_map()
+    if out:
+        print(out.relative_to(ROOT))
+    return 1 if any(s["error"] for s in summary.values()) else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(_main())

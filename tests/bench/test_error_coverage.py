@@ -1,0 +1,51 @@
+"""The per-row error estimate's coverage of the true error (issue 21 item 1): the summary
+arithmetic, and the committed measurement (results/error_coverage/coverage.json, written by
+`make error-coverage`) meets the issue's targets for every preset: the estimate covers the
+true pull-off error against a much finer run in at least 90 % of the scenes and is not
+looser than 10x in the median."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from sweep.bench import error_coverage
+
+ROOT = Path(__file__).resolve().parents[2]
+COVERAGE = ROOT / "results" / "error_coverage" / "coverage.json"
+
+
+def _row(est, true, status="ok", ref="ok"):
+    return {"reference": {"status": ref},
+            **{name: {"status": status, "error_estimate": est, "true_error": true}
+               for name in error_coverage.PRESET_NAMES}}
+
+
+def test_summary_arithmetic():
+    rows = [_row(2e-3, 1e-3), _row(1e-4, 1e-3), _row(5e-3, 1e-3), _row(1.0, math.nan, ref="failed"),
+            _row(1.0, 1.0, status="failed")]
+    s = error_coverage.summarize(rows)["fast"]
+    assert s["scenes"] == 3 and s["coverage"] == pytest.approx(2 / 3)
+    assert s["median_looseness"] == pytest.approx(2.0)
+
+
+def test_the_sample_is_seeded_and_inside_the_ranges():
+    a, b = error_coverage.sample(20, seed=3), error_coverage.sample(20, seed=3)
+    assert a == b
+    for d in error_coverage.sample(200, seed=1, bem_range=False):
+        for name, (lo, hi) in error_coverage.USER_RANGES.items():
+            assert lo * 0.999 <= d[name] <= hi * 1.001, (name, d)
+    assert any(d["k"] == 1.0 for d in error_coverage.sample(200, seed=1, bem_range=False))
+
+
+@pytest.mark.parametrize("preset", error_coverage.PRESET_NAMES)
+def test_the_committed_measurement_meets_the_targets(preset):
+    doc = json.loads(COVERAGE.read_text())
+    assert doc["command"].startswith("python -m sweep.bench.error_coverage")
+    summary = error_coverage.summarize(doc["rows"])            # recomputed from the rows
+    s = summary[preset]
+    assert s == pytest.approx(doc["summary"][preset])
+    assert s["scenes"] >= 15
+    assert s["coverage"] >= 0.9 and s["median_looseness"] <= 10.0, s
