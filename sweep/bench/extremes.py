@@ -175,7 +175,8 @@ def _row(d, model, res, seconds) -> dict:
     cls, verdict = classify(d, res)
     return dict(d, asked=model, status=res.status, reason=res.reason, pull_off=res.pull_off,
                 model=res.model_used or model, nodes=res.nodes_used,
-                lower=relaxed_pull_off(d["mu"], d["a0"]), upper=upper_bound(d["mu"], d["k"], d["a0"]),
+                lower=relaxed_pull_off(d["mu"], d["a0"]),
+                upper=upper_bound(d["mu"], d["k"], d["a0"]),
                 cls=cls, verdict=verdict, seconds=seconds)
 
 
@@ -250,7 +251,8 @@ def print_table(rows, out=print, header=True) -> None:
     if header:
         out(HEADER)
     for r in rows:
-        out(f"{r['mu']:5g} {r['a0']:4g} {r['n']:4g} {r['k']:6g} {r['rate']:6g} {r['model']:>7} "
+        out(f"{r['mu']:5.3g} {r['a0']:4.3g} {r['n']:4.3g} {r['k']:6.3g} {r['rate']:6.3g} "
+            f"{r['model']:>7} "
             f"{r['cls']:>7} {r['pull_off']:9.5g} {r['lower']:7.4f} {r['upper']:9.4g} "
             f"{r['nodes']:5d} {r['seconds']:6.1f}  {r['verdict'][:110]}")
 
@@ -268,7 +270,8 @@ def summary_lines(report: dict) -> list[str]:
 
 
 def _scene_str(r) -> str:
-    return f"mu = {r['mu']:g}, a0 = {r['a0']:g}, n = {r['n']:g}, k = {r['k']:g}, rate = {r['rate']:g}"
+    return (f"mu = {r['mu']:.4g}, a0 = {r['a0']:.4g}, n = {r['n']:.4g}, k = {r['k']:.4g}, "
+            f"rate = {r['rate']:.4g}")
 
 
 def summary_md(report: dict) -> str:
