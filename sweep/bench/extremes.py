@@ -42,6 +42,7 @@ import json
 import math
 import os
 import platform
+import re
 import subprocess
 import sys
 import time
@@ -274,9 +275,15 @@ def _scene_str(r) -> str:
             f"rate = {r['rate']:.4g}")
 
 
+def reason_key(reason: str) -> str:
+    """A failure reason with its numbers replaced by ``#`` and cut at 100 characters: the
+    same failure of several scenes gives the same key."""
+    return re.sub(r"(?<![A-Za-z_])[-+]?\d+(\.\d+)?([eE][-+]?\d+)?", "#", reason or "")[:100]
+
+
 def summary_md(report: dict) -> str:
-    """``summary.md``: how the table was made, the counts, and every row that is not ok or
-    physically refused (scene, model that ran, verdict)."""
+    """``summary.md``: how the table was made, the counts, the reasons of the failed rows
+    (grouped, with how many scenes gave each) and every wrong or error row."""
     out = [f"# Extremes: {report['scenes']} scenes of (n, k, rate, a0, mu)", "",
            f"`{report['command']}` on {report['date']} (commit {report['commit']}), "
            f"preset {report['preset']}, time budget {report['time_budget_s']:g} s a scene, "
@@ -287,9 +294,19 @@ def summary_md(report: dict) -> str:
            "escaped simulate).", ""]
     out += summary_lines(report)
     for model, m in report["models"].items():
-        bad = [r for r in m["rows"] if r["cls"] in ("failed", "wrong", "error")]
+        groups: dict = {}
+        for r in m["rows"]:
+            if r["cls"] in ("refused", "failed"):
+                groups.setdefault((r["cls"], r["model"], reason_key(r["reason"])), []).append(r)
+        if groups:
+            out += ["", f"## {model}: reasons of the refused and failed rows", "",
+                    "| class | model that ran | scenes | reason (numbers as #) | e.g. |",
+                    "|---|---|---|---|---|"]
+            for (cls, ran, key), rows in sorted(groups.items(), key=lambda g: -len(g[1])):
+                out.append(f"| {cls} | {ran} | {len(rows)} | {key} | {_scene_str(rows[0])} |")
+        bad = [r for r in m["rows"] if r["cls"] in ("wrong", "error")]
         if bad:
-            out += ["", f"## {model}: failed, wrong and errors", ""]
+            out += ["", f"## {model}: wrong and errors", ""]
             out += [f"- {_scene_str(r)} ({r['model']}, {r['seconds']:.1f} s): {r['verdict']}"
                     for r in bad]
     return "\n".join(out) + "\n"
@@ -312,7 +329,14 @@ def _main(argv=None) -> int:
     p.add_argument("--out", type=Path, default=None,
                    help="directory of extremes.json and summary.md (default results/extremes, "
                    "results/quick/extremes with --quick)")
+    p.add_argument("--summary-from", type=Path, metavar="JSON",
+                   help="only rewrite summary.md beside JSON, an extremes.json of an earlier run")
     args = p.parse_args(argv)
+    if args.summary_from is not None:
+        report = json.loads(args.summary_from.read_text())
+        (args.summary_from.parent / "summary.md").write_text(summary_md(report))
+        print(f"written: {args.summary_from.parent / 'summary.md'}")
+        return 0
     out_dir = args.out or Path("results/quick/extremes" if args.quick else "results/extremes")
     out = lambda s: print(s, flush=True)        # noqa: E731
     scenes = QUICK if args.quick else all_scenes()
