@@ -182,11 +182,27 @@ def _row(d, model, res, seconds) -> dict:
 
 
 def run_scene(d: dict, model: str = "bem", numerics=None) -> dict:
-    """Run and judge one scene (a dict of Scene fields) with ``model``: its row.
+    """Run and judge one scene with ``model``: its row.
 
     An exception escaping :func:`simulate` is caught and recorded as class "error" with its
     traceback (``internal``: whether :func:`sweep.errors.is_internal_error` calls it a bug),
     so that one bug does not end the table.
+
+    Parameters
+    ----------
+    d : dict
+        The scene's fields n, k, rate, a0, mu.
+    model : str
+        One of :data:`sweep.scene.MODEL_NAMES`.
+    numerics : Numerics, optional
+        Default: the :data:`PRESET` preset with a :data:`TIME_BUDGET_S` budget.
+
+    Returns
+    -------
+    dict
+        The scene's fields and asked, status, reason, pull_off, model (the one that ran),
+        nodes, lower, upper, cls (:data:`CLASSES`), verdict, seconds; an error row also has
+        internal and traceback.
     """
     numerics = numerics or Numerics.preset(PRESET, time_budget_s=TIME_BUDGET_S)
     t0 = time.perf_counter()
@@ -224,12 +240,26 @@ def counts(rows) -> dict:
 
 
 def random_scenes(count: int, seed: int, floors=None) -> list[dict]:
-    """``count`` scenes drawn log-uniformly across the limits Scene declares for n, k, rate,
-    a0 and mu (:data:`sweep.scene.AXES`), with ``numpy.random.default_rng(seed)``.
+    """Scenes drawn log-uniformly across the limits Scene declares for n, k, rate, a0 and mu
+    (:data:`sweep.scene.AXES`).
 
     A limit open at 0 (n, k, rate) has no log-uniform law: its lower end is replaced by
     ``floors[name]``, by default the table's smallest value of the axis (n 0.05, k 1e-4,
     rate 1e-4); a closed lower limit (a0, mu) is used as declared.
+
+    Parameters
+    ----------
+    count : int
+        Number of scenes.
+    seed : int
+        Seed of ``numpy.random.default_rng``: the same seed gives the same scenes.
+    floors : dict, optional
+        Lower ends of the axes whose declared limit is open at 0.
+
+    Returns
+    -------
+    list of dict
+        Dicts of the Scene fields n, k, rate, a0, mu.
     """
     floors = {"n": min(N_VALUES), "k": min(K_VALUES), "rate": min(RATES), **(floors or {})}
     rng = np.random.default_rng(seed)
