@@ -26,7 +26,8 @@ help:
 	@echo "make pdms-bem - the PDMS's linear BEM pull-off curve (results/pdms/bem.json, ~30 min), then make pdms"
 	@echo "make agreement - BEM vs crack-front model vs PB estimate (results/agreement/)"
 	@echo "make agreement-high-mu - its mu = 15 point (about 35 min), merged by make agreement"
-	@echo "make extremes [QUICK=1] - stability at the extremes of (n, k, rate, a0, mu)"
+	@echo "make extremes [QUICK=1] [MODEL='bem auto'] - stability at the extremes of (n, k, rate, a0, mu)"
+	@echo "               (results/extremes/: ok / physically refused / failed / wrong per model)"
 	@echo "make tip-convergence - tip-following BEM: pull-off vs spacing and window, mu = 30, 100 (k = 0.5) and 30 (k = 0.1, rate 10^2.5)"
 	@echo "make elastic-table - elastic pull-off vs mu (0.01 ... 100), quasi-static branch"
 	@echo "make calibrate-demo - fit a synthetic PDMS-like pull-off curve (results/calibrate/)"
@@ -83,10 +84,11 @@ bench-detail: $(STAMP)
 	$(BIN)/python -m sweep.bench.benchmarks store --out results/bench/store.json
 
 # issue 10: the whole Tabor range. Stability at the extremes of (n, k, rate, a0, mu) (144
-# scenes; QUICK=1 the covering subset), the tip-following mesh's convergence at mu = 30 and
+# scenes per model, MODEL="bem auto" by default, into results/extremes/; QUICK=1 the covering
+# subset, into results/quick/extremes/), the tip-following mesh's convergence at mu = 30 and
 # 100, the elastic pull-off against mu (quasi-static branch)
 extremes: $(STAMP)
-	$(BIN)/python -m sweep.bench.extremes $(if $(filter 1,$(QUICK)),--quick)
+	$(BIN)/python -m sweep.bench.extremes $(if $(filter 1,$(QUICK)),--quick) $(if $(MODEL),--model $(MODEL))
 
 tip-convergence: $(STAMP)
 	$(BIN)/python -m sweep.engine.tip_following --mu 30 100
