@@ -103,8 +103,6 @@ MAP: dict[tuple[str, str], tuple[str | None, str | None, str]] = {
     (_R, "sweep scene --n 0.8 --k 0.5 --mu 30 --a0 15 --rate 1"): (
         "sweep scene --n 0.8 --k 0.5 --mu 100 --a0 15 --rate 1", None,
         "about 65 s: the quick form is a scene refused for too many steps before any solve"),
-    (_R, "sweep scene --n 0.8 --k 0.5 --mu 30 --a0 10 --rate 1e-4"): (
-        "sweep scene --help", None, "about 20 s; no quick scene ends on the time budget"),
 }
 
 # the quick form reads the QUICK=1 campaign outputs where a page reads the full campaign's

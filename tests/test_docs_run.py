@@ -106,3 +106,21 @@ def test_readme_tradeoff_counts_are_results_tradeoff():
     table = pd.read_csv(ROOT / "results" / "tradeoff" / "table.csv")
     scenes = table["scene"].nunique() if "scene" in table else 3
     assert f"{len(table) // scenes} numerics x {scenes} scenes" in _readme()
+
+
+def test_readme_calibration_table_is_results_calibrate():
+    """`make calibrate-demo`'s table and cost quote results/calibrate/calibration.json."""
+    cal = json.loads((ROOT / "results" / "calibrate" / "calibration.json").read_text())
+    text = _readme()
+    for name, p in cal["parameters"].items():
+        row = re.search(rf"\| {name} [^|]*\| [^|]+ \| ([\d.]+) \| \[([\d.]+), ([\d.]+)[^|]*\] "
+                        rf"\| ([\w ]+) \|", text)
+        assert row, f"README.md: no calibration row for {name}"
+        for i, value in zip((1, 2, 3), (p["estimate"], *p["interval"])):
+            q = row.group(i)                 # equal to the digits quoted
+            half = 0.5 * 10.0 ** -len(q.partition(".")[2]) * 1.0001
+            assert abs(float(q) - value) <= half, f"README.md: {name} quotes {q}, JSON {value}"
+        assert row.group(4).strip() == p["status"], name
+    assert f"RMS log residual {cal['fit']['rms_log_residual']:.2g}" in text
+    assert f"{cal['scenes_run']} scenes ({cal['failed_scenes']} failed" in text
+    assert f"{cal['wall_s']:.0f} s wall" in text
