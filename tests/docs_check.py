@@ -38,7 +38,8 @@ Commands that cannot run as written are mapped to what runs instead through ONE 
 (``FILE.yaml``, ``master.csv``, ``results/x.h5``) are made first by ``SETUP``; the quick form
 reads the thinned ``QUICK=1`` outputs where the page reads a campaign's (``QUICK_SUBST``).
 A block that cannot run at all carries, on the line before its opening fence,
-``<!-- docs-check: skip (REASON) -->``; the runner reports it with its reason. Any other block
+``<!-- docs-check: skip (REASON) -->`` (the marker alone on its line; an inline command, the
+same marker right before it); the runner reports it with its reason. Any other block
 that fails, or whose language the runner does not know, fails the check with
 ``PAGE:LINE: ...``. Nothing is skipped silently: ``--list`` prints what runs, how, and why.
 """
@@ -220,7 +221,7 @@ def blocks(page: str, text: str | None = None) -> list[Block]:
             k = i - 1
             while k >= 0 and not lines[k].strip():
                 k -= 1
-            m = SKIP.search(lines[k]) if k >= 0 else None
+            m = SKIP.fullmatch(lines[k].strip()) if k >= 0 else None    # the marker's own line
             body = "\n".join(lines[i + 1:j])
             kind = ("console" if re.search(r"^\s*\$ ", body, re.M) else "shell") \
                 if lang in SHELL_LANGS else {"py": "python", "yml": "yaml"}.get(lang, lang)
@@ -235,8 +236,8 @@ def blocks(page: str, text: str | None = None) -> list[Block]:
         span = m.group(1)
         if not INLINE_CMD.match(span.strip()):
             continue
-        before = joined[max(0, m.start() - 200):m.start()]
-        sk = SKIP.search(before.rsplit("\n", 1)[-1]) or SKIP.search(before[-120:])
+        # an inline command is skipped by a marker right before it (whitespace between)
+        sk = re.search(SKIP.pattern + r"\s*$", joined[max(0, m.start() - 300):m.start()])
         out.append(Block(page, joined.count("\n", 0, m.start()) + 1, "inline",
                          " ".join(span.split()), sk.group(1) if sk else None))
     return sorted(out, key=lambda b: b.line)

@@ -61,6 +61,13 @@ def test_unmarked_block_it_cannot_run_fails(tmp_path, monkeypatch):
                     "```rust\nfn main() {}\n```\n")
     (step,) = dc.plan("page.md", quick=True)
     assert step.kind == "skip" and "not a language we run" in step.how
+    page.write_text("Type <!-- docs-check: skip (needs a cluster) --> `sweep run x.yaml` and "
+                    "`sweep info x.h5`; the marker `<!-- docs-check: skip (x) -->` in prose:\n"
+                    "```rust\nfn main() {}\n```\n")
+    with pytest.raises(dc.DocsCheckError, match=r"page\.md:2: a ```rust block"):
+        dc.plan("page.md", quick=True)
+    skipped = [b.text for b in dc.blocks("page.md") if b.skip]
+    assert skipped == ["sweep run x.yaml"]
 
 
 def test_failing_command_names_page_and_line(tmp_path):
