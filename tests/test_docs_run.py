@@ -131,3 +131,20 @@ def test_readme_calibration_table_is_results_calibrate():
     assert f"RMS log residual {cal['fit']['rms_log_residual']:.2g}" in text
     assert f"{cal['scenes_run']} scenes ({cal['failed_scenes']} failed" in text
     assert f"{cal['wall_s']:.0f} s wall" in text
+
+
+def test_scene_counts_the_docs_quote_are_the_configs():
+    """Scene counts quoted in README.md and docs/configs.md are those the configs expand to."""
+    from sweep.campaign.config import load_config
+
+    def count(name):
+        return len(load_config(ROOT / "configs" / f"{name}.yaml").scenes())
+
+    readme, configs = _readme(), " ".join((ROOT / "docs" / "configs.md").read_text().split())
+    assert f"runs a {count('demo')}-scene sweep" in readme
+    thr = count("threshold")
+    assert f"every 5th of its {thr} scenes ({len(range(0, thr, 5))}," in readme
+    assert f"{thr} scenes, none failed, **14.0 s**" in readme
+    assert f"({count('scale'):,} scenes:" in readme and f"{count('scale'):,} scenes, none" in readme
+    assert f"`make demo`: {count('demo')} fast scenes" in configs
+    assert f"`units: si`; {count('pdms')} scenes" in configs
