@@ -88,19 +88,27 @@ MAP: dict[tuple[str, str], tuple[str | None, str | None, str]] = {
         "about 5 min (QUICK=1: 30 s); its steps are the lines below"),
     (_R, "make threshold"): ("make threshold QUICK=1 JOBS=1", None, "the thinned grid"),
     (_R, "make vr"): ("make vr QUICK=1 JOBS=1", None, "the thinned grid"),
-    (_R, "make fig3"): ("make -n fig3 QUICK=1", None, "QUICK=1: 6 s"),
-    (_R, "make figures"): ("make -n figures QUICK=1", None, "QUICK=1: 10 s"),
-    (_R, "make report"): ("make -n report QUICK=1", None, "tests/paper/test_reproduce.py"),
+    (_R, "make fig3"): ("make -n fig3 QUICK=1", None,
+                        "about 30 s (QUICK=1: 6 s); no later line reads its output"),
+    (_R, "make figures"): ("make -n figures QUICK=1", None,
+                           "about 20 s (QUICK=1: 10 s); no later line reads its output"),
+    (_R, "make report"): ("make -n report QUICK=1", None,
+                          "the report of the campaigns; tests/paper/test_reproduce.py runs it "
+                          "on synthetic files"),
     (_R, "make reproduce QUICK=1"): (
-        "make -n reproduce QUICK=1", None, "30 s; its campaigns' quick forms run above"),
-    (_R, "make pdms"): ("make -n pdms", None, "about 15 s"),
+        "make -n reproduce QUICK=1", None,
+        "30 s; its threshold and vr campaigns ran above (make threshold / vr QUICK=1)"),
+    (_R, "make pdms"): ("make -n pdms", None,
+                        "about 15 s; tests/paper/test_pdms.py covers sweep.paper.pdms"),
     (_R, "make pdms-bem"): (
         "make -n pdms-bem", None,
         "about 20 s when it resumes the committed results/pdms/bem.json (30 min without it)"),
     (_R, "make agreement"): (
         "python -m sweep.bench.agreement --table-only", None,
         "about 5 min: the quick form rewrites its tables from the committed JSON"),
-    (_R, "make calibrate-demo"): ("make -n calibrate-demo", None, "about 5 min"),
+    (_R, "make calibrate-demo"): (
+        "make -n calibrate-demo", None,
+        "about 5 min; the line above runs sweep calibrate on a tiny FILE.yaml"),
     (_R, "sweep scene --n 0.8 --k 0.5 --mu 30 --a0 15 --rate 1"): (
         "sweep scene --n 0.8 --k 0.5 --mu 100 --a0 15 --rate 1", None,
         "about 65 s: the quick form is a scene refused for too many steps before any solve"),
@@ -587,11 +595,18 @@ def main(argv=None) -> int:
     ap.add_argument("--keep", action="store_true", help="keep the working directories")
     args = ap.parse_args(argv)
     if args.list:
+        totals: dict[str, int] = {}
+        fenced = inline = 0
         for page in args.pages:
+            fenced += sum(b.lang != "inline" for b in blocks(page))
+            inline += sum(b.lang == "inline" for b in blocks(page))
             for s in plan(page, args.quick):
                 print(f"{s.block.where:24s} {s.kind:6s} {s.how[:70]:70s} {_first(s.text)[:80]}")
+                key = s.how.split(":")[0].split(" (")[0]
+                totals[key] = totals.get(key, 0) + 1
+        print(f"{fenced} fenced blocks, {inline} inline commands; steps: {totals}")
         return 0
-    total, failed = time.perf_counter(), 0
+    total, failed, counts = time.perf_counter(), 0, {}
     for page in args.pages:
         print(f"{page}:")
         try:
@@ -601,8 +616,10 @@ def main(argv=None) -> int:
             failed += 1
             continue
         print(f"  {page}: {res['counts']} in {res['wall_s']:.1f} s")
+        for key, n in res["counts"].items():
+            counts[key] = counts.get(key, 0) + n
     print(f"docs check ({'quick' if args.quick else 'full'}): {len(args.pages) - failed} of "
-          f"{len(args.pages)} pages pass, {time.perf_counter() - total:.0f} s")
+          f"{len(args.pages)} pages pass, {time.perf_counter() - total:.0f} s; steps {counts}")
     return 1 if failed else 0
 
 
