@@ -162,9 +162,11 @@ INLINE_RUN: dict[tuple[str, str], tuple[tuple[str, ...], int]] = {
         (("failed (unresolved: the pull-off moves by 0.68",), 1),
 }
 
-# what a transcript's command must print in place of the first line the page shows, where
-# that line depends on the machine (the page says so beside it)
+# what a command must print where the page says what it prints; for a transcript, in place of
+# the first line the page shows where that line depends on the machine (the page says so)
 CHECKS: dict[tuple[str, str], tuple[str, ...]] = {
+    # "prints where results and figure are"
+    (_R, "make demo"): ("results: results/demo.h5", "figure: results/demo.png"),
     # ends on max_steps after 22603 steps when the machine is idle, on its time budget first
     # when it is loaded (README: both outputs are shown)
     (_R, "sweep scene --n 0.8 --k 0.5 --mu 30 --a0 15 --rate 1"): ("status failed (",),
@@ -398,9 +400,10 @@ def plan(page: str, quick: bool) -> list[Step]:
                 run = quick_cmd if quick else full_cmd
                 how = f"mapped: {why}" if run is not None else "as written"
                 expect, code = [], 0
+                if not (run or "").endswith("--help"):
+                    expect = list(CHECKS.get((page, cmd), ()))
                 if shown and not (run or "").endswith("--help"):
-                    expect = list(CHECKS.get((page, cmd), ())) or \
-                        [re.split(r"\d", shown[0], maxsplit=1)[0].strip()]
+                    expect = expect or [re.split(r"\d", shown[0], maxsplit=1)[0].strip()]
                     # a transcript of a failed scene: `sweep scene` exits 1
                     code = 1 if re.match(r"status\s+failed", shown[0]) else 0
                 steps.append(Step(b, "sh", subst(run if run is not None else cmd), how,
