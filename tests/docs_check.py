@@ -105,7 +105,7 @@ MAP: dict[tuple[str, str], tuple[str | None, str | None, str]] = {
         "about 20 s when it resumes the committed results/pdms/bem.json (30 min without it)"),
     (_R, "make agreement"): (
         "python -m sweep.bench.agreement --table-only", None,
-        "about 5 min: the quick form rewrites its tables from the committed JSON"),
+        "about a minute: the quick form rewrites its tables from the committed JSON"),
     (_R, "make calibrate-demo"): (
         "make -n calibrate-demo", None,
         "about 5 min; the line above runs sweep calibrate on a tiny FILE.yaml"),
