@@ -68,7 +68,7 @@ INLINE_CMD = re.compile(r"^(time\s+)?(sweep|make|python3?|\.venv/bin/[\w-]+)(\s+
 # ---------------------------------------------------------------------------------------
 # THE table. (page, command as the page gives it, comment and [optional] groups removed)
 # -> (quick form, full form, why). None: the command itself. The quick form is what
-# `make test` runs (budget: about a minute for all pages); the full form `make docs-check`.
+# `make test` runs (about 70 s for all pages); the full form `make docs-check` (about 12 min).
 # ---------------------------------------------------------------------------------------
 _R = "README.md"
 MAP: dict[tuple[str, str], tuple[str | None, str | None, str]] = {
