@@ -1,0 +1,150 @@
+"""The docs run (issue 25 item 4): every block and command of README.md and docs/*.md, in the
+quick form of tests/docs_check.py (``make docs-check`` runs the full form), and the runner's own
+rules: unmarked blocks it cannot run fail, markers are visible, the table names only commands
+the docs still give."""
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from tests import docs_check as dc
+
+ROOT = dc.ROOT
+
+
+@pytest.mark.parametrize("page", dc.PAGES)
+def test_page_runs_quick(page):
+    """Each page's blocks run in order in a fresh directory (quick form)."""
+    failure, res = None, None
+    try:
+        res = dc.check_page(page, quick=True, say=lambda line: None)
+    except dc.DocsCheckError as exc:
+        failure = str(exc)
+    if failure:
+        pytest.fail(failure, pytrace=False)
+    assert sum(res["counts"].values()) > 0
+
+
+def test_every_page_is_checked():
+    pages = {"README.md", *(f"docs/{p.name}" for p in (ROOT / "docs").glob("*.md"))}
+    assert pages == set(dc.PAGES), f"tests/docs_check.py PAGES misses {pages - set(dc.PAGES)}"
+
+
+def test_map_names_only_commands_the_docs_give():
+    """A table entry whose command left the docs is stale: the table must shrink with them."""
+    given = set()
+    for page in dc.PAGES:
+        for b in dc.blocks(page):
+            if b.lang in ("shell", "console"):
+                given |= {(page, dc._strip(c)[0]) for c, _ in dc._commands(b)}
+            elif b.lang == "inline":
+                given.add((page, dc._strip(b.text)[0]))
+    stale = [k for k in [*dc.MAP, *dc.INLINE_RUN, *dc.CHECKS] if k not in given]
+    assert not stale, f"tests/docs_check.py maps commands no page gives: {stale}"
+
+
+def test_skip_markers_give_a_reason_and_are_few():
+    skipped = [b for page in dc.PAGES for b in dc.blocks(page) if b.skip is not None]
+    assert all(len(b.skip) > 10 for b in skipped), [b.where for b in skipped]
+    assert {b.page for b in skipped} <= {"docs/cluster.md"}, [b.where for b in skipped]
+
+
+def test_unmarked_block_it_cannot_run_fails(tmp_path, monkeypatch):
+    page = tmp_path / "page.md"
+    page.write_text("# x\n\n```rust\nfn main() {}\n```\n")
+    monkeypatch.setattr(dc, "ROOT", tmp_path)
+    with pytest.raises(dc.DocsCheckError, match=r"page\.md:3: a ```rust block"):
+        dc.plan("page.md", quick=True)
+    page.write_text("# x\n\n<!-- docs-check: skip (not a language we run) -->\n"
+                    "```rust\nfn main() {}\n```\n")
+    (step,) = dc.plan("page.md", quick=True)
+    assert step.kind == "skip" and "not a language we run" in step.how
+    page.write_text("Type <!-- docs-check: skip (needs a cluster) --> `sweep run x.yaml` and "
+                    "`sweep info x.h5`; the marker `<!-- docs-check: skip (x) -->` in prose:\n"
+                    "```rust\nfn main() {}\n```\n")
+    with pytest.raises(dc.DocsCheckError, match=r"page\.md:2: a ```rust block"):
+        dc.plan("page.md", quick=True)
+    skipped = [b.text for b in dc.blocks("page.md") if b.skip]
+    assert skipped == ["sweep run x.yaml"]
+
+
+def test_failing_command_names_page_and_line(tmp_path):
+    block = dc.Block("README.md", 42, "shell", "false")
+    with pytest.raises(dc.DocsCheckError, match=r"^README\.md:42: `false` exited 1"):
+        dc.run_step(dc.Step(block, "sh", "false", "as written"), tmp_path, timeout=10)
+    shown = dc.Step(block, "sh", "echo status ok", "as written", expect=["status  failed"])
+    with pytest.raises(dc.DocsCheckError, match=r"README\.md:42: .* did not print"):
+        dc.run_step(shown, tmp_path, timeout=10)
+
+
+def test_commands_strip_comments_and_optional_groups():
+    cmd, flags = dc._strip("sweep pb --n 0.4 --v 1e-2,1 [--json] [-j 2]   # Gamma_eff [mN]")
+    assert cmd == "sweep pb --n 0.4 --v 1e-2,1" and flags == ["--json"]
+    b = dc.Block("x.md", 1, "console", "$ sweep scene --a0 2 \\\n  --rate 1   # 3 s\nstatus  ok 2.1")
+    assert dc._commands(b) == [("sweep scene --a0 2 --rate 1   # 3 s", ["status  ok 2.1"])]
+
+
+# -- numbers the README quotes from committed results files ----------------------------------
+
+def _readme() -> str:
+    return " ".join((ROOT / "README.md").read_text().split())
+
+
+def test_readme_bench_table_is_results_bench_json():
+    """The `make bench` table quotes results/bench.json (the committed run)."""
+    bench = json.loads((ROOT / "results" / "bench.json").read_text())
+    text = _readme()
+    som = bench["step_over_matvec"]
+    assert f"{som['500']:.3g}" in text                                      # 4.35
+    assert f"| `compile_s` cold / cached | {bench['compile_s']['cold']:.0f} s" in text
+    assert f"| {bench['scenes_per_minute']:.0f} (every 5th" in text
+    assert f"**{bench['parallel_speedup']:.2f}**" in text
+    assert f"| {bench['scale_minutes']:.1f} (the 80 sampled" in text
+    for key, ps in bench["prony_speedup"].items():
+        assert re.search(rf"\b{ps:.0f}\b", text), (key, ps)
+
+
+def test_readme_tradeoff_counts_are_results_tradeoff():
+    """`make tradeoff`'s figures: 57 numerics x 3 scenes (results/tradeoff/table.csv)."""
+    import pandas as pd
+
+    table = pd.read_csv(ROOT / "results" / "tradeoff" / "table.csv")
+    scenes = table["scene"].nunique() if "scene" in table else 3
+    assert f"{len(table) // scenes} numerics x {scenes} scenes" in _readme()
+
+
+def test_readme_calibration_table_is_results_calibrate():
+    """`make calibrate-demo`'s table and cost quote results/calibrate/calibration.json."""
+    cal = json.loads((ROOT / "results" / "calibrate" / "calibration.json").read_text())
+    text = _readme()
+    for name, p in cal["parameters"].items():
+        row = re.search(rf"\| {name} [^|]*\| [^|]+ \| ([\d.]+) \| \[([\d.]+), ([\d.]+)[^|]*\] "
+                        rf"\| ([\w ]+) \|", text)
+        assert row, f"README.md: no calibration row for {name}"
+        for i, value in zip((1, 2, 3), (p["estimate"], *p["interval"])):
+            q = row.group(i)                 # equal to the digits quoted
+            half = 0.5 * 10.0 ** -len(q.partition(".")[2]) * 1.0001
+            assert abs(float(q) - value) <= half, f"README.md: {name} quotes {q}, JSON {value}"
+        assert row.group(4).strip() == p["status"], name
+    assert f"RMS log residual {cal['fit']['rms_log_residual']:.2g}" in text
+    assert f"{cal['scenes_run']} scenes ({cal['failed_scenes']} failed" in text
+    assert f"{cal['wall_s']:.0f} s wall" in text
+
+
+def test_scene_counts_the_docs_quote_are_the_configs():
+    """Scene counts quoted in README.md and docs/configs.md are those the configs expand to."""
+    from sweep.campaign.config import load_config
+
+    def count(name):
+        return len(load_config(ROOT / "configs" / f"{name}.yaml").scenes())
+
+    readme, configs = _readme(), " ".join((ROOT / "docs" / "configs.md").read_text().split())
+    assert f"runs a {count('demo')}-scene sweep" in readme
+    thr = count("threshold")
+    assert f"every 5th of its {thr} scenes ({len(range(0, thr, 5))}," in readme
+    assert f"{thr} scenes, none failed, **14.0 s**" in readme
+    assert f"({count('scale'):,} scenes:" in readme and f"{count('scale'):,} scenes, none" in readme
+    assert f"`make demo`: {count('demo')} fast scenes" in configs
+    assert f"`units: si`; {count('pdms')} scenes" in configs
