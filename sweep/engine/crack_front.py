@@ -381,7 +381,9 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     vanished.direction = -1.0
 
     # time scale: the indentation at which a JKR contact with Gamma = g_max would be gone
-    span = (abs(delta0) + 2.0 * a0 * a0 + 10.0) / abs(ddot)
+    # (delta = a0^2 - sqrt(2 a0 g_max): a frozen contact opens only when g nears g_max = 1/k)
+    g_max = float(getattr(law, "g_max", 1.0))
+    span = (abs(delta0) + 2.0 * a0 * a0 + 10.0 + math.sqrt(2.0 * a0 * g_max)) / abs(ddot)
     try:
         out = solve_ivp(rhs, (t1, t1 + span), [a0], method="Radau", jac=jac,
                         events=[tensile_minimum, vanished], rtol=rtol, atol=rtol * a0,

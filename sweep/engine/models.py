@@ -256,14 +256,16 @@ NAMES = {"pb": "PB estimate", "crack": "crack-front model", "bem": "BEM",
          "elastic": "elastic branch"}
 
 
-def _fallback(scene, numerics, failed) -> Choice | None:
-    """After the BEM failed an "auto" scene for a reason another model can lift (not a
-    physical refusal): the crack-front model, the physical limit where the BEM cannot
-    resolve the tip zone, with its measured error; None where it cannot answer either."""
-    if (is_physical_refusal(failed.reason) or not _accepts("crack", scene)
-            or math.isnan(measured_error("crack", scene.mu))):
+def _fallback(scene, failed: Result, model: str) -> Choice | None:
+    """After the BEM (or the elastic branch) failed an "auto" scene for a reason another
+    model can lift (not a physical refusal): the crack-front model, the physical limit where
+    the BEM cannot resolve the tip zone, with its measured error (a contact below its
+    fixed-grip limit it refuses, for that physical reason); None where it cannot answer
+    either (mu below its measurement)."""
+    if is_physical_refusal(failed.reason) or math.isnan(measured_error("crack", scene.mu)):
         return None
-    return Choice("crack", f"auto: crack-front model: the BEM failed ({failed.reason[:160]})")
+    return Choice("crack", f"auto: crack-front model: the {NAMES[model]} failed "
+                           f"({failed.reason[:160]})")
 
 
 #: model name -> simulate(scene, numerics=None) -> Result
@@ -320,8 +322,8 @@ def simulate_model(scene, model: str = "bem", numerics=None):
                 f"pull_off_rtol {numerics.pull_off_rtol:g}" if res.ok else
                 f"auto: BEM: the {NAMES[choice.model]} failed ({res.reason[:120]})")
         choice, res = Choice("bem", miss), _run("bem", scene, numerics)
-    if model == "auto" and choice.model == "bem" and res.status == "failed":
-        fallback = _fallback(scene, numerics, res)
+    if model == "auto" and choice.model in ("bem", "elastic") and res.status == "failed":
+        fallback = _fallback(scene, res, choice.model)
         if fallback is not None:
             choice, res = fallback, _run("crack", scene, numerics)
             if res.ok:
@@ -329,7 +331,9 @@ def simulate_model(scene, model: str = "bem", numerics=None):
     res.model_used = choice.model
     res.model_reason = choice.reason
     if choice.model == "crack" and res.ok and model == "auto":
-        res.model_reason += f"; measured error {res.error_estimate:.2g}"
+        tol = numerics.pull_off_rtol
+        over = f" (above pull_off_rtol {tol:g})" if res.error_estimate > tol else ""
+        res.model_reason += f"; measured error {res.error_estimate:.2g}{over}"
     return res
 
 

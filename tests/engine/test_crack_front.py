@@ -161,3 +161,12 @@ def test_the_integrator_keeps_the_time_budget():
     law = PerssonBrenerLaw(2.5, 0.93, l0_hat(100.0), "mpl")
     sol = unload(law, rate=1e9, mu=100.0, a0=3.0, time_budget_s=1e-6)
     assert sol.status == "failed" and sol.reason.startswith("time budget")
+
+
+def test_a_frozen_contact_opens_within_the_time_span():
+    """Unloaded far faster than the crack runs (rate 1.44e9, k = 3e-4), the contact opens
+    only where g nears g_max = 1/k: the integration span reaches that indentation (it ended
+    before, 'no load minimum'); the pull-off lies between 1.5 and the glassy 2/k."""
+    res = simulate_crack(Scene(n=3.55, k=0.000302, mu=13.72, a0=0.911, rate=1.44e9))
+    assert res.ok, res.reason
+    assert 1.5 < res.pull_off < 2 / 0.000302

@@ -186,3 +186,12 @@ def test_the_scene_limits_are_the_union_of_the_model_ranges():
         for r in filter(None, ranges):
             assert lo <= r[0] and r[1] <= hi
     assert any(not r for r in models.MODEL_RANGES.values())   # one model takes every scene
+
+
+def test_an_elastic_branch_failure_is_not_the_answer_of_auto():
+    """k = 1 from a0 = 0.31 at mu = 11.8: the elastic branch's Newton fails there (a random
+    sample's scene); the crack-front model, its mu -> infinity limit, refuses the contact for
+    the physical reason (below the fixed-grip limit a0 = 0.5)."""
+    res = models.simulate(Scene(n=0.779, k=1.0, mu=11.82, a0=0.31, rate=2.65e5, model="auto"))
+    assert res.status == "failed" and is_physical_refusal(res.reason), res.reason
+    assert res.model_reason.startswith("auto: crack-front model: the elastic branch failed")
