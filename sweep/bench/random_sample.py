@@ -105,8 +105,8 @@ def plot_map(results: Path = RESULTS) -> Path | None:
     for kind, marker in (("refused", "s"), ("failed", "x"), ("error", "X")):
         d = df[[k == kind for k in kinds]]
         if len(d):
-            ax.scatter(d.mu, d.rate, c="k", marker=marker, s=30, label=f"{kind} ({len(d)})",
-                       facecolors="none" if marker == "s" else None)
+            style = (dict(facecolors="none", edgecolors="k") if marker == "s" else dict(c="k"))
+            ax.scatter(d.mu, d.rate, marker=marker, s=30, label=f"{kind} ({len(d)})", **style)
     ax.axvline(100.0, color="0.6", lw=0.8, ls="--")
     ax.set(xscale="log", yscale="log", xlabel="Tabor parameter mu",
            ylabel="unloading rate r tau0 / h0",
@@ -127,7 +127,7 @@ def plot_map(results: Path = RESULTS) -> Path | None:
     bx.set(xscale="log", yscale="log", xlabel="Tabor parameter mu",
            ylabel="|crack-front / BEM - 1|",
            title="crack-front model vs the BEM (make model-errors)")
-    bx.legend(fontsize=8, loc="lower left")
+    bx.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
     out = results / "model_map.png"
     fig.savefig(out, dpi=120)
