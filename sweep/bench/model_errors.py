@@ -25,7 +25,7 @@ import numpy as np
 
 from ..campaign.store import provenance, to_jsonable
 from ..engine.crack_front import simulate_crack
-from ..engine.models import simulate, simulate_pb
+from ..engine.models import amplification, simulate, simulate_pb
 from ..scene import Numerics, Scene
 
 #: Tabor parameters of the measurement (the crack-front model is the mu -> infinity limit)
@@ -63,13 +63,6 @@ def run_scene(d: dict, budget_s: float) -> dict:
                                  if bem.ok and math.isfinite(row[f"{name}_pull_off"])
                                  else math.nan)
     return row
-
-
-def amplification(pull_off: float) -> float:
-    """The amplification of a model's pull-off over the elastic JKR one, ``P / 1.5``, at
-    least 1: with mu the variable the models' difference from the BEM grows with (a strongly
-    amplified crack opens with a tip zone much smaller than l0)."""
-    return max(pull_off / 1.5, 1.0)
 
 
 def _diff(row: dict, name: str) -> float:

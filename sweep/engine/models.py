@@ -171,7 +171,8 @@ def _fits() -> dict:
 
 def amplification(pull_off: float) -> float:
     """``max(P / 1.5, 1)``: a pull-off over the elastic JKR one, the second variable of the
-    measured error (:func:`measured_error`)."""
+    measured error (:func:`measured_error`): the models' difference from the BEM grows with
+    it (a strongly amplified crack opens with a tip zone much smaller than l0)."""
     return max(pull_off / 1.5, 1.0)
 
 
@@ -232,9 +233,10 @@ def model_choice(scene, numerics=None) -> Choice:
         return Choice("elastic", "auto: k = 1, quasi-static: the elastic branch")
     if not bem_ok:
         lo, hi = BEM_MU_RANGE
+        measured = _fits()["crack"]["mu_range"][1]
         return Choice("crack", f"auto: crack-front model, the mu -> infinity limit: mu = "
                                f"{scene.mu:g} is beyond the BEM's range [{lo:g}, {hi:g}] "
-                               f"(its error measured up to mu = {_fits()['crack']['mu_range'][1]:g})")
+                               f"(its error measured up to mu = {measured:g})")
     tol = numerics.pull_off_rtol
     for model in BY_COST[:-1]:
         err = measured_error(model, scene.mu)
