@@ -118,12 +118,23 @@ def _main(argv=None) -> int:
     p.add_argument("--out", default="results/error_coverage")
     p.add_argument("--probe", action="store_true",
                    help="also run each preset without its check and at the check's resolution")
+    p.add_argument("--grow", action="store_true",
+                   help="keep the rows of OUT/coverage.json (same seed) and run only the "
+                        "scenes it lacks (a larger --scenes extends the sample)")
     args = p.parse_args(argv)
     from joblib import Parallel, delayed
 
     t0 = time.perf_counter()
-    scenes = sample(args.scenes, args.seed)
-    rows = []
+    out = Path(args.out)
+    rows, wall, commands = [], 0.0, []
+    if args.grow and (out / "coverage.json").exists():
+        old = json.loads((out / "coverage.json").read_text())
+        if old["seed"] != args.seed:
+            raise SystemExit(f"error: --grow: {out / 'coverage.json'} has seed {old['seed']}, "
+                             f"not {args.seed}")
+        rows, wall, commands = old["rows"], old["wall_s"], old["command"].split(" && ")
+    have = [r["scene"] for r in rows]
+    scenes = [d for d in sample(args.scenes, args.seed) if d not in have]
     for row in Parallel(n_jobs=args.jobs, return_as="generator_unordered")(
             delayed(run_scene)(d, args.budget, args.probe) for d in scenes):
         rows.append(row)
@@ -137,13 +148,13 @@ def _main(argv=None) -> int:
         print(f"{name:9} {s['scenes']} scenes: coverage {s['coverage']:.2f}, median "
               f"looseness {s['median_looseness']:.3g}, median true error "
               f"{s['median_true_error']:.2g}")
-    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     command = " ".join(["python -m sweep.bench.error_coverage",
                         *(sys.argv[1:] if argv is None else argv)])
     (out / "coverage.json").write_text(json.dumps(to_jsonable(
-        {"summary": summary, "rows": rows, "seed": args.seed, "wall_s": time.perf_counter() - t0,
-         "reference": REFERENCE, "command": command, "date": time.strftime("%Y-%m-%d"),
+        {"summary": summary, "rows": rows, "seed": args.seed,
+         "wall_s": wall + time.perf_counter() - t0, "reference": REFERENCE,
+         "command": " && ".join([*commands, command]), "date": time.strftime("%Y-%m-%d"),
          **provenance()}), indent=1))
     return 0
 
