@@ -35,9 +35,10 @@ def resolution_error(spacing: float, length: float) -> float:
     (spacing/length)^2, with ``spacing`` the fine node spacing and ``length`` the tip zone
     it resolves (both a_ref).
 
-    A bound of the measured convergence: over a random sample of scenes
-    (``make error-coverage``) the pull-off error times (tip zone/spacing)^2 reached 2.2 (a
-    narrow-band, fast scene at mu = 1.6); on the reference scenes A, D, F it stays below 0.22.
+    A bound of the measured convergence: the pull-off error times (tip zone/spacing)^2
+    reached 2.2 on the narrow-band, fast scene at mu = 1.58 of
+    ``tests/engine/test_resolution.py`` (fast, balanced and accurate presets against a much
+    finer run, 2026-11-25); on the reference scenes A, D, F it stays below 0.22.
     """
     return RESOLUTION_ERROR_K * (spacing / length) ** 2
 
