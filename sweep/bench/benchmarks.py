@@ -290,6 +290,29 @@ def compile_seconds() -> dict:
     return out
 
 
+def _process_wall(argv: list[str], repeat: int) -> float:
+    """The best wall time of ``repeat`` runs of a command as a whole process, s."""
+    best = math.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        subprocess.run(argv, capture_output=True, check=True)
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def bench_scene_process(repeat: int = 3) -> dict:
+    """A single ``sweep scene`` (the paper scene, fast preset, Numba cache warm) as a whole
+    process against ``python -c "import numpy, scipy"`` (issue 24 item 3: under 2x)."""
+    sweep_cmd = str(Path(sys.executable).with_name("sweep"))
+    scene = [sweep_cmd, "scene", *(f"--{k}={v}" for k, v in PAPER_SCENE.items()),
+             "--preset", "fast"]
+    subprocess.run(scene, capture_output=True, check=True)          # the cache filled
+    imports = _process_wall([sys.executable, "-c", "import numpy, scipy"], repeat)
+    one = _process_wall(scene, repeat)
+    return {"scene_process_s": one, "import_numpy_scipy_s": imports, "ratio": one / imports,
+            "command": " ".join(["sweep", *scene[1:]]), "repeat": repeat}
+
+
 def bench_scene(repeat: int = 3, compile_: bool = True) -> dict:
     """Issue-3 numbers: per-preset wall time of the paper's scene, time per step over one
     dense matvec, Prony vs exact speed-up at equal steps, compile time."""
@@ -934,6 +957,13 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     progress(f"scale: {scale['scenes']} scenes in about {scale['minutes_estimate']:.1f} min "
              f"(cold upper bound {scale['minutes_sample_rate']:.1f}; sample of "
              f"{scale['sample']}: {scale['status_counts']})")
+    report["scene_process_over_import"] = None
+    if plan.compile:                                 # fresh processes, as compile_s
+        proc = bench_scene_process()
+        report["scene_process_over_import"] = proc["ratio"]
+        report["scene_process_detail"] = proc
+        progress(f"scene_process_over_import: {proc['ratio']:.2f} ({proc['scene_process_s']:.2f} "
+                 f"s vs {proc['import_numpy_scipy_s']:.2f} s)")
     choice = bench_model_choice()
     report["model_choice_ms"] = choice["ms_per_scene"]
     report["model_choice_detail"] = choice
@@ -971,6 +1001,9 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
                          "(set-up cached) cost scaled to the grid, plus one relaxed start "
                          "per start group and worker, over the sample's parallel speed-up; "
                          "scale_detail.minutes_sample_rate is the cold upper bound",
+        "scene_process_over_import": "best-of-3 wall of one `sweep scene` process (the paper "
+                                     "scene, fast preset, Numba cache warm) over that of "
+                                     "`python -c 'import numpy, scipy'`",
         "model_choice_ms": "milliseconds per scene of model_choice (what model auto runs), "
                            "balanced preset, over a seeded sample of 2000 scenes across the "
                            "declared ranges (a second, warm pass)",

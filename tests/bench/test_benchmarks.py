@@ -148,6 +148,8 @@ def test_bench_json_keys_with_a_tiny_plan():
         assert 0.0 < c["subset_fraction"] <= 1.0 and c["factorizations"] >= 1
     assert set(rep["prony_speedup"]) == {str(n) for n in plan.prony_steps}
     assert rep["compile_s"] is None                          # tiny: no fresh processes
+    assert rep["scene_process_over_import"] is None
+    assert rep["model_choice_ms"] > 0 and sum(rep["model_choice_detail"]["chosen"].values()) == 2000
     assert rep["scenes_per_minute"] > 0 and rep["parallel_speedup"] > 0
     sc = rep["scale_detail"]
     assert sc["sample"] == plan.scale_sample == sc["ran"] == sum(sc["status_counts"].values())
@@ -214,3 +216,12 @@ def test_newton_diagnosis_pairs_states_with_their_times():
     assert len(rows) == 3 and all(r["median"] < 1e-3 for r in rows)
     assert 0.0 <= out["chord_spectral_radius_after_steps"]["1"] < 0.5
     assert out["counters"]["newton_iterations_per_step"] >= 1.0
+
+
+def test_scene_process_is_timed_against_the_imports_of_numpy_and_scipy():
+    from sweep.bench.benchmarks import bench_scene_process
+
+    rep = bench_scene_process(repeat=1)
+    assert rep["command"].startswith("sweep scene --n=0.8") and "--preset fast" in rep["command"]
+    assert rep["ratio"] == pytest.approx(rep["scene_process_s"] / rep["import_numpy_scipy_s"])
+    assert rep["scene_process_s"] > rep["import_numpy_scipy_s"] > 0   # it imports both
