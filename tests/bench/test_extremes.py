@@ -209,3 +209,18 @@ def test_random_sample_auto_fails_only_for_physical_reasons():
     bad = [(extremes._scene_str(r), r["model"], r["reason"]) for r in _slow_rows()
            if r["cls"] not in ("ok", "refused")]
     assert not bad, bad
+
+
+def test_a_row_is_held_to_the_error_it_states():
+    from sweep.scene import Result
+    """The crack-front model's row at the slowest rate may differ from the relaxed elastic
+    pull-off by the error it states (its measured difference from the BEM), not more."""
+    d = dict(n=2.5, k=1e-4, rate=min(extremes.RATES), a0=15.0, mu=100.0)
+    lo = extremes.relaxed_pull_off(100.0, 15.0)
+    res = Result(scene=Scene(**d), numerics=Numerics.preset("fast"), status="ok",
+                 pull_off=1.015 * lo)
+    assert extremes.judge(d, res).startswith("WRONG")              # no stated error: 1 %
+    res.error_estimate = 0.028
+    assert extremes.judge(d, res) == "ok"
+    res.pull_off = 1.03 * lo
+    assert extremes.judge(d, res).startswith("WRONG")
