@@ -200,11 +200,10 @@ def test_random_sample_auto_large():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=False, reason="known holes of auto (issue 21; seed 21 on 2026-11-25: "
-                   "49 ok, 1 refused, 10 failed): it routes a0 < 0.5 beyond mu = 100 to the "
-                   "crack-front model, which fails 'InputError: a0 must be >= 0.5' (5), the "
-                   "crack-front model finds 'no load minimum' at fast rates (4), and the BEM "
-                   "'could not reach the initial contact radius' at mu = 0.03, a0 = 0.5 (1)")
+@pytest.mark.xfail(strict=False, reason="a known hole of auto (issue 21; seed 21, 2026-11-25 "
+                   "after the chooser: 53 ok, 6 physically refused, 1 failed): the BEM 'could "
+                   "not reach the initial contact radius' at mu = 0.033, a0 = 0.50 (the DMT "
+                   "side, where no other model answers)")
 def test_random_sample_auto_fails_only_for_physical_reasons():
     bad = [(extremes._scene_str(r), r["model"], r["reason"]) for r in _slow_rows()
            if r["cls"] not in ("ok", "refused")]
