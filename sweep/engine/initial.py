@@ -134,6 +134,11 @@ def relaxed_state(el: ElasticSolver, delta0=None, a0=None, mesh_key=None):
     return h, d
 
 
+#: the smallest d delta/da of the JKR branch the radius search starts from (its fold at
+#: a = 1/2 has none)
+MIN_JKR_DDELTA_DA = 0.25
+
+
 def _solve_relaxed(el: ElasticSolver, delta0=None, a0=None):
     """The relaxed state of :func:`relaxed_state`, solved."""
     if delta0 is not None:
@@ -143,7 +148,9 @@ def _solve_relaxed(el: ElasticSolver, delta0=None, a0=None):
     d1 = a0 * a0 - math.sqrt(2.0 * a0)
     h1 = _solve_at(el, d1)
     f1 = el.radius(h1) - a0
-    slope = 1.0 / (2 * a0 - 0.5 ** 0.5 * a0 ** -0.5)     # JKR da/d delta
+    # JKR da/d delta, d delta/da = 2 a - (2 a)^(-1/2) kept from the fold at a = 1/2, where it
+    # vanishes (a0 = 0.500-0.505 at mu = 0.03 sent the secant astray)
+    slope = 1.0 / max(2 * a0 - 0.5 ** 0.5 * a0 ** -0.5, MIN_JKR_DDELTA_DA)
     d2 = d1 - f1 / slope
     lo = hi = None
     for _ in range(60):

@@ -58,3 +58,19 @@ def test_viscoelastic_low_mu_between_the_relaxed_limit_and_2_over_k(mu):
         res = simulate(Scene(n=0.8, k=k, mu=mu, a0=a0, rate=rate))
         assert res.ok, res.reason
         assert relaxed * (1 - 1e-3) < res.pull_off < 2.0 / k
+
+
+@pytest.mark.parametrize("a0", [0.5, 0.5016, 0.505])
+def test_initial_radius_at_the_jkr_fold(a0):
+    """The radius search starts from the JKR branch, whose d delta/da vanishes at a = 1/2:
+    at mu = 0.033 a0 = 0.500-0.505 failed 'could not reach the initial contact radius' (a
+    random sample's scene) while 0.49 and 0.51 ran; the pull-off lies between theirs."""
+    from sweep import Numerics, Scene
+    from sweep.engine.models import simulate
+
+    kw = dict(n=0.1913, k=0.002652, mu=0.03253, rate=0.0003383)
+    num = Numerics.preset("balanced")
+    res, lo, hi = (simulate(Scene(**kw, a0=a), num) for a in (a0, 0.49, 0.51))
+    assert res.ok and lo.ok and hi.ok, res.reason
+    assert res.a0_result == pytest.approx(a0, rel=1e-9)
+    assert lo.pull_off < res.pull_off < hi.pull_off
