@@ -178,7 +178,8 @@ def classify(scene: dict, res) -> tuple[str, str]:
 def _row(d, model, res, seconds) -> dict:
     cls, verdict = classify(d, res)
     return dict(d, asked=model, status=res.status, reason=res.reason, pull_off=res.pull_off,
-                model=res.model_used or model, nodes=res.nodes_used,
+                error_estimate=res.error_estimate, model=res.model_used or model,
+                nodes=res.nodes_used,
                 lower=relaxed_pull_off(d["mu"], d["a0"]),
                 upper=upper_bound(d["mu"], d["k"], d["a0"]),
                 cls=cls, verdict=verdict, seconds=seconds)
