@@ -306,7 +306,7 @@ def bem_point(speed_um: float, case=PDMS_CASE, mu: float = BEM_MU, preset: str =
     dict
         ``speed_um_s``, ``mu``, ``h0_nm``, ``preset``, ``band_resolution``, ``status``,
         ``reason``, ``pull_off_mN``, ``pull_off_hat`` (pi dg R), ``error_indicator`` (the
-        engine's relative pull-off error indicator, ``Result.error_estimate``),
+        engine's relative pull-off error estimate, ``Result.error_estimate``),
         ``crack_speed_um_s`` (at pull-off), ``steps``, ``nodes``, ``wall_s``.
     """
     from ..engine.tip_following import simulate_tip_following

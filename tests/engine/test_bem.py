@@ -22,7 +22,7 @@ def _ref():
 
 
 def elastic(mu, a0=2.0, **num):
-    # compared with independent values: the error indicator's second solve is skipped
+    # compared with independent values: the error estimate's second solve is skipped
     num = {"nodes": 1000, "domain": 5.0, "step": 0.05, "tol": 1e-9, "pull_off_rtol": 0.0, **num}
     return simulate(Scene(n=1.0, k=1.0, mu=mu, a0=a0, rate=1.0), Numerics(**num))
 
@@ -86,7 +86,7 @@ def test_viscoelastic_matches_independent_solver(name):
 @pytest.mark.parametrize("n, rate", [(0.4, 3.16), (1.6, 316.2)])
 def test_prony_matches_exact_convolution(n, rate):
     # same step sequence (da_max off), default Prony tolerance of the balanced preset; two
-    # time integrators on the same coarse mesh (the mesh error indicator is off). 90 nodes:
+    # time integrators on the same coarse mesh (the mesh error estimate is off). 90 nodes:
     # on 100 and 120 the n = 1.6 scene's jump-off, 3 steps after the pull-off, finds no
     # equilibrium for the Prony run since the zone Newton of session 17 (the old Woodbury
     # Newton converged there by another path; both agree to every printed digit up to it)

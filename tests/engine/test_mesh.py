@@ -1,4 +1,4 @@
-"""Graded meshes (sweep.engine.mesh), the stop rule and the error indicator of a result."""
+"""Graded meshes (sweep.engine.mesh), the stop rule and the error estimate of a result."""
 import numpy as np
 import pytest
 

@@ -26,7 +26,7 @@ def test_uniform_nodes_resolves_none():
     assert Numerics(nodes=80).uniform_nodes == 80
     assert scene_mesh(NUM, 0.1, 2.0, 10.0).nodes == 500
     assert models.bem_node_budget(NUM) == 500
-    # the error indicator's cheaper solve really is coarser (half the nodes), not the same mesh
+    # the error estimate's cheaper solve really is coarser (half the nodes), not the same mesh
     assert coarser(NUM).nodes == 250 and coarser(Numerics(nodes=80)).nodes == 40
 
 
