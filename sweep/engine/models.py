@@ -314,22 +314,27 @@ def simulate_model(scene, model: str = "bem", numerics=None):
         choice = Choice("elastic", "bem: k = 1, quasi-static: the elastic branch")
     else:
         choice = Choice(model, f"{model}: asked for")
-    res = _run(choice.model, scene, numerics)
-    if res.ok and choice.model in ("crack", "pb"):
-        res.error_estimate = _model_error(choice.model, scene, res)
+    ran: dict[str, Result] = {}
+
+    def run(name: str) -> Result:     # each model at most once (a cheaper try is reused)
+        if name not in ran:
+            ran[name] = _run(name, scene, numerics)
+            if ran[name].ok and name in ("crack", "pb"):
+                ran[name].error_estimate = _model_error(name, scene, ran[name])
+        return ran[name]
+
+    res = run(choice.model)
     if model == "auto" and choice.model in ("crack", "pb") and scene.mu <= BEM_MU_RANGE[1] \
             and not res.error_estimate <= numerics.pull_off_rtol:
         miss = (f"auto: BEM: the {NAMES[choice.model]}'s measured error at its amplification "
                 f"{amplification(res.pull_off):.3g}, {res.error_estimate:.2g}, exceeds "
                 f"pull_off_rtol {numerics.pull_off_rtol:g}" if res.ok else
                 f"auto: BEM: the {NAMES[choice.model]} failed ({res.reason[:120]})")
-        choice, res = Choice("bem", miss), _run("bem", scene, numerics)
+        choice, res = Choice("bem", miss), run("bem")
     if model == "auto" and choice.model in ("bem", "elastic") and res.status == "failed":
         fallback = _fallback(scene, res, choice.model)
         if fallback is not None:
-            choice, res = fallback, _run("crack", scene, numerics)
-            if res.ok:
-                res.error_estimate = _model_error("crack", scene, res)
+            choice, res = fallback, run("crack")
     res.model_used = choice.model
     res.model_reason = choice.reason
     if choice.model == "crack" and res.ok and model == "auto":
