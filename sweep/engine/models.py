@@ -50,7 +50,7 @@ from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
 from .mesh import scene_mesh
 from .problem import BEM_MU_RANGE, derive
 from .quasistatic import simulate_elastic
-from .tip_following import simulate_tip_following
+from .tip_following import simulate_tip_following, window_nodes
 
 __all__ = ["MODELS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
            "simulate_scene", "choose_model", "model_choice", "Choice", "measured_error",
@@ -122,12 +122,28 @@ def _bem(scene, numerics=None):
     return bem.simulate(scene, numerics)
 
 
+#: a graded mesh sized from the band resolution runs as the tip-following mesh where its
+#: fixed crack band has this many times the nodes of the tip-following mesh (or more): a
+#: time step costs about nodes^2 (the dense residual), and the band grows with a0 while the
+#: window does not; where the tip leaves the band (slow rates) the graded mesh also solves
+#: the scene twice. Measured on the threshold grid at mu 3.24 with the balanced preset
+#: (n 0.4-1.6, k 0.1, rates 1-1e6, 2026-11-25): at a0 = 4.5 (1.16 times) the 32 scenes took
+#: 14.5 s of scene wall on the window against 25.7 s on the band, at a0 = 4 (1.08 times)
+#: 13.1 s against 12.1 s; pull-offs within 5e-5 of each other (docs/performance.md)
+TIP_FOLLOWING_NODE_RATIO = 1.1
+
+
 def wants_tip_following(scene, numerics) -> bool:
     """Whether a BEM scene runs on the tip-following mesh (:mod:`sweep.engine.tip_following`):
     a graded mesh sized from the band resolution (``nodes`` unset, not ``exact``) whose
-    fixed crack band would need more than ``numerics.max_nodes`` nodes (large mu or a0)."""
-    return (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact
-            and bem_nodes_needed(scene, numerics) > numerics.max_nodes)
+    fixed crack band would need more than ``numerics.max_nodes`` nodes (large mu or a0), or
+    :data:`TIP_FOLLOWING_NODE_RATIO` times the nodes of the window that follows the tip (the
+    cheaper mesh at equal resolution)."""
+    if not (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact):
+        return False
+    graded = bem_nodes_needed(scene, numerics)
+    return (graded > numerics.max_nodes
+            or graded >= TIP_FOLLOWING_NODE_RATIO * window_nodes(scene, numerics))
 
 
 def bem_nodes_needed(scene, numerics=None) -> int:

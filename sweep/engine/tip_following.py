@@ -39,12 +39,14 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
 from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
-                           STATUS_LEFT_BAND, STATUS_STEP_LIMIT, new_jacobian_cache, newton)
+                           STATUS_LEFT_BAND, STATUS_STEP_LIMIT, invalidate, new_jacobian_cache,
+                           newton)
 from ..kernels.interface import lj_traction
 
 from ..scene import Numerics, Result, Scene
 from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, no_contact_reason, unload_chunk
 from .initial import ElasticSolver, relaxed_state
+from .mesh import scene_mesh
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Refused, derive, jkr_radius, material_of, prepare
 from .quasistatic import ElasticBranch
@@ -186,6 +188,17 @@ def tip_window(tip: float, zone: float, ahead: float = WINDOW_AHEAD_ZONES,
     else:
         lo, hi = tip - behind * zone, tip + ahead * zone
     return max(lo, 0.0), hi
+
+
+def window_nodes(scene: Scene, numerics: Numerics, ahead: float = WINDOW_AHEAD_ZONES,
+                 behind: float = WINDOW_BEHIND_ZONES) -> int:
+    """Nodes of a scene's first tip-following mesh (the window at the estimated initial
+    contact radius, graded outside it): what one time step costs on this mesh, against
+    :func:`sweep.engine.models.bem_nodes_needed` on the graded mesh."""
+    s = derive(scene, numerics)
+    num = dataclasses.replace(numerics, mesh="graded", nodes=None, exact=False)
+    return scene_mesh(num, s.tip_zone, s.a0_estimate, s.domain,
+                      band=tip_window(s.a0_estimate, s.tip_zone, ahead, behind)).nodes
 
 
 def transfer(run, old, new, form: str = "auto") -> None:
@@ -399,6 +412,34 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
     return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
 
 
+#: a0 (a_ref) from which the initial state on the window mesh is first solved directly, as
+#: on the graded mesh (:func:`sweep.engine.initial.relaxed_state`, cached per process): twice
+#: the JKR fold radius 1/2, far above the fold of the relaxed branch at any mu; below it, and
+#: where the direct state's tip is not at a0 (a tip on the coarse mesh outside the window, at
+#: large mu), the state comes from the quasi-static branch (:func:`branch_state`)
+DIRECT_INITIAL_A0 = 1.0
+
+
+def _direct_initial_state(el: ElasticSolver, pb, scene: Scene):
+    """The relaxed state solved directly on the window mesh of ``pb`` (as the graded mesh
+    does, and cached alike): (gap, indentation), or None where that is not to be trusted
+    (a0 below :data:`DIRECT_INITIAL_A0`, no converged state, or a state whose tip is not
+    within two fine spacings of a0 inside the window)."""
+    if scene.a0 is None or scene.a0 < DIRECT_INITIAL_A0:
+        return None
+    try:
+        h, d = relaxed_state(el, a0=scene.a0, mesh_key=(pb.mesh.key, pb.mesh.spacing))
+    except RuntimeError:
+        return None
+    finally:
+        invalidate(el.cache)    # the unloading starts unfactorized, cached state or not
+    a = el.radius(h)
+    lo, hi = pb.tip_range
+    if not (lo <= a <= hi and abs(a - scene.a0) <= 2.0 * pb.mesh.spacing):
+        return None
+    return h, d
+
+
 def _probe(scene, numerics, run, delta0, a0, per_step, margin, deadline) -> str:
     """After a chunk of a run (the probe of PROBE_STEPS steps, then each chunk of at least
     as many; ``per_step`` its wall time per step): the reason to end the run now when the
@@ -475,14 +516,19 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                       f"the crack-front model (model crack)")
         return res
     try:
-        branch = (branch_state(scene, numerics.band_resolution, domain) if scene.a0 is not None
-                  else None)
+        branch = None
         # the initial state: where the relaxed tip lies outside the first window (delta0
         # scenes, whose radius is a JKR estimate), once more with the window there
         for _ in range(2):
             pb = prepare(scene, numerics, tip_window(a_est, zone, ahead, behind))
             el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, numerics.tol)
-            h_init, delta0 = initial_state(el, scene, branch)
+            direct = _direct_initial_state(el, pb, scene) if branch is None else None
+            if direct is not None:
+                h_init, delta0 = direct
+            else:
+                if branch is None and scene.a0 is not None:
+                    branch = branch_state(scene, numerics.band_resolution, domain)
+                h_init, delta0 = initial_state(el, scene, branch)
             a_init = el.radius(h_init)
             lo, hi = pb.tip_range
             if lo <= a_init <= hi or a_init <= 0.0:

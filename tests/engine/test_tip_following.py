@@ -114,6 +114,38 @@ def test_large_mu_bem_scenes_route_to_the_tip_following_mesh():
                                           Numerics.preset("balanced", nodes=800))
 
 
+def test_a_large_contact_runs_on_the_cheaper_tip_following_mesh_at_every_preset():
+    """The graded band grows with a0, the window does not: at mu = 3.24 a0 = 8 the
+    tip-following mesh has far fewer nodes and takes the scene at every preset; at a0 = 3 the
+    band is no wider than the window and the graded mesh keeps it."""
+    big, small = (Scene(n=0.8, k=0.1, mu=3.24, a0=a0, rate=10.0) for a0 in (8.0, 3.0))
+    for name in ("fast", "balanced", "accurate"):
+        num = Numerics.preset(name)
+        graded, window = models.bem_nodes_needed(big, num), tf.window_nodes(big, num)
+        assert graded >= models.TIP_FOLLOWING_NODE_RATIO * window, name
+        assert models.wants_tip_following(big, num), name
+        assert not models.wants_tip_following(small, num), name
+        assert models.bem_nodes_needed(small, num) < models.TIP_FOLLOWING_NODE_RATIO * \
+            tf.window_nodes(small, num), name
+
+
+def test_the_window_mesh_starts_from_the_same_relaxed_state_as_the_graded_mesh():
+    """A scene given by a0 >= DIRECT_INITIAL_A0 starts on the window mesh from the relaxed
+    state solved directly (as on the graded mesh), not from the quasi-static branch: the
+    contact radius is a0 on both meshes and the indentations agree to the discretization."""
+    scene = Scene(n=0.8, k=0.1, mu=3.24, a0=5.0, rate=1e3)
+    num = Numerics.preset("fast", pull_off_rtol=0.0)
+    moving = tf.simulate_tip_following(scene, num)
+    fixed = simulate(scene, num)
+    assert moving.ok and fixed.ok, (moving.reason, fixed.reason)
+    for res in (moving, fixed):
+        assert res.a0_result == pytest.approx(5.0, abs=1e-8)
+    assert moving.delta0_result == pytest.approx(fixed.delta0_result, rel=1e-4)
+    # the second method: the fixed band and the moving window agree within the fast
+    # preset's own error estimate of the fixed band (3e-4 here)
+    assert moving.pull_off == pytest.approx(fixed.pull_off, rel=1e-3)
+
+
 def test_a_load_jump_at_a_remeshing_is_detected_not_smoothed():
     P = np.array([-1.0, -1.1, -1.2, -1.3, -0.5, -0.51, -0.52])
     assert tf.remesh_jump(P, 4) == pytest.approx(0.8)
