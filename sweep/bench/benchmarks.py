@@ -412,6 +412,8 @@ class BenchPlan:
     #: ran in 1-2 s, too short for a parallel speed-up (dispatch and one 0.65 s scene)
     campaign_stride: int = 5
     jobs: int = 2
+    #: the accurate campaign of issue 24 (480 scenes at the balanced preset), run whole
+    balanced_campaign: str = "configs/threshold_balanced.yaml"
     scale_config: str = "configs/scale.yaml"
     scale_sample: int = 80
     scale_seed: int = 0
@@ -438,6 +440,7 @@ class BenchPlan:
                    prony_numerics=dict(nodes=60, domain=2.5, da_max=1e6, tol=1e-8,
                                        prony_rtol=1e-2),
                    compile=False, campaign="configs/smoke.yaml",
+                   balanced_campaign="configs/smoke.yaml",
                    campaign_stride=4, jobs=1, scale_config="configs/smoke.yaml",
                    scale_sample=3,
                    vs_numpy_scenes={"tiny": small},
@@ -749,6 +752,32 @@ def bench_scale(plan: "BenchPlan") -> dict:
             "loadavg": os.getloadavg()}
 
 
+def bench_balanced_campaign(plan: "BenchPlan") -> dict:
+    """The whole of ``plan.balanced_campaign`` (the version-0.1 threshold grid at the balanced
+    preset, 480 scenes: issue 24 item 1, under 60 s on 2 cores) run by ``run_sweep`` at
+    -j{jobs}, as a user runs it: kernels compiled, the on-disk caches (unit influence
+    matrix, Prony series) as this machine has them, fresh workers. Reports the wall, the
+    statuses, the scene walls summed and per a0, and the meshes the scenes ran on."""
+    cfg = load_config_path(plan.balanced_campaign)
+    tmp = Path(tempfile.mkdtemp(prefix="bench-balanced-"))
+    warm_up()
+    _fresh_loky_workers()
+    t = time.perf_counter()
+    rep = run_sweep(cfg, jobs=plan.jobs, out=tmp / "runs.h5", progress="none", resume=False)
+    wall = time.perf_counter() - t
+    df = load(tmp / "runs.h5")
+    tip = df.reason.fillna("").str.contains("tip-following mesh")
+    by_a0 = df.groupby("a0").wall_s.sum()
+    return {"config": plan.balanced_campaign, "scenes": int(len(df)), "ran": rep.ran,
+            "jobs": plan.jobs, "wall_s": wall,
+            "status_counts": {str(k): int(v) for k, v in df.status.value_counts().items()},
+            "scene_wall_s_sum": float(df.wall_s.sum()),
+            "scene_wall_s_by_a0": {f"{a0:g}": float(w) for a0, w in by_a0.items()},
+            "tip_following_scenes": int(tip.sum()),
+            "max_nodes_used": int(df.nodes_used.max()),
+            "loadavg": os.getloadavg()}
+
+
 def load_config_path(path: str):
     """A sweep config by path relative to the repository root (or absolute)."""
     p = Path(path)
@@ -951,6 +980,12 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     report["campaign_detail"] = camp
     progress(f"scenes_per_minute: {report['scenes_per_minute']:.1f}, "
              f"parallel_speedup {report['parallel_speedup']:.2f}")
+    balanced = bench_balanced_campaign(plan)
+    report["campaign_balanced_s"] = balanced["wall_s"]
+    report["campaign_balanced_detail"] = balanced
+    progress(f"campaign_balanced_s: {balanced['wall_s']:.1f} ({balanced['scenes']} scenes, "
+             f"{balanced['status_counts']}, {balanced['tip_following_scenes']} on the "
+             f"tip-following mesh)")
     scale = bench_scale(plan)
     report["scale_minutes"] = scale["minutes_estimate"]
     report["scale_detail"] = scale
@@ -990,6 +1025,9 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
         "scenes_per_minute": "the campaign's default numerics on every campaign_stride-th "
                              "scene of its grid, run_sweep with jobs workers (warm), scenes "
                              "per wall minute",
+        "campaign_balanced_s": "run_sweep wall of the whole balanced_campaign grid (the v0.1 "
+                               "threshold grid at the balanced preset, 480 scenes) at "
+                               "-j{jobs}, kernels compiled, fresh workers",
         "parallel_speedup": "run_sweep wall at -j1 / at -j{jobs} (warm workers), same subset, "
                             "both from the on-disk caches filled by a first run "
                             "(campaign_detail.wall_s.first_j1)",

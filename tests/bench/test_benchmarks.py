@@ -157,6 +157,10 @@ def test_bench_json_keys_with_a_tiny_plan():
     assert set(sc["sequential_s"]) == {"cold", "warm"}
     assert 1 <= sc["start_groups"]["sample"] <= sc["start_groups"]["grid"]
     assert rep["scale_minutes"] == sc["minutes_estimate"] > 0
+    bc = rep["campaign_balanced_detail"]
+    assert rep["campaign_balanced_s"] == bc["wall_s"] > 0
+    assert bc["scenes"] == bc["ran"] == sum(bc["status_counts"].values()) >= 2
+    assert sum(bc["scene_wall_s_by_a0"].values()) == pytest.approx(bc["scene_wall_s_sum"])
     assert set(rep["vs_numpy"]) == set(plan.vs_numpy_scenes)
     for by_cfg in rep["vs_numpy"].values():
         assert set(by_cfg) == set(plan.engine_numerics)
