@@ -27,7 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..engine.bem import simulate, warm_up
+from ..engine.bem import warm_up
+# the front door: each numerics runs on the mesh a user's scene runs on (the tip-following
+# mesh where it is the cheaper one, docs/design.md section 5)
+from ..engine.models import simulate
 from ..scene import PRESETS, Numerics, Scene
 
 ROOT = Path(__file__).resolve().parents[2]
