@@ -412,20 +412,31 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
     return relaxed_state(el, delta0=scene.delta0, a0=scene.a0)
 
 
-#: a0 (a_ref) from which the initial state on the window mesh is first solved directly, as
-#: on the graded mesh (:func:`sweep.engine.initial.relaxed_state`, cached per process): twice
-#: the JKR fold radius 1/2, far above the fold of the relaxed branch at any mu; below it, and
-#: where the direct state's tip is not at a0 (a tip on the coarse mesh outside the window, at
-#: large mu), the state comes from the quasi-static branch (:func:`branch_state`)
+#: a0 (a_ref) from which the initial state on the window mesh may be solved directly: twice
+#: the JKR fold radius 1/2, far above the fold of the relaxed branch at any mu
 DIRECT_INITIAL_A0 = 1.0
 
 
-def _direct_initial_state(el: ElasticSolver, pb, scene: Scene):
-    """The relaxed state solved directly on the window mesh of ``pb`` (as the graded mesh
-    does, and cached alike): (gap, indentation), or None where that is not to be trusted
-    (a0 below :data:`DIRECT_INITIAL_A0`, no converged state, or a state whose tip is not
-    within two fine spacings of a0 inside the window)."""
+def direct_initial_state(el: ElasticSolver, pb, scene: Scene):
+    """The relaxed state solved directly on the window mesh of ``pb``, as the graded mesh
+    solves it (:func:`sweep.engine.initial.relaxed_state`, cached per process alike):
+    (gap, indentation), or None where that is not to be trusted or not cheap, and the
+    quasi-static branch (:func:`branch_state`) gives the state instead:
+
+    - a0 below :data:`DIRECT_INITIAL_A0`;
+    - a scene whose graded band would not fit ``max_nodes`` (a large Tabor parameter): there
+      the LJ stiffness makes the direct solves ill-conditioned, Newton can settle with the
+      tip on the coarse mesh outside the window, and the continuation that follows costs a
+      dense factorization per solve (mu = 30, a0 = 1.5, balanced: 99 s, then no state);
+    - no converged state, or one whose tip is not within two fine spacings of a0 inside the
+      window.
+    """
+    numerics, s = pb.numerics, pb.scales
     if scene.a0 is None or scene.a0 < DIRECT_INITIAL_A0:
+        return None
+    band = scene_mesh(dataclasses.replace(numerics, nodes=None), s.tip_zone, s.a0_estimate,
+                      s.domain, pull_off_only=scene.stop == "pulloff")
+    if band.nodes > numerics.max_nodes:
         return None
     try:
         h, d = relaxed_state(el, a0=scene.a0, mesh_key=(pb.mesh.key, pb.mesh.spacing))
@@ -522,7 +533,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         for _ in range(2):
             pb = prepare(scene, numerics, tip_window(a_est, zone, ahead, behind))
             el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, numerics.tol)
-            direct = _direct_initial_state(el, pb, scene) if branch is None else None
+            direct = direct_initial_state(el, pb, scene) if branch is None else None
             if direct is not None:
                 h_init, delta0 = direct
             else:

@@ -146,6 +146,22 @@ def test_the_window_mesh_starts_from_the_same_relaxed_state_as_the_graded_mesh()
     assert moving.pull_off == pytest.approx(fixed.pull_off, rel=1e-3)
 
 
+def test_a_large_tabor_scene_starts_from_the_branch_not_the_direct_solve():
+    """At mu = 30 the graded band does not fit max_nodes: the direct relaxed solve on the
+    window mesh is not tried (it took 99 s there and found no state), the quasi-static
+    branch gives the state."""
+    from sweep.engine.initial import ElasticSolver
+    from sweep.engine.problem import derive, prepare
+
+    scene, num = Scene(n=0.8, k=0.5, mu=30.0, a0=1.5, rate=1.0), Numerics.preset("balanced")
+    assert models.bem_nodes_needed(scene, num) > num.max_nodes
+    s = derive(scene, num)
+    pb = prepare(scene, num, tf.tip_window(s.a0_estimate, s.tip_zone))
+    el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, num.tol)
+    assert tf.direct_initial_state(el, pb, scene) is None
+    assert el.stats.sum() == 0                        # not a single Newton iteration
+
+
 def test_a_load_jump_at_a_remeshing_is_detected_not_smoothed():
     P = np.array([-1.0, -1.1, -1.2, -1.3, -0.5, -0.51, -0.52])
     assert tf.remesh_jump(P, 4) == pytest.approx(0.8)
