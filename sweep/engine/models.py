@@ -50,7 +50,6 @@ from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
 from .mesh import scene_mesh
 from .problem import BEM_MU_RANGE, derive
 from .quasistatic import simulate_elastic
-from .tip_following import simulate_tip_following
 
 __all__ = ["MODELS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
            "simulate_scene", "choose_model", "model_choice", "Choice", "measured_error",
@@ -118,6 +117,8 @@ def simulate_pb(scene, numerics=None):
 def _bem(scene, numerics=None):
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     if wants_tip_following(scene, numerics):
+        from .tip_following import simulate_tip_following  # lazy: scipy.interpolate, optimize
+
         return simulate_tip_following(scene, numerics)
     return bem.simulate(scene, numerics)
 
