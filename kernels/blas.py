@@ -38,15 +38,20 @@ _N = ord("N")
 _T = ord("T")
 
 
-@njit(cache=True)
-def _ints(*values):
-    out = np.empty(len(values), np.int32)
-    for i, v in enumerate(values):
-        out[i] = v
+# the two helpers below are inlined where they are called (``inline='always'``): compiled
+# on their own they would be specialized for every literal argument (the transposition
+# code, the zeros), each specialization a compile of its own (docs/performance.md)
+@njit(cache=True, inline='always')
+def _ints(a, b, c, d):
+    out = np.empty(4, np.int32)
+    out[0] = a
+    out[1] = b
+    out[2] = c
+    out[3] = d
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def _gemv(trans, M, rows, cols, x, y, alpha, beta):
     """dgemv (sgemv for float32 ``M``, ``x``, ``y``) on the Fortran view of M[:rows, :cols]
     (cols x rows): ``trans`` T gives M @ x into y[:rows], N gives M^T @ x into y[:cols]."""
@@ -90,7 +95,7 @@ def lu_factor(K, piv):
     single precision) in place, pivots in ``piv`` (int32). The factors are those of K^T to
     LAPACK; :func:`lu_solve` accounts for it. Returns LAPACK's info (0: success, > 0:
     exactly singular)."""
-    dims = _ints(K.shape[0], 0)
+    dims = _ints(K.shape[0], 0, 0, 0)
     if K.itemsize == 4:
         _sgetrf(dims.ctypes, dims.ctypes, K.ctypes, dims.ctypes, piv.ctypes, dims[1:].ctypes)
     else:
@@ -106,7 +111,7 @@ def lu_solve(K, piv, B):
     if B.shape[0] == 0:
         return
     trans = np.array([_T], np.uint8)
-    dims = _ints(K.shape[0], B.shape[0], 0)
+    dims = _ints(K.shape[0], B.shape[0], 0, 0)
     if K.itemsize == 4:
         _sgetrs(trans.ctypes, dims[0:].ctypes, dims[1:].ctypes, K.ctypes, dims[0:].ctypes,
                 piv.ctypes, B.ctypes, dims[0:].ctypes, dims[2:].ctypes)

@@ -26,6 +26,13 @@ RunState, Records) and runs each time step as named parts: :func:`predict_step`,
 :func:`next_step`. The loop's scalars live in one float64 array named by RUN_*, its arrays
 in a :data:`Work` tuple.
 
+The parts called only from compiled code are inlined into their caller
+(``inline='always'``): compiled on its own, each would be a library of its own that links
+and machine-compiles again everything it calls (and one per literal argument), which made
+most of a cold compile; inlined, they are compiled once, within :func:`newton` or
+:func:`unload` (docs/performance.md, "The first run"). :func:`newton` and
+:func:`stop_reached` are also called from Python and stay compiled on their own.
+
 Status codes returned by :func:`unload`:
 0 finished (stop criterion met), 1 no equilibrium at the minimum step, 2 step limit,
 3 contact reached the mesh edge (domain too small), 4 the crack tip left the fine band of a
@@ -222,6 +229,16 @@ RECOVERY_STEPS = 5
 SEPARATION_LOAD = 1e-3
 
 
+@njit(cache=True, inline='always')
+def _copy(src, dst):
+    """dst[:] = src as a loop (a slice assignment compiles Numba's shape-mismatch message,
+    string formatting and all: about 2 s of a cold compile)."""
+    if dst.size != src.size:
+        raise ValueError("_copy: arrays of different sizes")
+    for i in range(src.size):
+        dst[i] = src[i]
+
+
 @njit(cache=True)
 def stop_reached(P, a, n, i_min, stop_mode, min_travel):
     """The one stop rule, on the records P[:n], a[:n] with the load minimum at ``i_min``.
@@ -243,7 +260,7 @@ def stop_reached(P, a, n, i_min, stop_mode, min_travel):
     return a_now == 0.0 and P_now > P_min and abs(P_now) < SEPARATION_LOAD * abs(P_min)
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def residual(h, g, A, ceff, H, h0, c, sig, w, F):
     """F = h - g - A (ceff sigma(h) - H); returns max |F|. sig, w are work arrays."""
     lj_traction(h, h0, c, sig)
@@ -258,7 +275,7 @@ def residual(h, g, A, ceff, H, h0, c, sig, w, F):
     return norm
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def positive_step(h, dh):
     """Largest step length <= 1 along ``dh`` that closes no gap by more than
     MAX_GAP_CLOSURE of it."""
@@ -271,7 +288,7 @@ def positive_step(h, dh):
     return lam
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def _norm2(F):
     s = 0.0
     for i in range(F.size):
@@ -279,7 +296,7 @@ def _norm2(F):
     return np.sqrt(s)
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def _refactorize(h, A, ceff, h0, c, cache, stats, reason):
     m = factorize(h, A, ceff, h0, c, cache)
     stats[STAT_FACTOR] += 1
@@ -288,7 +305,7 @@ def _refactorize(h, A, ceff, h0, c, cache, stats, reason):
         stats[reason] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def _direction(h, F, A, ceff, h0, c, sig, d, cache, stats):
     """Newton's direction at ``h`` (residual ``F``) with the cached factorization, made again
     once when it no longer fits (the crack tip left the zone). Returns (dh, ok,
@@ -302,7 +319,7 @@ def _direction(h, F, A, ceff, h0, c, sig, d, cache, stats):
     return dh, ok, True
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def _end_predicted(h, dh, theta, stats):
     """Take the full update ``dh`` without its residual (predicted below tolerance): the
     contraction estimate ``theta[0]`` grows by CONTRACTION_GROWTH (at most 1)."""
@@ -393,7 +410,7 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
     """Pseudo-transient continuation to a *stable* equilibrium, in place; True on success.
 
@@ -445,7 +462,7 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
     return norm <= tol
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def snap(mesh, physics, work, ceff, tol, max_iter, hm, cache, stats):
     """Newton from the gap profile ``work.h`` outside the crack tip shifted inward by 1 to
     SNAP_MAX_SHIFT nodes (the nodes more than SNAP_KEEP_INSIDE inside it kept).
@@ -475,13 +492,13 @@ def snap(mesh, physics, work, ceff, tol, max_iter, hm, cache, stats):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def load(sigma, wP):
     """P = 2 pi sum_j w_j sigma_j (positive = compressive)."""
     return 2.0 * np.pi * np.dot(wP, sigma)
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def predict_cubic(h, h_prev, h_prev2, h_prev3, dt, dt_prev, dt_prev2, dt_prev3, hp):
     """Starting gap of Newton: cubic (Lagrange) extrapolation through the last four
     accepted states, floored at PREDICT_FLOOR of the last gap; False (nothing written)
@@ -501,7 +518,7 @@ def predict_cubic(h, h_prev, h_prev2, h_prev3, dt, dt_prev, dt_prev2, dt_prev3, 
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp):
     """Starting gap of the next solve: quadratic (Lagrange) extrapolation through the last
     three accepted states (linear after one, constant at the start), floored at
@@ -522,11 +539,11 @@ def predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp):
         for i in range(N):
             hp[i] = max(h[i] + s * (h[i] - h_prev[i]), PREDICT_FLOOR * h[i])
         return False
-    hp[:] = h
+    _copy(h, hp)
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
     """Step control after an accepted step: (next indentation step, easy-step count).
 
@@ -556,7 +573,7 @@ def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
 
 # ------------------------------------------------------------------ the unloading loop
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def new_work(r, h_init, q):
     """The loop's arrays (:data:`Work`), the last four states all ``h_init``."""
     N = h_init.size
@@ -569,7 +586,7 @@ def new_work(r, h_init, q):
                 np.empty(M), np.empty(N), np.empty(N), r2half, q)
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def start_run(mesh, physics, start, records, work, run, hm):
     """The state the loop starts from: the tractions of ``work.h`` and the run's time,
     indentation and contact radius (record 0, the initial state, written for a new run).
@@ -595,7 +612,7 @@ def start_run(mesh, physics, start, records, work, run, hm):
     return n, i_min
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def predict_step(physics, work, run):
     """-- predict: the step's time step, C_eff, H and g for the step ``run[RUN_DD]``, and
     Newton's starting gaps: the quadratic extrapolation in ``work.h_pred`` (and ``hp``),
@@ -611,7 +628,7 @@ def predict_step(physics, work, run):
         work.g[i] = -(delta - dd) + h0 + work.r2half[i]
     quadratic = predict(work.h, work.h_prev, work.h_prev2, dt, run[RUN_DT_PREV],
                         run[RUN_DT_PREV2], work.hp)
-    work.h_pred[:] = work.hp
+    _copy(work.hp, work.h_pred)
     # Newton starts from the cubic extrapolation (where four states exist): on the
     # vs-numpy scenes its residual is several times smaller, and 1.2-1.8 Newton
     # iterations per step remain instead of 1.7-2.4; the quadratic one (h_pred) stays
@@ -621,7 +638,7 @@ def predict_step(physics, work, run):
     return quadratic, cubic
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     """-- solve: Newton from ``work.hp``, again from the quadratic start where the cubic one
     failed; after a failure the step is halved, down to SNAP_STEP_FRACTION step_max, and
@@ -634,7 +651,7 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
         # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
         # cubic start can overshoot: again from the quadratic one before the step halves
         stats[STAT_FAILED_SOLVES] += 1
-        hp[:] = work.h_pred
+        _copy(work.h_pred, hp)
         ok = newton(hp, work.g, A, ceff, work.H, h0, c, tol, control.max_iter, cache, stats)
     if ok:
         return SOLVED
@@ -652,13 +669,13 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     stats[STAT_JUMPS] += 1
     if snap(mesh, physics, work, ceff, tol, control.max_iter, hm, cache, stats):
         return SNAPPED
-    hp[:] = work.h
+    _copy(work.h, hp)
     if relax(hp, work.g, A, ceff, work.H, h0, c, tol, RELAX_MAX_ITER, stats):
         return SNAPPED
     return FAILED
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def control_step(mesh, physics, control, work, run, hm, stats):
     """-- control the step: the crack tip (at the gap ``hm``) may move by da_max at most; a
     step that moves it further is halved until the motion, assumed proportional to the
@@ -678,7 +695,7 @@ def control_step(mesh, physics, control, work, run, hm, stats):
     return True, a_new, da
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def step_load(mesh, physics, work, quadratic):
     """The load of the solved state ``work.hp`` (its tractions into ``work.sig_new``) and the
     step-error estimate: the relative load error of the quadratic extrapolation, inf
@@ -692,17 +709,17 @@ def step_load(mesh, physics, work, quadratic):
     return P, abs(load(work.sigma_pred, wP) - P) / max(abs(P), LOAD_ERROR_FLOOR)
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def accept_step(mesh, physics, work, run, records, n, P, a_new):
     """-- accept: the Prony modes, the last four states and time steps move on by the
     solved state ``work.hp``, and record ``n`` (load ``P``, contact radius ``a_new``) is
     written."""
     update_modes(work.e, work.b, work.q, work.sig_new, work.sigma)
-    work.h_prev3[:] = work.h_prev2
-    work.h_prev2[:] = work.h_prev
-    work.h_prev[:] = work.h
-    work.h[:] = work.hp
-    work.sigma[:] = work.sig_new
+    _copy(work.h_prev2, work.h_prev3)
+    _copy(work.h_prev, work.h_prev2)
+    _copy(work.h, work.h_prev)
+    _copy(work.hp, work.h)
+    _copy(work.sig_new, work.sigma)
     dt = run[RUN_DT]
     run[RUN_DT_PREV3] = run[RUN_DT_PREV2]
     run[RUN_DT_PREV2] = run[RUN_DT_PREV]
@@ -717,7 +734,7 @@ def accept_step(mesh, physics, work, run, records, n, P, a_new):
     records.a_inner[n] = crossing_radius(work.h, mesh.r, physics.h0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def stop_status(mesh, control, records, n, i_min):
     """-- stop: after record ``n - 1``, the status that ends the run (the contact reached the
     mesh edge, the crack tip left the band, or :func:`stop_reached`), else STATUS_RUNNING."""
@@ -792,6 +809,6 @@ def unload(mesh, physics, control, start, records, cache, stats):
             break
         run[RUN_DD], easy = next_step(run[RUN_DD], easy, da, control.da_max, err,
                                       control.step_max * h0, control.step_tol * h0)
-    records.h[:] = work.h
+    _copy(work.h, records.h)
     start.step[0] = run[RUN_DD] / h0
     return status, n

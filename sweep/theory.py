@@ -39,8 +39,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.special import gammainc, gammaincc, gammaln, rgamma
-from scipy.special import gamma as gamma_fn
 
 from .errors import InputError, check_array, check_positive, check_range
 
@@ -106,6 +104,7 @@ def _kernel_w(s):
 
 def _mpl_integrals(n: float, c: np.ndarray):
     """I(c), J(c) = 1 - I(c) and c dJ/dc for the Gamma(n) spectrum; c is a 1-D array > 0."""
+    from scipy.special import gammainc, gammaincc, gammaln  # lazy: not on a BEM scene's path
     lnc = np.log(c)
     s0 = np.minimum(-_TAIL, -lnc - _TAIL)
     s1 = np.maximum(_TAIL, -lnc + _TAIL)
@@ -296,6 +295,7 @@ def _hyp1f2(a: float, b1: float, b2: float, z: float):
 
 
 def _closed_form_scalar(n: float, v: float, g: float, rtol: float) -> float:
+    from scipy.special import gamma as gamma_fn, rgamma  # lazy: not on a BEM scene's path
     z = -((g / (4.0 * math.pi * v)) ** 2)
     f0, m0 = _hyp1f2(-0.5, 0.5 - 0.5 * n, 1.0 - 0.5 * n, z)
     f1, m1 = _hyp1f2(0.5 * (n - 1.0), 0.5, 1.0 + 0.5 * n, z)

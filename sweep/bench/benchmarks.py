@@ -308,8 +308,12 @@ def bench_scene_process(repeat: int = 3) -> dict:
              "--preset", "fast"]
     subprocess.run(scene, capture_output=True, check=True)          # the cache filled
     imports = _process_wall([sys.executable, "-c", "import numpy, scipy"], repeat)
+    # the floor of any process that runs a kernel: numba's import alone is about twice
+    # that of numpy and scipy (docs/performance.md, "The first run")
+    with_numba = _process_wall([sys.executable, "-c", "import numpy, scipy, numba"], repeat)
     one = _process_wall(scene, repeat)
     return {"scene_process_s": one, "import_numpy_scipy_s": imports, "ratio": one / imports,
+            "import_numpy_scipy_numba_s": with_numba,
             "command": " ".join(["sweep", *scene[1:]]), "repeat": repeat}
 
 

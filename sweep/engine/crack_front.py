@@ -52,8 +52,6 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.interpolate import PchipInterpolator
 
 from .. import units
 from ..errors import (NUMERICAL_ERRORS, InputError, check_choice, check_positive, check_range,
@@ -148,6 +146,7 @@ class GentSchultzLaw:
 @lru_cache(maxsize=32)
 def _pb_table(kind: str, n: float, k: float, weights: tuple, times: tuple):
     """log(vhat) as a monotone function of log(Gamma - 1) for the PB law (vhat = v tau0/l0)."""
+    from scipy.interpolate import PchipInterpolator  # lazy: not on a BEM scene's path
     vh = np.logspace(-10.0, 24.0, 681)
     if kind == "mpl":
         g = pb_gamma_eff(n, k, vh)
@@ -339,6 +338,8 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     # pinned phase: the edge stays at a0 until g(a0, delta) reaches Gamma(0)
     d1 = a0 * a0 - math.sqrt(2.0 * a0 * g_th) if g_th > 1.0 else delta0
     t1 = (d1 - delta0) / ddot
+
+    from scipy.integrate import solve_ivp  # lazy: not on a BEM scene's path
 
     def delta_of(t):
         return delta0 + ddot * t

@@ -17,6 +17,8 @@ uniform mesh scales the cached unit-spacing matrix.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -297,3 +299,35 @@ def scene_mesh(numerics, l0: float, a0_estimate: float, domain: float,
     if numerics.nodes is not None:
         return graded_mesh_with_nodes(numerics.nodes, domain, band, numerics.grading)
     return graded_mesh(domain, band, l0 / numerics.band_resolution, numerics.grading)
+
+
+# -- the tip-following window (sweep.engine.tip_following) ---------------------------------
+
+#: room for the tip in its direction of motion, in tip zones (Scales.tip_zone: the process
+#: zone l0 at mu >= 1.83; the tip moves this far, less TIP_MARGIN_ZONES, between two meshes)
+WINDOW_AHEAD_ZONES = 16.0
+#: fine region behind the tip (the cohesive zone, a few l0, and the recent wake), tip zones
+WINDOW_BEHIND_ZONES = 8.0
+
+
+def tip_window(tip: float, zone: float, ahead: float = WINDOW_AHEAD_ZONES,
+               behind: float = WINDOW_BEHIND_ZONES, direction: int = -1) -> tuple[float, float]:
+    """The fine window (a_ref radii) for a crack tip at ``tip`` moving inward
+    (``direction`` -1, the contact shrinks) or outward (+1): ``ahead`` tip zones ``zone`` of
+    room in the direction of motion, ``behind`` zones on the other side."""
+    if direction < 0:
+        lo, hi = tip - ahead * zone, tip + behind * zone
+    else:
+        lo, hi = tip - behind * zone, tip + ahead * zone
+    return max(lo, 0.0), hi
+
+
+def window_nodes(numerics, zone: float, a0_estimate: float, domain: float,
+                 ahead: float = WINDOW_AHEAD_ZONES, behind: float = WINDOW_BEHIND_ZONES) -> int:
+    """Nodes of a scene's first tip-following mesh: the window at the estimated initial
+    contact radius ``a0_estimate`` for the tip zone ``zone``, graded outside it to
+    ``domain`` (a_ref), at the fine spacing of ``numerics`` (what one time step costs on
+    that mesh, against the graded mesh's fixed band, :func:`scene_mesh`)."""
+    num = dataclasses.replace(numerics, mesh="graded", nodes=None, exact=False)
+    return scene_mesh(num, zone, a0_estimate, domain,
+                      band=tip_window(a0_estimate, zone, ahead, behind)).nodes

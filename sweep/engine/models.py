@@ -47,10 +47,9 @@ from ..scene import Numerics, Result, Scene
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem
 from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
-from .mesh import scene_mesh
+from .mesh import scene_mesh, window_nodes
 from .problem import BEM_MU_RANGE, derive
 from .quasistatic import simulate_elastic
-from .tip_following import simulate_tip_following, window_nodes
 
 __all__ = ["MODELS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
            "simulate_scene", "choose_model", "model_choice", "Choice", "measured_error",
@@ -118,6 +117,8 @@ def simulate_pb(scene, numerics=None):
 def _bem(scene, numerics=None):
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     if wants_tip_following(scene, numerics):
+        from .tip_following import simulate_tip_following  # lazy: scipy.interpolate, optimize
+
         return simulate_tip_following(scene, numerics)
     return bem.simulate(scene, numerics)
 
@@ -142,8 +143,11 @@ def wants_tip_following(scene, numerics) -> bool:
     if not (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact):
         return False
     graded = bem_nodes_needed(scene, numerics)
-    return (graded > numerics.max_nodes
-            or graded >= TIP_FOLLOWING_NODE_RATIO * window_nodes(scene, numerics))
+    if graded > numerics.max_nodes:
+        return True
+    s = derive(scene, numerics)
+    return graded >= TIP_FOLLOWING_NODE_RATIO * window_nodes(numerics, s.tip_zone,
+                                                             s.a0_estimate, s.domain)
 
 
 def bem_nodes_needed(scene, numerics=None) -> int:

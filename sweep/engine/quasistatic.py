@@ -45,7 +45,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ..kernels.influence import assemble_nodes, load_weights_nodes
 from ..kernels.interface import TIP_GAP, lj_traction_and_stiffness
@@ -309,6 +308,8 @@ def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, a_start=None,
                               spacing=float(radii[0] * (br.x[br.m + 1] - 1.0)),
                               domain=float(radii[0] * br.x[-1]))
     cache = {}
+
+    from scipy.optimize import minimize_scalar  # lazy: not on a BEM scene's path
 
     def neg_pull(a):
         j = int(np.argmin(np.abs(radii - a)))

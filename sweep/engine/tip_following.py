@@ -46,18 +46,12 @@ from ..kernels.interface import lj_traction
 from ..scene import Numerics, Result, Scene
 from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, no_contact_reason, unload_chunk
 from .initial import ElasticSolver, relaxed_state
-from .mesh import scene_mesh
+from .mesh import WINDOW_AHEAD_ZONES, WINDOW_BEHIND_ZONES, scene_mesh, tip_window
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Refused, derive, jkr_radius, material_of, prepare
 from .quasistatic import ElasticBranch
 from .resolution import estimate_error
 
-#: room for the tip in its direction of motion, in tip zones (Scales.tip_zone: the process
-#: zone l0 at mu >= 1.83; the tip moves this far,
-#: less TIP_MARGIN_ZONES, between two meshes)
-WINDOW_AHEAD_ZONES = 16.0
-#: fine region behind the tip (the cohesive zone, a few l0, and the recent wake), tip zones
-WINDOW_BEHIND_ZONES = 8.0
 #: Newton tolerance (units of h0) of a first relaxed solve where the numerics' one stalls
 LOOSE_TOL = 1e-4
 #: time steps of the probe after which a run first estimates what it still needs (then
@@ -176,29 +170,6 @@ def estimate_steps(scene: Scene, numerics: Numerics, delta: float, a: float,
     tip_steps, travel_steps = int(math.ceil(tip / da)), int(math.ceil(rest / step))
     return StepEstimate(steps=max(tip_steps, travel_steps), tip_travel=tip, tip_step=da,
                         tip_steps=tip_steps, travel=rest, step=step, travel_steps=travel_steps)
-
-
-def tip_window(tip: float, zone: float, ahead: float = WINDOW_AHEAD_ZONES,
-               behind: float = WINDOW_BEHIND_ZONES, direction: int = -1) -> tuple[float, float]:
-    """The fine window (a_ref radii) for a crack tip at ``tip`` moving inward
-    (``direction`` -1, the contact shrinks) or outward (+1): ``ahead`` tip zones ``zone`` of
-    room in the direction of motion, ``behind`` zones on the other side."""
-    if direction < 0:
-        lo, hi = tip - ahead * zone, tip + behind * zone
-    else:
-        lo, hi = tip - behind * zone, tip + ahead * zone
-    return max(lo, 0.0), hi
-
-
-def window_nodes(scene: Scene, numerics: Numerics, ahead: float = WINDOW_AHEAD_ZONES,
-                 behind: float = WINDOW_BEHIND_ZONES) -> int:
-    """Nodes of a scene's first tip-following mesh (the window at the estimated initial
-    contact radius, graded outside it): what one time step costs on this mesh, against
-    :func:`sweep.engine.models.bem_nodes_needed` on the graded mesh."""
-    s = derive(scene, numerics)
-    num = dataclasses.replace(numerics, mesh="graded", nodes=None, exact=False)
-    return scene_mesh(num, s.tip_zone, s.a0_estimate, s.domain,
-                      band=tip_window(s.a0_estimate, s.tip_zone, ahead, behind)).nodes
 
 
 def transfer(run, old, new, form: str = "auto") -> None:

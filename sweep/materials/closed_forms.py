@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import special
 
 from ..errors import check_range
 from ._checks import _as_time_array, _check_n
@@ -13,6 +12,7 @@ from ._checks import _as_time_array, _check_n
 
 def _dlgamma(a: float, e: float) -> float:
     """(lnGamma(a+e) - lnGamma(a))/e for a >= 1, |e| <= 1/2; psi(a) at e = 0."""
+    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     if e == 0.0:
         return float(special.digamma(a))
     if abs(e) < 0.05:
@@ -36,6 +36,7 @@ def _mpl_series(T: np.ndarray, n: float, d: int, J: int = 40) -> np.ndarray:
     * expm1(eps D)/sin(pi eps),  q = j - d,  D = ln T - dlg(1+m, eps) - dlg(q+1, -eps).
     No cancellation for small T (every term is O(T^2) or O(T^(n+1))).
     """
+    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     lnT = np.log(T)
     out = np.zeros_like(T)
     N = int(math.floor(n + 0.5))
@@ -72,6 +73,7 @@ def _mpl_switch(n: float) -> float:
 
 def _mpl_one_minus_phi(T: np.ndarray, n: float) -> np.ndarray:
     """1 - E[exp(-T/x)], x ~ Gamma(n): 1 - 2 T^(n/2) K_n(2 sqrt T)/Gamma(n), accurate at small T."""
+    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     out = np.zeros_like(T)
     out[np.isinf(T)] = 1.0
     fin = (T > 0) & np.isfinite(T)
@@ -91,6 +93,7 @@ def _mpl_one_minus_phi(T: np.ndarray, n: float) -> np.ndarray:
 
 def _mpl_F(T: np.ndarray, n: float) -> np.ndarray:
     """F(T) = int_0^T (1 - E[exp(-s/x)]) ds = T - n + 2^(-n) X^(n+1) K_{n+1}(X)/Gamma(n), X = 2 sqrt T."""
+    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     out = np.zeros_like(T)
     out[np.isinf(T)] = np.inf
     fin = (T > 0) & np.isfinite(T)

@@ -6,7 +6,6 @@ import math
 import time
 
 import numpy as np
-from scipy.optimize import linprog, lsq_linear, nnls
 
 from .prony_series import PronySeries
 
@@ -31,6 +30,7 @@ def _design(t: np.ndarray, taus: np.ndarray) -> np.ndarray:
 
 def _lp_weights(M: np.ndarray, b: np.ndarray):
     """min_c max |M c - b| subject to c >= 0 (HiGHS).  Returns (c, e) or (None, inf)."""
+    from scipy.optimize import linprog  # lazy: not on a BEM scene's path (a Prony fit: disk-cached)
     m, p = M.shape
     cost = np.zeros(p + 1)
     cost[-1] = 1.0
@@ -53,6 +53,7 @@ def _nnls(M: np.ndarray, b: np.ndarray) -> np.ndarray:
     mode with a huge weight can shave the error at t_min, but such a series is unphysical
     (Chat(0) < 0) and ruins the hereditary recursion (C_eff = 1 - sum c_i b_i < 0).
     """
+    from scipy.optimize import lsq_linear, nnls  # lazy: not on a BEM scene's path (a Prony fit: disk-cached)
     try:
         c = nnls(M, b, maxiter=100 * M.shape[1])[0]
     except RuntimeError:                       # pragma: no cover - not seen in practice

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import special
 
 from ..errors import InputError, check_positive
 from ._checks import _EULER
@@ -19,6 +18,7 @@ def _expint_series(p: float, z: np.ndarray) -> np.ndarray:
     (-1)^(N-1) z^(N-1)/(N-1)! * expm1(eps D)/eps, D = lnGamma(1+eps)/eps - ln z
     - sum_{j<N} log1p(-eps/j)/eps  (-> psi(N) - ln z at eps = 0).
     """
+    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     N = int(math.floor(p + 0.5))
     out = np.zeros(z.shape, dtype=complex)
     term = np.ones(z.shape, dtype=complex)
@@ -40,6 +40,7 @@ def _expint_series(p: float, z: np.ndarray) -> np.ndarray:
 
 def _lgamma1p_over(eps: float) -> float:
     """lnGamma(1+eps)/eps for |eps| <= 1/2, with its limit -Euler at eps = 0."""
+    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     if eps == 0.0:
         return -_EULER
     if abs(eps) < 0.05:

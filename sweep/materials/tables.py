@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import special
 
 from ..errors import InputError, check_positive
 from .closed_forms import _h
@@ -183,6 +182,7 @@ def _gamma_lattice(n: float, v_lo: float):
     carrying the lattice tail below v_lo with its exact lattice mass and mean (first-moment
     lumping, second-order error).  Returns (masses, nodes).
     """
+    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     # step: smallest omega with 2|Gamma(n - i omega)|/Gamma(n) < 1e-15
     om = 10.0
     lg = special.gammaln(n)

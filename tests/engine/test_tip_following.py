@@ -14,7 +14,7 @@ import pytest
 
 from sweep import Numerics, Scene
 from sweep.engine.bem import simulate  # the BEM on the graded mesh (not the model dispatch)
-from sweep.engine import models
+from sweep.engine import mesh, models
 from sweep.engine import tip_following as tf
 from sweep.engine.bem import UnloadingState
 
@@ -34,11 +34,11 @@ def test_remesh_jumps_measures_the_jump_of_the_old_transfer():
 
 
 def test_window_leaves_room_in_the_direction_of_motion():
-    lo, hi = tf.tip_window(1.0, 0.01, ahead=16, behind=8, direction=-1)
+    lo, hi = mesh.tip_window(1.0, 0.01, ahead=16, behind=8, direction=-1)
     assert lo == pytest.approx(0.84) and hi == pytest.approx(1.08)
-    lo, hi = tf.tip_window(1.0, 0.01, ahead=16, behind=8, direction=1)
+    lo, hi = mesh.tip_window(1.0, 0.01, ahead=16, behind=8, direction=1)
     assert lo == pytest.approx(0.92) and hi == pytest.approx(1.16)
-    assert tf.tip_window(0.05, 0.01)[0] == 0.0
+    assert mesh.tip_window(0.05, 0.01)[0] == 0.0
 
 
 def _window_problems(scene, num, old_band, new_band):
@@ -114,6 +114,12 @@ def test_large_mu_bem_scenes_route_to_the_tip_following_mesh():
                                           Numerics.preset("balanced", nodes=800))
 
 
+def _window_nodes(scene, num):
+    from sweep.engine.problem import derive
+    s = derive(scene, num)
+    return mesh.window_nodes(num, s.tip_zone, s.a0_estimate, s.domain)
+
+
 def test_a_large_contact_runs_on_the_cheaper_tip_following_mesh_at_every_preset():
     """The graded band grows with a0, the window does not: at mu = 3.24 a0 = 8 the
     tip-following mesh has far fewer nodes and takes the scene at every preset; at a0 = 3 the
@@ -121,12 +127,12 @@ def test_a_large_contact_runs_on_the_cheaper_tip_following_mesh_at_every_preset(
     big, small = (Scene(n=0.8, k=0.1, mu=3.24, a0=a0, rate=10.0) for a0 in (8.0, 3.0))
     for name in ("fast", "balanced", "accurate"):
         num = Numerics.preset(name)
-        graded, window = models.bem_nodes_needed(big, num), tf.window_nodes(big, num)
+        graded, window = models.bem_nodes_needed(big, num), _window_nodes(big, num)
         assert graded >= models.TIP_FOLLOWING_NODE_RATIO * window, name
         assert models.wants_tip_following(big, num), name
         assert not models.wants_tip_following(small, num), name
         assert models.bem_nodes_needed(small, num) < models.TIP_FOLLOWING_NODE_RATIO * \
-            tf.window_nodes(small, num), name
+            _window_nodes(small, num), name
 
 
 def test_the_window_mesh_starts_from_the_same_relaxed_state_as_the_graded_mesh():
@@ -156,7 +162,7 @@ def test_a_large_tabor_scene_starts_from_the_branch_not_the_direct_solve():
     scene, num = Scene(n=0.8, k=0.5, mu=30.0, a0=1.5, rate=1.0), Numerics.preset("balanced")
     assert models.bem_nodes_needed(scene, num) > num.max_nodes
     s = derive(scene, num)
-    pb = prepare(scene, num, tf.tip_window(s.a0_estimate, s.tip_zone))
+    pb = prepare(scene, num, mesh.tip_window(s.a0_estimate, s.tip_zone))
     el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, num.tol)
     assert tf.direct_initial_state(el, pb, scene) is None
     assert el.stats.sum() == 0                        # not a single Newton iteration
