@@ -188,3 +188,19 @@ def test_tip_predictor_follows_a_tip_held_by_the_nodes(count):
     hp[:] = -1.0
     assert not predict_lattice(r, h, past, past_ta, count, dt, hp)
     assert np.all(hp == -1.0)
+
+
+def test_the_two_starts_are_scored_on_the_band_around_the_tip():
+    # log2 of the tip predictor's error over the cubic's, max over the band around the tip:
+    # an error far from the tip does not count
+    from sweep.kernels.solve import LATTICE_BAND_OUT, score_starts
+    r = 0.01 * np.arange(300)
+    h = np.ones_like(r)
+    starts = np.ones((2, r.size))
+    tip = 100
+    starts[0, tip + 1] += 0.4                      # the cubic misses next to the tip
+    starts[1, tip - 2] += 0.1                      # the tip predictor by a quarter of that
+    starts[1, tip + LATTICE_BAND_OUT + 5] += 9.0   # beyond the band: not counted
+    assert score_starts(r, starts, h, r[tip] - 0.005) == pytest.approx(-2.0)
+    starts[1, tip - 2] += 0.7
+    assert score_starts(r, starts, h, r[tip] - 0.005) == pytest.approx(1.0)
