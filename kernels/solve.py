@@ -223,9 +223,9 @@ LATTICE_HISTORY = 16
 LATTICE_BAND_IN = 48
 LATTICE_BAND_OUT = 24
 #: Newton starts from the tip predictor where its error on the band, over the cubic's, has
-#: been below this (log2: half) on average over the last steps where both were made: on
-#: coarse meshes, where the nodes hold the tip, it is a tenth of the cubic's or less; on finer
-#: meshes, where the tip slides, 2-500 times the cubic's (docs/performance.md)
+#: been below this (log2: half) on average over the last steps where both were made: where
+#: the nodes hold the tip (coarse meshes) it is below a tenth of the cubic's at most steps;
+#: where the tip slides, 1.7-200 times the cubic's (medians; docs/performance.md)
 LATTICE_SCORE_USE = -1.0
 #: the weight of the last step in that average (the weights of older steps halve each step)
 LATTICE_SCORE_WEIGHT = 0.5
