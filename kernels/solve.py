@@ -122,9 +122,13 @@ Records = namedtuple("Records", ["t", "delta", "P", "a", "a_inner", "h"])
 #: the unloading loop's arrays (:func:`new_work`): the last four accepted gaps (h newest),
 #: Newton's start hp and the quadratic extrapolation h_pred, the tractions of the last
 #: state, of hp and of h_pred, the step's Prony coefficients e and b (M,), H and g of the
-#: equation, r^2/2 at the nodes, and the modes q (M, N) (those of RunState)
+#: equation, r^2/2 at the nodes, the modes q (M, N) (those of RunState), the ring of the
+#: last LATTICE_HISTORY accepted states of the tip predictor (:func:`predict_lattice`): their
+#: gaps past (LATTICE_HISTORY, N) and times and contact radii past_ta (2, LATTICE_HISTORY),
+#: and the step's two starts, cubic and tip predictor's, starts (2, N)
 Work = namedtuple("Work", ["h", "h_prev", "h_prev2", "h_prev3", "hp", "h_pred", "sigma",
-                           "sig_new", "sigma_pred", "e", "b", "H", "g", "r2half", "q"])
+                           "sig_new", "sigma_pred", "e", "b", "H", "g", "r2half", "q",
+                           "past", "past_ta", "starts"])
 
 # the loop's scalars: one float64 array (N_RUN), positions named RUN_*
 RUN_T = 0          # time of the last accepted state
@@ -136,7 +140,11 @@ RUN_CEFF = 5       # its C_eff
 RUN_DT_PREV = 6    # the time steps of the last three accepted states (0 until they exist)
 RUN_DT_PREV2 = 7
 RUN_DT_PREV3 = 8
-N_RUN = 9
+RUN_PAST = 9       # accepted states written to the tip predictor's ring (Work.past)
+RUN_TIP_MADE = 10  # 1 where the step's tip predictor was made (Work.starts[1])
+RUN_TIP_SCORE = 11  # log2 of the tip predictor's error over the cubic's, averaged over the
+                    # steps where both were made (:func:`score_starts`)
+N_RUN = 12
 
 # outcomes of :func:`solve_step`
 SOLVED = 0         # Newton converged: hp is the new state
@@ -213,6 +221,23 @@ SMOOTH_STEP_FACTOR = 8.0
 SMOOTH_DA_FRACTION = 0.6
 #: the predictor never puts a gap below this fraction of the last accepted one
 PREDICT_FLOOR = 0.5
+#: the tip predictor (:func:`predict_lattice`) looks this many accepted states back for the
+#: one where the crack tip was one node further along its path; a tip slower than a node in
+#: that many steps keeps the cubic start
+LATTICE_HISTORY = 16
+#: the tip predictor's band: nodes from LATTICE_BAND_IN inside the crack tip to
+#: LATTICE_BAND_OUT outside it start from it (the rest from the cubic extrapolation)
+LATTICE_BAND_IN = 48
+LATTICE_BAND_OUT = 24
+#: Newton starts from the tip predictor where its error on the band, over the cubic's, has
+#: been below this (log2: half) on average over the last steps where both were made: where
+#: the nodes hold the tip (coarse meshes) it is below a tenth of the cubic's at most steps;
+#: where the tip slides, 1.7-200 times the cubic's (medians; docs/performance.md)
+LATTICE_SCORE_USE = -1.0
+#: the weight of the last step in that average (the weights of older steps halve each step)
+LATTICE_SCORE_WEIGHT = 0.5
+#: spacings equal within this relative difference are one spacing (the tip predictor's band)
+SPACING_RTOL = 1e-6
 #: the predictor's load error is relative to max(|P|, this) (units of pi dg R; absolute
 #: where the load passes through zero)
 LOAD_ERROR_FLOOR = 1.0
@@ -519,6 +544,93 @@ def predict_cubic(h, h_prev, h_prev2, h_prev3, dt, dt_prev, dt_prev2, dt_prev3, 
 
 
 @njit(cache=True, inline='always')
+def _ring_crossing(past_ta, row, count, level):
+    """In the tip predictor's ring (``count`` states written, LATTICE_HISTORY kept), the
+    newest two consecutive states between which row ``row`` of ``past_ta`` (0 time, 1
+    contact radius) passed ``level``: (ring index of the older one, fraction of the way
+    to the newer one); (-1, 0) where it did not within the ring."""
+    K = past_ta.shape[1]
+    x = past_ta[row]
+    for back in range(min(count, K) - 1):
+        j1 = (count - 1 - back) % K
+        j = (j1 - 1) % K
+        if (x[j] - level) * (x[j1] - level) <= 0.0 and x[j] != x[j1]:
+            return j, (level - x[j]) / (x[j1] - x[j])
+    return -1, 0.0
+
+
+@njit(cache=True)
+def _uniform_band(r, tip, ds):
+    """The tip predictor's band [lo, hi) around node ``tip``, LATTICE_BAND_IN nodes inside
+    and LATTICE_BAND_OUT outside, cut to the nodes spaced ``ds`` (and one node off either
+    end of the mesh, so that a node's neighbours exist)."""
+    N = r.size
+    lo, hi = tip, tip
+    tol = SPACING_RTOL * ds
+    while lo > max(tip - LATTICE_BAND_IN, 1) and abs(r[lo] - r[lo - 1] - ds) <= tol:
+        lo -= 1
+    while hi < min(tip + LATTICE_BAND_OUT, N - 1) and abs(r[hi + 1] - r[hi] - ds) <= tol:
+        hi += 1
+    return lo, hi
+
+
+@njit(cache=True)
+def predict_lattice(r, h, past, past_ta, count, dt, hp):
+    """Newton's start near the crack tip (overwrites ``hp`` there; True where it did): on a
+    mesh the tip does not slide at a steady speed but is held and released by the nodes it
+    crosses, so the gaps next to it move in a cycle that repeats, node by node, each time the
+    tip has moved one spacing. The start is the last gap ``h`` plus the change the same step
+    ``dt`` made one cycle earlier, taken one node along: from the ring of accepted states
+    (``past``, times and contact radii ``past_ta``, ``count`` written), the time tau at which
+    the contact radius was one spacing from its last value a on the far side of its motion
+    (interpolated between states) and the gaps at tau and tau + dt (interpolated in time),
+    h_i + [h(tau + dt) - h(tau)]_(i + s), s = +1 for a receding tip (-1 advancing), on the
+    nodes of the band around a. Nothing is written while the tip has not moved one spacing
+    within the ring or when it moved more than that within one step."""
+    K = past.shape[0]
+    if count < 3:
+        return False
+    last, prev = (count - 1) % K, (count - 2) % K
+    a, a_prev = past_ta[1, last], past_ta[1, prev]
+    tip = np.searchsorted(r, a)
+    if a == a_prev or tip < 1 or tip >= r.size:
+        return False
+    ds = r[tip] - r[tip - 1]
+    s = 1 if a < a_prev else -1
+    m, f = _ring_crossing(past_ta, 1, count, a + s * ds)
+    if m < 0:
+        return False
+    m1 = (m + 1) % K
+    tau = past_ta[0, m] + f * (past_ta[0, m1] - past_ta[0, m])
+    q, g = _ring_crossing(past_ta, 0, count, tau + dt)
+    if q < 0:
+        return False
+    q1 = (q + 1) % K
+    lo, hi = _uniform_band(r, tip, ds)
+    for i in range(max(lo, -s), min(hi, r.size - max(s, 0))):
+        j = i + s
+        dh = (past[q, j] + g * (past[q1, j] - past[q, j])
+              - past[m, j] - f * (past[m1, j] - past[m, j]))
+        hp[i] = max(h[i] + dh, PREDICT_FLOOR * h[i])
+    return True
+
+
+@njit(cache=True)
+def score_starts(r, starts, h, a):
+    """log2 of max |start - h| of the tip predictor's start (``starts[1]``) over that of the
+    cubic one (``starts[0]``), on the tip predictor's band around the crack tip ``a``
+    (LATTICE_BAND_IN nodes inside, LATTICE_BAND_OUT outside), ``h`` the solved gap."""
+    tip = np.searchsorted(r, a)
+    e_cubic, e_tip = 0.0, 0.0
+    for i in range(max(tip - LATTICE_BAND_IN, 0), min(tip + LATTICE_BAND_OUT, r.size)):
+        e_cubic = max(e_cubic, abs(starts[0, i] - h[i]))
+        e_tip = max(e_tip, abs(starts[1, i] - h[i]))
+    if e_tip == 0.0 or e_cubic == 0.0:
+        return 0.0
+    return np.log2(e_tip / e_cubic)
+
+
+@njit(cache=True, inline='always')
 def predict(h, h_prev, h_prev2, dt, dt_prev, dt_prev2, hp):
     """Starting gap of the next solve: quadratic (Lagrange) extrapolation through the last
     three accepted states (linear after one, constant at the start), floored at
@@ -575,7 +687,8 @@ def next_step(dd, easy, da, da_max, err, dd_max, step_tol):
 
 @njit(cache=True, inline='always')
 def new_work(r, h_init, q):
-    """The loop's arrays (:data:`Work`), the last four states all ``h_init``."""
+    """The loop's arrays (:data:`Work`), the last four states all ``h_init``, the tip
+    predictor's ring empty."""
     N = h_init.size
     M = q.shape[0]
     r2half = np.empty(N)
@@ -583,7 +696,9 @@ def new_work(r, h_init, q):
         r2half[i] = 0.5 * r[i] ** 2
     return Work(h_init.copy(), h_init.copy(), h_init.copy(), h_init.copy(), np.empty(N),
                 np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(M),
-                np.empty(M), np.empty(N), np.empty(N), r2half, q)
+                np.empty(M), np.empty(N), np.empty(N), r2half, q,
+                np.empty((LATTICE_HISTORY, N)), np.empty((2, LATTICE_HISTORY)),
+                np.empty((2, N)))
 
 
 @njit(cache=True, inline='always')
@@ -613,11 +728,13 @@ def start_run(mesh, physics, start, records, work, run, hm):
 
 
 @njit(cache=True, inline='always')
-def predict_step(physics, work, run):
+def predict_step(mesh, physics, work, run):
     """-- predict: the step's time step, C_eff, H and g for the step ``run[RUN_DD]``, and
     Newton's starting gaps: the quadratic extrapolation in ``work.h_pred`` (and ``hp``),
-    the cubic one, where four states exist, in ``work.hp``. Returns (quadratic, cubic):
-    which extrapolations were made."""
+    the cubic one, where four states exist, in ``work.hp``, replaced near the crack tip by
+    the tip predictor's (:func:`predict_lattice`) where it applies and has been the nearer
+    of the two on the last steps where both were made (LATTICE_SCORE_USE). Returns
+    (quadratic, cubic): which extrapolations were made."""
     h0, dd = physics.h0, run[RUN_DD]
     dt = dd / (physics.rate * h0)
     run[RUN_DT] = dt
@@ -635,6 +752,15 @@ def predict_step(physics, work, run):
     # the step-error estimate
     cubic = predict_cubic(work.h, work.h_prev, work.h_prev2, work.h_prev3, dt,
                           run[RUN_DT_PREV], run[RUN_DT_PREV2], run[RUN_DT_PREV3], work.hp)
+    run[RUN_TIP_MADE] = 0.0
+    if cubic:
+        work.starts[0] = work.hp
+        if predict_lattice(mesh.r, work.h, work.past, work.past_ta, int(run[RUN_PAST]), dt,
+                           work.hp):
+            run[RUN_TIP_MADE] = 1.0
+            work.starts[1] = work.hp
+            if not run[RUN_TIP_SCORE] < LATTICE_SCORE_USE:
+                work.hp[:] = work.starts[0]
     return quadratic, cubic
 
 
@@ -712,7 +838,8 @@ def step_load(mesh, physics, work, quadratic):
 @njit(cache=True, inline='always')
 def accept_step(mesh, physics, work, run, records, n, P, a_new):
     """-- accept: the Prony modes, the last four states and time steps move on by the
-    solved state ``work.hp``, and record ``n`` (load ``P``, contact radius ``a_new``) is
+    solved state ``work.hp`` (also written to the tip predictor's ring, and the step's two
+    starts compared on it), and record ``n`` (load ``P``, contact radius ``a_new``) is
     written."""
     update_modes(work.e, work.b, work.q, work.sig_new, work.sigma)
     _copy(work.h_prev2, work.h_prev3)
@@ -732,6 +859,14 @@ def accept_step(mesh, physics, work, run, records, n, P, a_new):
     records.P[n] = P
     records.a[n] = a_new
     records.a_inner[n] = crossing_radius(work.h, mesh.r, physics.h0)
+    if run[RUN_TIP_MADE] != 0.0:
+        run[RUN_TIP_SCORE] += LATTICE_SCORE_WEIGHT * (
+            score_starts(mesh.r, work.starts, work.h, a_new) - run[RUN_TIP_SCORE])
+    k = int(run[RUN_PAST]) % LATTICE_HISTORY
+    work.past[k] = work.h
+    work.past_ta[0, k] = run[RUN_T]
+    work.past_ta[1, k] = a_new
+    run[RUN_PAST] += 1
 
 
 @njit(cache=True, inline='always')
@@ -783,7 +918,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
     easy = 0
     status = STATUS_STEP_LIMIT
     while n <= control.max_steps:
-        quadratic, cubic = predict_step(physics, work, run)
+        quadratic, cubic = predict_step(mesh, physics, work, run)
         outcome = solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats)
         if outcome != SOLVED:
             easy = 0

@@ -5,6 +5,7 @@ This is the interface a tip-following mesh and a wall-time budget build on. Its 
 predictors are exact for polynomials in time of their order.
 """
 import numpy as np
+import pytest
 
 from sweep.kernels.solve import (N_STATS, STATUS_DONE, STATUS_STEP_LIMIT, MeshArrays, Physics,
                                  Records, RunState, StepControl, new_jacobian_cache, unload)
@@ -141,3 +142,65 @@ def test_predictors_are_exact_for_polynomials_of_their_order():
     hp[:] = -1.0
     assert not predict_cubic(h, h1, h2, h3, dt, dts[0], dts[1], 0.0, hp)
     assert np.all(hp == -1.0)                            # nothing written before four states
+
+
+def _lattice_states(count, dt, T, ds, r, h0=1.0):
+    """A crack tip held and released by the nodes (spacing ``ds``): it recedes one spacing
+    in each period ``T`` at a speed that varies by a factor 9 within the period, the gap a
+    sharp profile that travels with it plus a slow uniform opening (units of h0)."""
+    def tip(t):
+        return 2.0 - ds * (t / T - 0.8 * np.sin(2 * np.pi * t / T) / (2 * np.pi))
+
+    def gap(t):
+        x = (r - tip(t)) / (1.5 * ds)
+        return h0 * (1.0 + np.log1p(np.exp(x)) ** 2) + 0.01 * h0 * t
+    times = dt * np.arange(count)
+    return times, [gap(t) for t in times], np.array([tip(t) for t in times]), gap
+
+
+@pytest.mark.parametrize("count", [12, 21])           # the ring not yet full, and wrapped
+def test_tip_predictor_follows_a_tip_held_by_the_nodes(count):
+    # the gaps next to a tip that moves in a cycle repeated node by node: the tip predictor
+    # (the change of one cycle earlier, one node along) is exact where the steps hit the
+    # cycle, the cubic extrapolation at the nodes misses by tenths of h0
+    from sweep.kernels.solve import (LATTICE_HISTORY, PREDICT_FLOOR, predict_cubic,
+                                     predict_lattice)
+    ds, T = 0.02, 1.0
+    dt = T / 5
+    r = ds * np.arange(200)
+    times, states, tips, gap = _lattice_states(count, dt, T, ds, r)
+    past, past_ta = np.empty((LATTICE_HISTORY, r.size)), np.empty((2, LATTICE_HISTORY))
+    for k in range(count):
+        past[k % LATTICE_HISTORY] = states[k]
+        past_ta[:, k % LATTICE_HISTORY] = times[k], tips[k]
+    h = states[-1]
+    hp = np.empty_like(r)
+    assert predict_cubic(h, states[-2], states[-3], states[-4], dt, dt, dt, dt, hp)
+    exact = gap(times[-1] + dt)
+    near = np.abs(r - tips[-1]) < 10 * ds
+    cubic_error = np.max(np.abs(hp - exact)[near])
+    assert cubic_error > 0.05
+    assert predict_lattice(r, h, past, past_ta, count, dt, hp)
+    assert np.max(np.abs(hp - exact)[near]) < 1e-9
+    assert np.all(hp >= PREDICT_FLOOR * h)
+    # a tip that has not moved one node within the ring: nothing written
+    past_ta[1] = tips[-1] + 1e-3 * ds * np.arange(LATTICE_HISTORY)
+    hp[:] = -1.0
+    assert not predict_lattice(r, h, past, past_ta, count, dt, hp)
+    assert np.all(hp == -1.0)
+
+
+def test_the_two_starts_are_scored_on_the_band_around_the_tip():
+    # log2 of the tip predictor's error over the cubic's, max over the band around the tip:
+    # an error far from the tip does not count
+    from sweep.kernels.solve import LATTICE_BAND_OUT, score_starts
+    r = 0.01 * np.arange(300)
+    h = np.ones_like(r)
+    starts = np.ones((2, r.size))
+    tip = 100
+    starts[0, tip + 1] += 0.4                      # the cubic misses next to the tip
+    starts[1, tip - 2] += 0.1                      # the tip predictor by a quarter of that
+    starts[1, tip + LATTICE_BAND_OUT + 5] += 9.0   # beyond the band: not counted
+    assert score_starts(r, starts, h, r[tip] - 0.005) == pytest.approx(-2.0)
+    starts[1, tip - 2] += 0.7
+    assert score_starts(r, starts, h, r[tip] - 0.005) == pytest.approx(1.0)
