@@ -19,7 +19,7 @@ help:
 	@echo "make test   - create/update .venv and run the test suite"
 	@echo "make docs-check [QUICK=1] - run every command and snippet of README.md and docs/"
 	@echo "               (QUICK=1: the quick form that make test runs, tests/test_docs_run.py)"
-	@echo "make bench  - speed benchmarks of issue 9 (results/bench.json, ~2 min)"
+	@echo "make bench  - speed benchmarks of issues 9 and 24 (results/bench.json, ~5 min)"
 	@echo "make tradeoff [QUICK=1] - accuracy vs time over a grid of numerics (results/tradeoff/)"
 	@echo "make coverage-kernels - kernel tests with NUMBA_DISABLE_JIT=1 under coverage"
 	@echo "make reproduce - the paper's campaigns, fits, figures and results/REPORT.md"
