@@ -18,7 +18,6 @@ uniform mesh scales the cached unit-spacing matrix.
 from __future__ import annotations
 
 import dataclasses
-
 import math
 from dataclasses import dataclass
 from pathlib import Path
