@@ -754,13 +754,13 @@ def predict_step(mesh, physics, work, run):
                           run[RUN_DT_PREV], run[RUN_DT_PREV2], run[RUN_DT_PREV3], work.hp)
     run[RUN_TIP_MADE] = 0.0
     if cubic:
-        work.starts[0] = work.hp
+        _copy(work.hp, work.starts[0])
         if predict_lattice(mesh.r, work.h, work.past, work.past_ta, int(run[RUN_PAST]), dt,
                            work.hp):
             run[RUN_TIP_MADE] = 1.0
-            work.starts[1] = work.hp
+            _copy(work.hp, work.starts[1])
             if not run[RUN_TIP_SCORE] < LATTICE_SCORE_USE:
-                work.hp[:] = work.starts[0]
+                _copy(work.starts[0], work.hp)
     return quadratic, cubic
 
 
@@ -863,7 +863,7 @@ def accept_step(mesh, physics, work, run, records, n, P, a_new):
         run[RUN_TIP_SCORE] += LATTICE_SCORE_WEIGHT * (
             score_starts(mesh.r, work.starts, work.h, a_new) - run[RUN_TIP_SCORE])
     k = int(run[RUN_PAST]) % LATTICE_HISTORY
-    work.past[k] = work.h
+    _copy(work.h, work.past[k])
     work.past_ta[0, k] = run[RUN_T]
     work.past_ta[1, k] = a_new
     run[RUN_PAST] += 1

@@ -321,12 +321,22 @@ def tip_window(tip: float, zone: float, ahead: float = WINDOW_AHEAD_ZONES,
     return max(lo, 0.0), hi
 
 
+def band_nodes(numerics, zone: float, a0_estimate: float, domain: float,
+               pull_off_only: bool = True) -> int:
+    """Nodes of a scene's graded mesh sized from the band resolution (``numerics.nodes``
+    ignored): its fixed crack band from ``a0_estimate`` for the tip zone ``zone``, graded
+    outside it to ``domain`` (a_ref). What one time step costs on the graded mesh, against
+    :func:`window_nodes`, and what ``numerics.max_nodes`` bounds."""
+    return scene_mesh(dataclasses.replace(numerics, nodes=None), zone, a0_estimate, domain,
+                      pull_off_only=pull_off_only).nodes
+
+
 def window_nodes(numerics, zone: float, a0_estimate: float, domain: float,
                  ahead: float = WINDOW_AHEAD_ZONES, behind: float = WINDOW_BEHIND_ZONES) -> int:
     """Nodes of a scene's first tip-following mesh: the window at the estimated initial
     contact radius ``a0_estimate`` for the tip zone ``zone``, graded outside it to
     ``domain`` (a_ref), at the fine spacing of ``numerics`` (what one time step costs on
-    that mesh, against the graded mesh's fixed band, :func:`scene_mesh`)."""
+    that mesh, against the graded mesh's fixed band, :func:`band_nodes`)."""
     num = dataclasses.replace(numerics, mesh="graded", nodes=None, exact=False)
     return scene_mesh(num, zone, a0_estimate, domain,
                       band=tip_window(a0_estimate, zone, ahead, behind)).nodes

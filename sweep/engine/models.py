@@ -30,7 +30,6 @@ the store and the analysis do not care which ran.
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import time
@@ -47,7 +46,7 @@ from ..scene import Numerics, Result, Scene
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem
 from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
-from .mesh import scene_mesh, window_nodes
+from .mesh import band_nodes, window_nodes
 from .problem import BEM_MU_RANGE, derive
 from .quasistatic import simulate_elastic
 
@@ -155,16 +154,15 @@ def bem_nodes_needed(scene, numerics=None) -> int:
 
     Uniform mesh: its automatic (or given) domain over the spacing at which the process zone
     ``l0 = 1.693/mu^2`` spans ``numerics.zone_nodes`` spacings. Graded mesh: the nodes of
-    the mesh the solver would build (:func:`sweep.engine.mesh.scene_mesh`, sized from the band
+    the mesh the solver would build (:func:`sweep.engine.mesh.band_nodes`, sized from the band
     resolution).
     """
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     s = derive(scene, numerics)
     if numerics.mesh == "uniform":
         return int(math.ceil(s.domain * numerics.zone_nodes / s.tip_zone)) + 1
-    mesh = scene_mesh(dataclasses.replace(numerics, nodes=None), s.tip_zone, s.a0_estimate,
-                      s.domain, pull_off_only=scene.stop == "pulloff")
-    return mesh.nodes
+    return band_nodes(numerics, s.tip_zone, s.a0_estimate, s.domain,
+                      pull_off_only=scene.stop == "pulloff")
 
 
 def bem_node_budget(numerics) -> int:

@@ -46,7 +46,7 @@ from ..kernels.interface import lj_traction
 from ..scene import Numerics, Result, Scene
 from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, no_contact_reason, unload_chunk
 from .initial import ElasticSolver, relaxed_state
-from .mesh import WINDOW_AHEAD_ZONES, WINDOW_BEHIND_ZONES, scene_mesh, tip_window
+from .mesh import WINDOW_AHEAD_ZONES, WINDOW_BEHIND_ZONES, band_nodes, tip_window
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Refused, derive, jkr_radius, material_of, prepare
 from .quasistatic import ElasticBranch
@@ -405,9 +405,8 @@ def direct_initial_state(el: ElasticSolver, pb, scene: Scene):
     numerics, s = pb.numerics, pb.scales
     if scene.a0 is None or scene.a0 < DIRECT_INITIAL_A0:
         return None
-    band = scene_mesh(dataclasses.replace(numerics, nodes=None), s.tip_zone, s.a0_estimate,
-                      s.domain, pull_off_only=scene.stop == "pulloff")
-    if band.nodes > numerics.max_nodes:
+    if band_nodes(numerics, s.tip_zone, s.a0_estimate, s.domain,
+                  pull_off_only=scene.stop == "pulloff") > numerics.max_nodes:
         return None
     try:
         h, d = relaxed_state(el, a0=scene.a0, mesh_key=(pb.mesh.key, pb.mesh.spacing))
