@@ -119,18 +119,26 @@ def relaxed_state(el: ElasticSolver, delta0=None, a0=None, mesh_key=None):
     law, tolerance and initial state; ``el`` then solves nothing (its Jacobian cache stays
     unfactorized). Returns (h, delta0) or raises RuntimeError with a reason.
     """
-    key = None
-    if mesh_key is not None:
-        key = (mesh_key, el.h0, el.c, el.tol, delta0, a0)
-        hit = _RELAXED.get(key)
-        if hit is not None:
-            _RELAXED.move_to_end(key)
-            return hit[0].copy(), hit[1]
-    h, d = _solve_relaxed(el, delta0, a0)
-    if key is not None:
-        _RELAXED[key] = (h.copy(), d)
-        if len(_RELAXED) > RELAXED_CACHE_SIZE:
-            _RELAXED.popitem(last=False)
+    if mesh_key is None:
+        return _solve_relaxed(el, delta0, a0)
+    return cached_state((mesh_key, el.h0, el.c, el.tol, delta0, a0),
+                        lambda: _solve_relaxed(el, delta0, a0))
+
+
+def cached_state(key, solve):
+    """The state (gap h, indentation delta) kept under ``key`` in this process's cache of
+    relaxed states (RELAXED_CACHE_SIZE of them, least recently used dropped), else
+    ``solve()``'s, kept; a copy of the gap either way. ``key`` must determine the state: the
+    mesh, the LJ law, the tolerance and the initial state (and the method, where two give
+    different states)."""
+    hit = _RELAXED.get(key)
+    if hit is not None:
+        _RELAXED.move_to_end(key)
+        return hit[0].copy(), hit[1]
+    h, d = solve()
+    _RELAXED[key] = (h.copy(), d)
+    if len(_RELAXED) > RELAXED_CACHE_SIZE:
+        _RELAXED.popitem(last=False)
     return h, d
 
 

@@ -45,7 +45,7 @@ from ..kernels.interface import lj_traction
 
 from ..scene import Numerics, Result, Scene
 from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, no_contact_reason, unload_chunk
-from .initial import ElasticSolver, relaxed_state
+from .initial import ElasticSolver, cached_state, relaxed_state
 from .mesh import WINDOW_AHEAD_ZONES, WINDOW_BEHIND_ZONES, band_nodes, tip_window
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Refused, derive, jkr_radius, material_of, prepare
@@ -497,19 +497,32 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                       f"the crack-front model (model crack)")
         return res
     try:
-        branch = None
+        branch, from_branch = None, False
+
+        def branch_start():
+            nonlocal branch
+            if branch is None and scene.a0 is not None:
+                branch = branch_state(scene, numerics.band_resolution, domain)
+            try:
+                return initial_state(el, scene, branch)
+            finally:
+                invalidate(el.cache)    # the unloading starts unfactorized, cached or not
+
         # the initial state: where the relaxed tip lies outside the first window (delta0
         # scenes, whose radius is a JKR estimate), once more with the window there
         for _ in range(2):
             pb = prepare(scene, numerics, tip_window(a_est, zone, ahead, behind))
             el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, numerics.tol)
-            direct = direct_initial_state(el, pb, scene) if branch is None else None
+            direct = direct_initial_state(el, pb, scene) if not from_branch else None
             if direct is not None:
                 h_init, delta0 = direct
             else:
-                if branch is None and scene.a0 is not None:
-                    branch = branch_state(scene, numerics.band_resolution, domain)
-                h_init, delta0 = initial_state(el, scene, branch)
+                # the branch and its polish depend on the window mesh, mu and a0 (or
+                # delta0) only: once per process for a sweep over materials and rates
+                from_branch = True
+                h_init, delta0 = cached_state(
+                    ("branch", pb.mesh.key, pb.mesh.spacing, el.h0, el.c, el.tol, scene.a0,
+                     scene.delta0, numerics.band_resolution, domain), branch_start)
             a_init = el.radius(h_init)
             lo, hi = pb.tip_range
             if lo <= a_init <= hi or a_init <= 0.0:

@@ -296,3 +296,28 @@ def test_pull_off_on_a_remeshing_is_read_on_one_mesh():
     assert "load minimum at a re-meshing" in res.reason and "tip-following mesh" in res.reason
     assert res.crack_speed == pytest.approx(3.07e4, rel=0.01)
     assert res.pull_off == pytest.approx(95.380, rel=1e-4)
+
+
+def test_the_branch_start_is_solved_once_per_process_for_a_sweep_over_rates(monkeypatch):
+    """The start from the quasi-static branch (fast preset, a0 = 8: the graded band is above
+    max_nodes) depends on the window mesh, mu and a0 only: a second scene that differs in
+    rate reuses it (the branch is not solved again), and a run from the cache gives the
+    pull-off of a run that solved it (cleared cache: the second method)."""
+    from sweep.engine.initial import clear_relaxed_cache
+
+    num = Numerics.preset("fast", pull_off_rtol=0.0)
+    slow, quick = (Scene(n=0.8, k=0.1, mu=3.24, a0=8.0, rate=r) for r in (10**0.5, 1e3))
+    assert models.bem_nodes_needed(slow, num) > num.max_nodes
+    calls = []
+    solve_branch = tf.branch_state
+    monkeypatch.setattr(tf, "branch_state", lambda *a, **kw: calls.append(1) or solve_branch(*a, **kw))
+    clear_relaxed_cache()
+    first = tf.simulate_tip_following(slow, num)
+    cached = tf.simulate_tip_following(quick, num)
+    assert first.ok and cached.ok, (first.reason, cached.reason)
+    assert len(calls) == 1
+    clear_relaxed_cache()
+    solved = tf.simulate_tip_following(quick, num)
+    assert len(calls) == 2
+    assert (cached.delta0_result, cached.a0_result) == (solved.delta0_result, solved.a0_result)
+    assert cached.pull_off == pytest.approx(solved.pull_off, rel=1e-12)
