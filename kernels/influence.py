@@ -155,7 +155,8 @@ def influence_matrix_nodes(r, xs_smooth, ws_smooth, xs_sing, ws_sing, xs_far, ws
     """
     N = r.size
     ext = np.empty(N + 1)
-    ext[:N] = r
+    for i in range(N):      # a loop: a slice assignment compiles a shape-mismatch message
+        ext[i] = r[i]
     ext[N] = 2.0 * r[N - 1] - r[N - 2]
     A = np.zeros((N, N))
     for i in range(N):

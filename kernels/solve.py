@@ -45,6 +45,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
+from .blas import lu_factor, lu_solve
 from .history import history_vector, step_coefficients, update_modes
 from .interface import TIP_GAP, crossing_radius, lj_traction, lj_traction_and_stiffness
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
@@ -458,6 +459,9 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
     n2 = _norm2(F)
     dtau = RELAX_DTAU_START
     J = np.empty((N, N))
+    piv = np.empty(N, np.int32)
+    rhs = np.empty((1, N))
+    dh = rhs[0]
     for it in range(max_iter):
         if norm <= tol:
             return True
@@ -468,7 +472,12 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
             for j in range(N):
                 J[i, j] = -ceff * A[i, j] * d[j]
             J[i, i] += 1.0 + 1.0 / dtau
-        dh = -np.linalg.solve(J, F)
+        # LAPACK's LU through kernels.blas (np.linalg.solve: 5 s of a cold compile)
+        if lu_factor(J, piv) != 0:
+            raise np.linalg.LinAlgError("relax: the Jacobian is singular")
+        for i in range(N):
+            dh[i] = -F[i]
+        lu_solve(J, piv, rhs)
         lam = positive_step(h, dh)
         for i in range(N):
             ht[i] = h[i] + lam * dh[i]

@@ -200,3 +200,24 @@ def test_relaxed_state_is_cached_per_mesh_and_reused_unchanged():
     h4, _ = relaxed_state(el2, a0=1.4, mesh_key=key)
     assert el2.stats[ks.STAT_ITER] > 0
     assert abs(el2.radius(h4) - 1.4) < r[1]
+
+
+def test_relax_reaches_the_equilibrium_newton_finds():
+    # the pseudo-transient fallback (LU through kernels.blas) from the same start as Newton:
+    # it must zero the residual computed here by numpy and land on Newton's solution
+    from sweep.engine.initial import ElasticSolver, relaxed_state
+    N = 120
+    A, _, h0, c, _ = _problem(N=N, seed=3)
+    r = np.arange(N) * 3.0 / (N - 1)
+    h_start, _ = relaxed_state(ElasticSolver(A, r, h0, c, 1e-10), delta0=1.0)
+    g = -(1.0 - 0.2 * h0) + h0 + 0.5 * r**2
+    ceff, H = 0.8, -0.05 * np.exp(-r)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    hn = h_start.copy()
+    assert ks.newton(hn, g, A, ceff, H, h0, c, 1e-10 * h0, 40, ks.new_jacobian_cache(N), stats)
+    hr = h_start.copy()
+    assert ks.relax(hr, g, A, ceff, H, h0, c, 1e-10 * h0, ks.RELAX_MAX_ITER, stats)
+    sig, d = np.empty(N), np.empty(N)
+    lj_traction_and_stiffness(hr, h0, c, sig, d)
+    assert np.max(np.abs(hr - g - A @ (ceff * sig - H))) < 1e-10 * h0
+    assert np.max(np.abs(hr - hn)) < 1e-8 * h0
