@@ -474,14 +474,17 @@ def test_first_run_says_it_compiles(monkeypatch):
         def message(self, text):
             said.append(text)
 
+    from sweep import Numerics, Scene
+
+    grid = [Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1.0)], Numerics.preset("balanced")
     monkeypatch.setattr(bem, "warm_up", lambda: 42.25)
     monkeypatch.setattr(bem, "kernels_cached", lambda: False)
-    scheduler._warm_parent(Prog())
+    scheduler._warm_parent(Prog(), *grid)
     assert said == ["compiling kernels (first run only) ...",
                     "compiling kernels (first run only): done in 42.2 s"]
     said.clear()
     monkeypatch.setattr(bem, "kernels_cached", lambda: True)
-    scheduler._warm_parent(Prog())
+    scheduler._warm_parent(Prog(), *grid)
     assert said == []                                  # a warm cache: nothing to say
 
 

@@ -135,17 +135,19 @@ def _one_line(text: str, limit: int = 300) -> str:
 
 
 def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | None = None,
-              in_worker: bool = True):
+              in_worker: bool = True, warm: bool = True):
     """Worker task: simulate one scene; return ``(row, trajectory or None)``, plain data.
 
     Never raises for a failing scene. The engine reports numerical failures as
     ``status="failed"`` with a reason; an exception that escapes it is a bug (TypeError, ...)
     and becomes ``status="error"`` with the exception as reason and its traceback in the row's
     :data:`TRACEBACK_KEY` (the parent writes it to the error log and drops it from the row).
-    ``in_worker=False`` (the sequential path in the parent) leaves the thread limits alone.
+    ``in_worker=False`` (the sequential path in the parent) leaves the thread limits alone;
+    ``warm=False`` (a grid whose models need no BEM kernel, on a cold Numba cache) leaves them
+    uncompiled.
     """
     if in_worker:
-        _prepare_worker(warm=simulate is None)
+        _prepare_worker(warm=warm and simulate is None)
     if simulate is None:   # after _prepare_worker: see there
         from ..engine.models import simulate   # the front door: dispatches on scene.model
     t0 = time.perf_counter()
@@ -544,11 +546,11 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
     completed = False
     try:
         if todo:
-            if simulate is None:
-                _warm_parent(prog)
+            warm = simulate is None and _warm_parent(prog, [scene for _, scene in todo],
+                                                     cfg.numerics)
             prog.start()
             chunks = dispatch_chunks(todo, cfg.numerics, n_jobs)
-            results = _results(chunks, cfg, backend, n_jobs, client, simulate)
+            results = _results(chunks, cfg, backend, n_jobs, client, simulate, warm)
             try:
                 for row, traj in results:
                     tb = row.pop(TRACEBACK_KEY, None)
@@ -613,8 +615,11 @@ def _close_dask(client, cluster) -> None:
                 pass
 
 
-def _warm_parent(prog: Progress | None = None) -> None:
-    """Compile (or load) the Numba kernels once, in the parent, before the workers start.
+def _warm_parent(prog: Progress | None = None, scenes=(), numerics=None) -> bool:
+    """Compile (or load) the Numba kernels once, in the parent, before the workers start;
+    True if it did (the workers then load them too), False if the cache is cold and no scene
+    of ``scenes`` runs the BEM (:func:`needs_bem_kernels`): a crack-front or PB grid compiles
+    nothing.
 
     On a cold cache (the first run after an install or an edit of the kernels) the compile
     takes tens of seconds: ``prog`` then gets a line before and one with its time after."""
@@ -623,24 +628,44 @@ def _warm_parent(prog: Progress | None = None) -> None:
     except ImportError as exc:
         raise SweepRuntimeError(f"cannot import the solver ({exc})") from None
     cold = not solver.kernels_cached()
+    if cold and not needs_bem_kernels(scenes, numerics):
+        return False
     if cold and prog is not None:
         prog.message("compiling kernels (first run only) ...")
     seconds = solver.warm_up()
     if cold and prog is not None:
         prog.message(f"compiling kernels (first run only): done in {seconds:.1f} s")
+    return True
+
+
+def needs_bem_kernels(scenes, numerics) -> bool:
+    """Whether any scene runs the BEM's unloading kernels: model "bem" (but an elastic,
+    quasi-static scene: the elastic branch), or "auto" where :func:`model_choice` picks the
+    BEM. An "auto" scene whose cheaper model misses its tolerance at run time still gets the
+    BEM, its kernels compiled on that first call."""
+    from ..engine.models import model_choice, wants_quasistatic
+
+    for scene in scenes:
+        model = getattr(scene, "model", "bem")
+        if model == "bem" and not wants_quasistatic(scene, numerics):
+            return True
+        if model == "auto" and model_choice(scene, numerics).model == "bem":
+            return True
+    return False
 
 
 def run_chunk(scenes, numerics, trajectories: bool = False,
-              simulate: Callable | None = None) -> list:
+              simulate: Callable | None = None, warm: bool = True) -> list:
     """Worker task: :func:`run_scene` on each scene of a dispatch chunk, in order; returns
     the list of their ``(row, trajectory or None)``."""
-    return [run_scene(scene, numerics, trajectories, simulate) for scene in scenes]
+    return [run_scene(scene, numerics, trajectories, simulate, warm=warm) for scene in scenes]
 
 
-def _results(chunks, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate):
+def _results(chunks, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate,
+             warm: bool = True):
     """Yield ``(row, trajectory)`` per scene: chunk by chunk in completion order."""
     calls = (delayed(run_chunk)([scene for _, scene in chunk], cfg.numerics,
-                                cfg.trajectories, simulate)
+                                cfg.trajectories, simulate, warm)
              for chunk in chunks)
     if backend == "loky" and n_jobs == 1:
         limits = limit_loaded_pools()

@@ -181,6 +181,29 @@ def test_worker_warms_numba_cache_once(monkeypatch):
     assert calls == [1] and row["status"] == "ok" and traj is None
 
 
+def test_a_grid_without_bem_scenes_compiles_no_kernels_on_a_cold_cache(monkeypatch):
+    """On a cold Numba cache the parent warms (compiles) the BEM kernels only where a scene
+    needs them: model bem (not the elastic branch), or auto choosing the BEM; a crack-front
+    or PB grid compiles nothing, and its workers are told not to. On a warm cache it always
+    loads them (cheap)."""
+    import sweep.engine.bem as solver
+    calls, cached = [], [False]
+    monkeypatch.setattr(solver, "warm_up", lambda: calls.append(1) or 0.0)
+    monkeypatch.setattr(solver, "kernels_cached", lambda: cached[0])
+    num = Numerics.preset("balanced")
+    crack = [Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=r, model="crack") for r in (1, 100)]
+    pb = [Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1.0, model="pb")]
+    elastic = [Scene(n=0.8, k=1.0, mu=3.24, a0=2.0, rate=1.0)]       # bem -> elastic branch
+    far = [Scene(n=0.8, k=0.1, mu=1e4, a0=2.0, rate=1.0, model="auto")]  # auto -> crack
+    bem = [Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1.0)]
+    auto_bem = [Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1.0, model="auto")]
+    assert not scheduler._warm_parent(None, crack + pb + elastic + far, num) and calls == []
+    assert scheduler._warm_parent(None, crack + bem, num) and calls == [1]
+    assert scheduler._warm_parent(None, pb + auto_bem, num) and calls == [1, 1]
+    cached[0] = True
+    assert scheduler._warm_parent(None, crack, num) and calls == [1, 1, 1]
+
+
 def test_dask_local_cluster_matches_loky(tmp_path):
     distributed = pytest.importorskip("distributed")
     c = cfg(n=(0.4, 0.8, 1.6), rate=(1, 100))
