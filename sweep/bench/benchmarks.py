@@ -54,7 +54,7 @@ from .error_coverage import sample
 from .plain_solver import plain_unload
 from .tradeoff import (REFERENCE_OVERRIDES, REFERENCES, TRADEOFF_SCENES, VS_NUMPY_SCENES,
                        compute_reference, existing, load_references, reference_for,
-                       relative_error, to_numerics, write_tradeoff)
+                       relative_error, rederive_presets, to_numerics, write_tradeoff)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -1173,9 +1173,19 @@ def reference_cmd(only, out):
 @bench.command("tradeoff")
 @click.option("--quick", is_flag=True, help="A few points on two scenes (smoke test).")
 @click.option("--out", default="results/tradeoff", show_default=True, help="Output directory.")
-def tradeoff_cmd(quick, out):
+@click.option("--repeat", default=2, show_default=True, type=click.IntRange(1, 10),
+              help="Runs per numerics and scene, the best wall kept: the first pays the "
+                   "numerics' set-up (Prony fit, relaxed start on its mesh) that a campaign "
+                   "pays once per worker.")
+@click.option("--from-table", is_flag=True,
+              help="Derive presets.json again from OUT/table.csv, running nothing.")
+def tradeoff_cmd(quick, out, repeat, from_table):
     """Accuracy vs wall time over a grid of numerics: table.csv, pareto.png, presets.json."""
-    report = write_tradeoff(out, quick=quick, progress=lambda m: click.echo(m, err=True))
+    if from_table:
+        click.echo(json.dumps(rederive_presets(out), indent=2, default=str))
+        return
+    report = write_tradeoff(out, quick=quick, repeat=repeat,
+                            progress=lambda m: click.echo(m, err=True))
     click.echo(json.dumps(report["presets"], indent=2, default=str))
 
 

@@ -68,20 +68,29 @@ def run_scene(d: dict, budget_s: float = 30.0, probe: bool = False) -> dict:
                                      "pull_off": ref.pull_off, "wall_s": ref.wall_s,
                                      "nodes": ref.nodes_used}}
     for name in PRESET_NAMES:
-        res = simulate(scene, Numerics.preset(name, time_budget_s=budget_s))
-        true = abs(res.pull_off / ref.pull_off - 1.0) if (res.ok and ref.ok) else math.nan
-        row[name] = {"status": res.status, "reason": res.reason, "pull_off": res.pull_off,
-                     "error_estimate": res.error_estimate, "true_error": true,
-                     "wall_s": res.wall_s, "nodes": res.nodes_used, "spacing": res.spacing,
-                     "steps": res.steps, "prony_error": res.prony_error,
-                     "model": res.model_used}
-        if probe:
-            num = Numerics.preset(name, time_budget_s=budget_s, pull_off_rtol=0.0)
-            for key, n2 in (("plain", num), ("coarse", coarser(num))):
-                r2 = simulate(scene, n2)
-                row[name][f"{key}_pull_off"] = r2.pull_off
-                row[name][f"{key}_wall_s"] = r2.wall_s
+        row[name] = run_preset(d, name, row["reference"], budget_s, probe)
     return row
+
+
+def run_preset(d: dict, name: str, reference: dict, budget_s: float = 30.0,
+               probe: bool = False) -> dict:
+    """One preset on one scene: its pull-off, estimate and true error against
+    ``reference`` (the reference entry of a row: status and pull-off)."""
+    scene = Scene(**d)
+    res = simulate(scene, Numerics.preset(name, time_budget_s=budget_s))
+    ok = res.ok and reference["status"] == "ok"
+    true = abs(res.pull_off / reference["pull_off"] - 1.0) if ok else math.nan
+    out = {"status": res.status, "reason": res.reason, "pull_off": res.pull_off,
+           "error_estimate": res.error_estimate, "true_error": true,
+           "wall_s": res.wall_s, "nodes": res.nodes_used, "spacing": res.spacing,
+           "steps": res.steps, "prony_error": res.prony_error, "model": res.model_used}
+    if probe:
+        num = Numerics.preset(name, time_budget_s=budget_s, pull_off_rtol=0.0)
+        for key, n2 in (("plain", num), ("coarse", coarser(num))):
+            r2 = simulate(scene, n2)
+            out[f"{key}_pull_off"] = r2.pull_off
+            out[f"{key}_wall_s"] = r2.wall_s
+    return out
 
 
 def summarize(rows: list[dict]) -> dict:
@@ -121,6 +130,9 @@ def _main(argv=None) -> int:
     p.add_argument("--grow", action="store_true",
                    help="keep the rows of OUT/coverage.json (same seed) and run only the "
                         "scenes it lacks (a larger --scenes extends the sample)")
+    p.add_argument("--rerun", choices=PRESET_NAMES, action="append", default=[],
+                   help="run this preset again on every scene of OUT/coverage.json, the "
+                        "references kept (after the preset changed); repeatable")
     args = p.parse_args(argv)
     from joblib import Parallel, delayed
 
@@ -133,8 +145,20 @@ def _main(argv=None) -> int:
             raise SystemExit(f"error: --grow: {out / 'coverage.json'} has seed {old['seed']}, "
                              f"not {args.seed}")
         rows, wall, commands = old["rows"], old["wall_s"], old["command"].split(" && ")
+    if args.rerun:
+        if not (out / "coverage.json").exists():
+            raise SystemExit(f"error: --rerun: no {out / 'coverage.json'} to take the scenes "
+                             f"and references from")
+        old = json.loads((out / "coverage.json").read_text())
+        rows, wall, commands = old["rows"], old["wall_s"], old["command"].split(" && ")
+        jobs = [(i, name) for i, _ in enumerate(rows) for name in args.rerun]
+        for (i, name), got in zip(jobs, Parallel(n_jobs=args.jobs)(
+                delayed(run_preset)(rows[i]["scene"], name, rows[i]["reference"], args.budget,
+                                    args.probe) for i, name in jobs)):
+            rows[i][name] = got
+        print(f"reran {', '.join(args.rerun)} on {len(rows)} scenes")
     have = [r["scene"] for r in rows]
-    scenes = [d for d in sample(args.scenes, args.seed) if d not in have]
+    scenes = [] if args.rerun else [d for d in sample(args.scenes, args.seed) if d not in have]
     for row in Parallel(n_jobs=args.jobs, return_as="generator_unordered")(
             delayed(run_scene)(d, args.budget, args.probe) for d in scenes):
         rows.append(row)

@@ -80,6 +80,29 @@ def test_suggested_presets_are_cheapest_under_each_worst_case_target():
     assert s["0.001"]["total_wall_s"] == pytest.approx(1.0)
 
 
+def test_each_preset_is_set_beside_the_cheapest_numerics_with_an_error_estimate():
+    """presets_on_front: per preset, the cheapest point meeting its target among the numerics
+    that carry the error estimate (pull_off_rtol > 0): a cheaper point without it does not
+    count, nor one whose grading (unseen by the estimate) differs; a cheaper point with it
+    does (the preset is then off the front by the ratio)."""
+    from sweep.bench.tradeoff import PRESET_TARGETS
+    tgt = PRESET_TARGETS["balanced"]
+    rows = []
+    for label, err, wall, rtol, grading in (("balanced", 0.5 * tgt, 1.0, 0.01, 1.1),
+                                            ("no_estimate", 0.1 * tgt, 0.1, 0.0, 1.1),
+                                            ("other_grading", 0.1 * tgt, 0.2, 0.01, 1.3),
+                                            ("cheaper", 0.9 * tgt, 0.5, 0.01, 1.1),
+                                            ("too_coarse", 2.0 * tgt, 0.05, 0.01, 1.1)):
+        rows += [{"scene": sc, "label": label, "err_pull_off": err, "err_crack_speed": err,
+                  "wall_s": wall, "pull_off_rtol": rtol, "grading": grading, "tail_gap": 60.0,
+                  "domain": None} for sc in ("s1", "s2")]
+    got = suggest_presets(rows)
+    on = got["presets_on_front"]["balanced"]
+    assert on["cheapest"] == "cheaper" and on["meets_target"]
+    assert on["wall_over_cheapest"] == pytest.approx(2.0)
+    assert got["suggested"]["0.001"]["label"] == "no_estimate"    # the plain front: any point
+
+
 def test_grid_has_the_presets_first_and_only_existing_fields():
     g = grid()
     assert [p["label"] for p in g[:len(PRESETS)]] == list(PRESETS)
@@ -229,3 +252,21 @@ def test_scene_process_is_timed_against_the_imports_of_numpy_and_scipy():
     assert rep["command"].startswith("sweep scene --n=0.8") and "--preset fast" in rep["command"]
     assert rep["ratio"] == pytest.approx(rep["scene_process_s"] / rep["import_numpy_scipy_s"])
     assert rep["scene_process_s"] > rep["import_numpy_scipy_s"] > 0   # it imports both
+
+
+def test_presets_derived_again_from_the_table_match_those_of_the_run(tmp_path):
+    """`benchmarks tradeoff --from-table`: table.csv read back (numbers as floats, empty
+    cells as None) gives the suggestions the in-memory rows gave."""
+    import json as _json
+    from sweep.bench.tradeoff import rederive_presets
+    rows = [{"scene": sc, "label": lab, "err_pull_off": e, "err_crack_speed": e, "wall_s": w,
+             "pull_off_rtol": 0.01, "grading": 1.1, "tail_gap": 60.0, "domain": None,
+             "status": "ok"}
+            for sc in ("s1", "s2") for lab, e, w in (("balanced", 5e-4, 1.0), ("x", 9e-4, 0.5))]
+    write_table(rows, tmp_path / "table.csv")
+    (tmp_path / "presets.json").write_text(_json.dumps({"wall_s": 1.0, "presets": {}}))
+    got = rederive_presets(tmp_path)
+    assert got == _json.loads(_json.dumps(suggest_presets(rows)))
+    assert got["presets_on_front"]["balanced"]["cheapest"] == "x"
+    doc = _json.loads((tmp_path / "presets.json").read_text())
+    assert doc["wall_s"] == 1.0 and "presets_from" in doc

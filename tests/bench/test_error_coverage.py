@@ -49,3 +49,21 @@ def test_the_committed_measurement_meets_the_targets(preset):
     assert s == pytest.approx(doc["summary"][preset])
     assert s["scenes"] >= 15
     assert s["coverage"] >= 0.9 and s["median_looseness"] <= 10.0, s
+
+
+def test_rerun_replaces_one_presets_rows_and_keeps_the_references(tmp_path):
+    """--rerun runs a changed preset again on the scenes of an earlier file: its rows are
+    new, measured against the kept reference; the other presets' rows stay as they were."""
+    scene = dict(n=0.8, k=0.5, mu=3.24, a0=1.5, rate=10.0, material="mpl")
+    stale = {"status": "ok", "error_estimate": 9.0, "true_error": 8.0}
+    reference = {"status": "ok", "pull_off": 1.0}      # far from the scene's: a known error
+    doc = {"rows": [{"scene": scene, "reference": reference,
+                     **{name: dict(stale) for name in error_coverage.PRESET_NAMES}}],
+           "seed": 7, "wall_s": 1.0, "command": "python -m sweep.bench.error_coverage"}
+    (tmp_path / "coverage.json").write_text(json.dumps(doc))
+    assert error_coverage._main(["--rerun", "fast", "--out", str(tmp_path), "-j", "1"]) == 0
+    row = json.loads((tmp_path / "coverage.json").read_text())["rows"][0]
+    assert row["reference"] == reference and row["balanced"] == stale
+    fast = row["fast"]
+    assert fast["status"] == "ok"
+    assert fast["true_error"] == pytest.approx(abs(fast["pull_off"] - 1.0))
