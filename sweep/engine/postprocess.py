@@ -69,6 +69,44 @@ def crack_speed_at(t, a, t_star, spacing, window_nodes=3.0, min_points=5):
     return -coef[1] / scale
 
 
+def crack_speed_on_mesh(t, a, t_star, spacing, lo, hi, window_nodes=3.0, min_points=5):
+    """:func:`crack_speed_at` on the records ``lo:hi`` computed on one mesh; where its fit's
+    samples reach an end of that span at which the run was re-meshed, the records of the
+    neighbouring mesh within the same radius window join the fit, each side with an offset
+    of its own (the small step the state transfer makes in the radius), so that the fit is
+    not one-sided: at a minimum on the last record of a mesh a one-sided quadratic read the
+    crack speed 4 % low (n 0.8, a0 5, rate 1, balanced, window 10/6)."""
+    seg_t, seg_a = t[lo:hi], a[lo:hi]
+    a_star = np.interp(t_star, seg_t, seg_a)
+    win = window_nodes * spacing
+    sel = np.flatnonzero(np.abs(seg_a - a_star) <= win)
+    before, after = [], []
+    if sel.size and lo > 0 and sel[0] == 0:
+        j = lo - 1
+        while j >= 0 and abs(a[j] - a_star) <= win:
+            before.append(j)
+            j -= 1
+    if sel.size and hi < len(t) and sel[-1] == hi - lo - 1:
+        j = hi
+        while j < len(t) and abs(a[j] - a_star) <= win:
+            after.append(j)
+            j += 1
+    if not before and not after:
+        return crack_speed_at(seg_t, seg_a, t_star, spacing, window_nodes, min_points)
+    idx = np.array(sorted(before) + list(lo + sel) + after)
+    tt = t[idx] - t_star
+    scale = max(np.max(np.abs(tt)), 1e-300)
+    x = tt / scale
+    cols = [np.ones_like(x), x, x * x]
+    cols += [(idx < lo).astype(float)] if before else []
+    cols += [(idx >= hi).astype(float)] if after else []
+    X = np.column_stack(cols)
+    if idx.size < X.shape[1] + 2:
+        return crack_speed_at(seg_t, seg_a, t_star, spacing, window_nodes, min_points)
+    coef = np.linalg.lstsq(X, a[idx], rcond=None)[0]
+    return -coef[1] / scale
+
+
 def one_mesh_span(i: int, n: int, remeshed=()) -> tuple[int, int]:
     """The records ``lo:hi`` computed on the same mesh as record ``i`` of ``n``, where
     ``remeshed`` lists the first record of each new mesh (a re-meshing of the tip-following
@@ -136,7 +174,7 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         res.reason = "no tensile load reached"
         return
     span = slice(lo, hi)
-    speed = float(crack_speed_at(t[span], a[span], t_star, spacing))
+    speed = float(crack_speed_on_mesh(t, a, t_star, spacing, lo, hi))
     if speed < 0:
         res.reason = (f"negative crack speed at the pull-off ({speed:.4g} a_ref/tau0, the "
                       f"contact advancing at the load minimum P = {P_star:.6g}, a = "

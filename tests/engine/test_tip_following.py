@@ -321,3 +321,19 @@ def test_the_branch_start_is_solved_once_per_process_for_a_sweep_over_rates(monk
     assert len(calls) == 2
     assert (cached.delta0_result, cached.a0_result) == (solved.delta0_result, solved.a0_result)
     assert cached.pull_off == pytest.approx(solved.pull_off, rel=1e-12)
+
+
+def test_crack_speed_at_a_remeshing_is_read_from_both_meshes():
+    """A load minimum on the last record of a window mesh (n 0.8, a0 5, rate 1, balanced,
+    window 10/6 tip zones): the crack-speed fit takes the next mesh's records too, with an
+    offset of their own, instead of extrapolating a one-sided quadratic (4 % low before).
+    Second method: the 16/8 window, whose re-meshing lies far from the minimum."""
+    scene = Scene(n=0.8, k=0.1, mu=3.24, a0=5.0, rate=1.0)
+    num = Numerics.preset("balanced", pull_off_rtol=0.0)
+    edge = tf.simulate_tip_following(scene, num, 10.0, 6.0)
+    far = tf.simulate_tip_following(scene, num, 16.0, 8.0)
+    assert edge.ok and far.ok, (edge.reason, far.reason)
+    assert "load minimum at a re-meshing" in edge.reason
+    assert "load minimum at a re-meshing" not in far.reason
+    assert edge.pull_off == pytest.approx(far.pull_off, rel=1e-5)
+    assert edge.crack_speed == pytest.approx(far.crack_speed, rel=5e-3)   # measured 3.1e-3
