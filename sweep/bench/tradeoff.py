@@ -371,16 +371,20 @@ def plot_pareto(rows: list[dict], path: str | Path, references: dict | None = No
         ax.set_yscale("log")
         ax.set_xlabel("wall time per scene [s]")
         ax.set_ylabel(f"relative {title} error")
-        ax.set_title(f"{title} error vs wall time (lines: Pareto fronts of the numerics "
-                     f"with the error estimate; x: without it)", fontsize=10)
+        ax.set_title(f"{title} error vs wall time")
         ax.grid(True, which="both", alpha=0.3)
     handles, labels = axes[0].get_legend_handles_labels()
     for name, m in markers.items():
         handles.append(plt.Line2D([], [], marker=m, ls="", mfc="none", mec="k"))
         labels.append(f"preset {name}")
+    handles.append(plt.Line2D([], [], marker="x", ls="", color="k"))
+    labels.append("without the error estimate")
     handles.append(plt.Line2D([], [], ls=":", color="k"))
     labels.append("reference uncertainty")
-    fig.legend(handles, labels, fontsize=9, loc="outside lower center", ncol=len(labels))
+    fig.suptitle("lines: Pareto front of each scene over the numerics that carry the error "
+                 "estimate (a preset's candidates); below a dotted line the error is not resolved",
+                 fontsize=10)
+    fig.legend(handles, labels, fontsize=9, loc="outside lower center", ncol=(len(labels) + 1) // 2)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
