@@ -139,18 +139,15 @@ def _main(argv=None) -> int:
     t0 = time.perf_counter()
     out = Path(args.out)
     rows, wall, commands = [], 0.0, []
-    if args.grow and (out / "coverage.json").exists():
-        old = json.loads((out / "coverage.json").read_text())
-        if old["seed"] != args.seed:
-            raise SystemExit(f"error: --grow: {out / 'coverage.json'} has seed {old['seed']}, "
-                             f"not {args.seed}")
+    path = out / "coverage.json"
+    if args.rerun and not path.exists():
+        raise SystemExit(f"error: --rerun: no {path} to take the scenes and references from")
+    if (args.grow or args.rerun) and path.exists():
+        old = json.loads(path.read_text())
+        if args.grow and old["seed"] != args.seed:
+            raise SystemExit(f"error: --grow: {path} has seed {old['seed']}, not {args.seed}")
         rows, wall, commands = old["rows"], old["wall_s"], old["command"].split(" && ")
     if args.rerun:
-        if not (out / "coverage.json").exists():
-            raise SystemExit(f"error: --rerun: no {out / 'coverage.json'} to take the scenes "
-                             f"and references from")
-        old = json.loads((out / "coverage.json").read_text())
-        rows, wall, commands = old["rows"], old["wall_s"], old["command"].split(" && ")
         jobs = [(i, name) for i, _ in enumerate(rows) for name in args.rerun]
         for (i, name), got in zip(jobs, Parallel(n_jobs=args.jobs)(
                 delayed(run_preset)(rows[i]["scene"], name, rows[i]["reference"], args.budget,

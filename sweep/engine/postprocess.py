@@ -80,17 +80,16 @@ def crack_speed_on_mesh(t, a, t_star, spacing, lo, hi, window_nodes=3.0, min_poi
     a_star = np.interp(t_star, seg_t, seg_a)
     win = window_nodes * spacing
     sel = np.flatnonzero(np.abs(seg_a - a_star) <= win)
-    before, after = [], []
-    if sel.size and lo > 0 and sel[0] == 0:
-        j = lo - 1
-        while j >= 0 and abs(a[j] - a_star) <= win:
-            before.append(j)
-            j -= 1
-    if sel.size and hi < len(t) and sel[-1] == hi - lo - 1:
-        j = hi
-        while j < len(t) and abs(a[j] - a_star) <= win:
-            after.append(j)
-            j += 1
+
+    def reach(j, step):     # the neighbouring mesh's records within the window, from j on
+        out = []
+        while 0 <= j < len(t) and abs(a[j] - a_star) <= win:
+            out.append(j)
+            j += step
+        return out
+
+    before = reach(lo - 1, -1) if sel.size and sel[0] == 0 else []
+    after = reach(hi, 1) if sel.size and sel[-1] == hi - lo - 1 else []
     if not before and not after:
         return crack_speed_at(seg_t, seg_a, t_star, spacing, window_nodes, min_points)
     idx = np.array(sorted(before) + list(lo + sel) + after)
