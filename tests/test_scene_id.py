@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import shutil
 
 import h5py
@@ -19,7 +20,7 @@ from sweep.cli import main
 from sweep.campaign.config import parse_config
 from sweep.scene import SCENE_ID_VERSION, axis
 from sweep.campaign.scheduler import run_sweep
-from sweep.campaign.store import load, load_trajectory, read_attrs
+from sweep.campaign.store import load, load_trajectory, read_attrs, recorded_numerics
 
 V1_FILE = reference.DATA / "results_v1.h5"
 
@@ -58,12 +59,21 @@ def test_a_defaulted_new_field_renames_no_scene():
 def _pinned_config(path):
     """The file's config with its preset replaced by the numerics its rows were run with
     (the presets were redefined when the graded mesh came; explicit numerics keep ids)."""
-    row = load(path).iloc[0]
-    num = {c[len("num_"):]: row[c] for c in row.index if c.startswith("num_")}
-    num = {k: None if isinstance(v, float) and v != v else getattr(v, "item", lambda: v)()
-           for k, v in num.items()}
     return dataclasses.replace(parse_config(read_attrs(path)["config_text"]),
-                               numerics=Numerics(**num))
+                               numerics=recorded_numerics(path))
+
+
+def test_recorded_numerics_are_the_rows(tmp_path):
+    ran = recorded_numerics(V1_FILE)
+    row = load(V1_FILE).iloc[0]
+    assert (ran.nodes, ran.step, ran.da_max, ran.mesh) == (row.num_nodes, row.num_step,
+                                                          row.num_da_max, "uniform")
+    # a file written now records every field: its rows give back the config's numerics
+    cfg = parse_config(read_attrs(V1_FILE)["config_text"])
+    out = tmp_path / "now.h5"
+    run_sweep(cfg, jobs=1, out=out, simulate=_fake, progress="none")
+    assert recorded_numerics(out) == cfg.numerics != ran
+    assert recorded_numerics(tmp_path / "nothing.h5") is None
 
 
 def test_version_1_file_loads_and_shows_in_info(capsys):
@@ -147,4 +157,28 @@ def test_version_1_file_grows_or_refuses_in_one_line(tmp_path, capsys):
     assert main(["run", str(cfg_path), "--out", str(path), "--progress", "none"]) == 2
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
     assert len(err) == 1 and "numerics meant other values" in err[0], err
+    assert "its rows ran with other values than this config's (" in err[0], err
+    assert "mesh 'uniform' -> 'graded'" in err[0], err
+    assert "give the file's values in this config's numerics" in err[0], err
     assert path.read_bytes() == before and len(load(path)) == 3
+    # the same grown config with the rows' numerics given explicitly grows the file: the
+    # three finished scenes are kept, only the new one (n = 1.0) runs
+    pinned = text.replace("numerics: {preset: fast, nodes: 80}",
+                          "numerics: " + json.dumps(recorded_numerics(path).to_dict()))
+    assert pinned != text
+    ran = []
+
+    def record(scene, numerics):
+        ran.append(scene.n)
+        return _fake(scene, numerics)
+
+    report = run_sweep(parse_config(pinned), jobs=1, out=path, simulate=record,
+                       progress="none")
+    assert (report.total, report.skipped, report.ran, ran) == (4, 3, 1, [1.0])
+    df = load(path)
+    assert len(df) == 4 and set(load(V1_FILE).scene_id) < set(df.scene_id)
+    # numerics other than the rows' are refused, naming the field
+    cfg_path.write_text(pinned.replace('"da_max": 1.0', '"da_max": 0.5'))
+    assert main(["run", str(cfg_path), "--out", str(path), "--progress", "none"]) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert len(err) == 1 and "da_max 1.0 -> 0.5" in err[0], err

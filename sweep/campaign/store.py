@@ -62,6 +62,7 @@ File contents (plain arrays and text only; no pickles):
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import errno
 import json
 import math
@@ -80,7 +81,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError
-from ..scene import SCENE_AXES, SCENE_ID_VERSION
+from ..scene import SCENE_AXES, SCENE_ID_VERSION, Numerics
 from .config import parse_config
 from .si import si_row
 
@@ -347,6 +348,45 @@ def load_results(path) -> pd.DataFrame:
         raise InputError(f"results: {str(path)!r} is not a sweep results file ({exc})") from None
 
 
+def recorded_numerics(path) -> Numerics | None:
+    """The numerics the rows of the results at ``path`` ran with (their ``num_*`` columns;
+    fields added since take their defaults), or None when the file has no rows or its rows
+    ran with more than one set.
+
+    A file written before a preset or default changed resumes under these values when a
+    config gives them explicitly (:meth:`ResultStore.prepare`).
+    """
+    try:
+        df = load(path)
+    except (OSError, KeyError, ValueError):
+        return None
+    cols = [c for c in df.columns if c.startswith("num_")]
+    if len(df) == 0 or not cols:
+        return None
+    distinct = df[cols].astype(str).drop_duplicates()
+    if len(distinct) != 1:
+        return None
+    values = {}
+    for c in cols:
+        v = plain(df[c].iloc[0])
+        values[c[len("num_"):]] = None if isinstance(v, float) and math.isnan(v) else v
+    try:
+        return Numerics(**values)
+    except (InputError, TypeError):
+        return None
+
+
+def _numerics_diff(a, b) -> str:
+    """The fields in which two Numerics differ, as "name a -> b", comma-separated."""
+    da, db = a.to_dict(), b.to_dict()
+    return ", ".join(f"{k} {da.get(k)!r} -> {db.get(k)!r}" for k in sorted(set(da) | set(db))
+                     if da.get(k) != db.get(k))
+
+
+#: what a refusal for changed numerics advises (one line, with the fields named before it)
+PIN_ADVICE = "give the file's values in this config's numerics to resume it"
+
+
 def _history(value) -> list[dict]:
     """The ``config_history`` attribute of a grown file: a list of {config_hash, config_text,
     until} of the earlier configs whose scenes it holds (empty for a file that never grew)."""
@@ -597,11 +637,16 @@ class ResultStore:
                         f"visco-sweep's {SCENE_ID_VERSION}: resume it with the version that "
                         f"wrote it, or use --out to write elsewhere")
                 if h != self.config_hash and text and text == self.meta.get("config_text"):
+                    ran = recorded_numerics(self.path)
+                    what = (f" (its rows ran with other values: "
+                            f"{_numerics_diff(ran, self.config.numerics)})"
+                            if ran is not None and self.config is not None else "")
                     raise InputError(
                         f"{where} was written by this same config when its numerics meant "
-                        f"other values (a preset or default changed since; the file's scenes "
-                        f"are kept and still load): use --fresh to recompute (the old file is "
-                        f"kept as a .bak) or --out to write elsewhere")
+                        f"other values{what}; a preset or default changed since, the file's "
+                        f"scenes are kept and still load: {PIN_ADVICE}, use --fresh to "
+                        f"recompute (the old file is kept as a .bak) or --out to write "
+                        f"elsewhere")
                 if h != self.config_hash:
                     reason = self._grow_refusal(h, text)
                     if reason is None:
@@ -627,8 +672,18 @@ class ResultStore:
         except InputError as exc:
             return f"its recorded config no longer reads ({exc})"
         if old.config_hash != old_hash:
-            return ("its config's numerics meant other values when it was written (a preset "
-                    "or default changed since)")
+            # a preset or default changed since: the file's scenes ran with the numerics
+            # its rows record, and grow into a config that gives those explicitly
+            ran = recorded_numerics(self.path)
+            if ran is None:
+                return ("its config's numerics meant other values when it was written (a "
+                        "preset or default changed since)")
+            old = dataclasses.replace(old, numerics=ran)
+            changed = ("its config's numerics meant other values when it was written (a "
+                       "preset or default changed since) and its rows ran with other values "
+                       "than this config's (")
+        else:
+            changed = "numerics differ ("
         new = self.config
         if new is None:
             try:
@@ -638,10 +693,8 @@ class ResultStore:
         if old.units != new.units:
             return f"units differ (file {old.units}, this config {new.units})"
         if old.numerics != new.numerics:
-            a, b = old.numerics.to_dict(), new.numerics.to_dict()
-            diff = [f"{k} {a.get(k)!r} -> {b.get(k)!r}" for k in sorted(set(a) | set(b))
-                    if a.get(k) != b.get(k)]
-            return f"numerics differ ({', '.join(diff) or 'preset'})"
+            return (f"{changed}{_numerics_diff(old.numerics, new.numerics) or 'preset'}); "
+                    f"{PIN_ADVICE}")
         if old.trajectories != new.trajectories:
             return (f"store.trajectories differs (file {str(old.trajectories).lower()}, this "
                     f"config {str(new.trajectories).lower()})")
