@@ -125,7 +125,9 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     on the mesh of the minimum's record (:func:`one_mesh_span`); the state transfer makes the
     load and the tip radius step a little (within the continuity guard), and a difference
     quotient across such a step is no crack speed. Where the minimum is the first or last
-    record of its mesh, the reason says so and how far the load stepped there. An ``ok``
+    record of its mesh, the reason says so and how far the load stepped there. Where it is
+    the initial state (the contact starts at or beyond its pull-off), the crack speed is the
+    first step's radius change over its time, and the reason says so. An ``ok``
     result never has a negative crack speed at pull-off (the contact advancing at the load
     minimum): that is a failure with its reason.
 
@@ -173,7 +175,14 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         res.reason = "no tensile load reached"
         return
     span = slice(lo, hi)
-    speed = float(crack_speed_on_mesh(t, a, t_star, spacing, lo, hi))
+    at_start = i == 0 and hi > 1
+    if at_start:
+        # the contact starts at or beyond its pull-off (e.g. past the JKR fold, a0 >= 1/2 at
+        # low mu): the load only rises from the initial state, and a fit centred there is
+        # one-sided and as poor as the few records it spans; the first step's radius change
+        speed = float((a[0] - a[1]) / (t[1] - t[0]))
+    else:
+        speed = float(crack_speed_on_mesh(t, a, t_star, spacing, lo, hi))
     if speed < 0:
         res.reason = (f"negative crack speed at the pull-off ({speed:.4g} a_ref/tau0, the "
                       f"contact advancing at the load minimum P = {P_star:.6g}, a = "
@@ -183,6 +192,9 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         return
     res.status = "ok"
     notes = []
+    if at_start:
+        notes.append("load minimum at the initial state (the contact starts at or beyond its "
+                     "pull-off): crack speed from the first step")
     if status == STATUS_NEWTON_FAILED:
         notes.append("stopped at the jump-off instability after pull-off")
     edge = [m for m in (lo, hi) if 0 < m < len(P) and i in (m - 1, m)]
