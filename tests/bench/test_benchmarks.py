@@ -84,18 +84,24 @@ def test_each_preset_is_set_beside_the_cheapest_numerics_with_an_error_estimate(
     """presets_on_front: per preset, the cheapest point meeting its target among the numerics
     that carry the error estimate (pull_off_rtol > 0): a cheaper point without it does not
     count, nor one whose grading (unseen by the estimate) differs; a cheaper point with it
-    does (the preset is then off the front by the ratio)."""
-    from sweep.bench.tradeoff import PRESET_TARGETS
+    does (the preset is then off the front by the ratio), unless the error-coverage sample
+    refused its numerics (REFUSED_BEYOND_THE_SCENES: da_max 2) or its crack speed misses the
+    preset's crack-speed target (CRACK_SPEED_TARGETS)."""
+    from sweep.bench.tradeoff import CRACK_SPEED_TARGETS, PRESET_TARGETS
     tgt = PRESET_TARGETS["balanced"]
     rows = []
     for label, err, wall, rtol, grading in (("balanced", 0.5 * tgt, 1.0, 0.01, 1.1),
                                             ("no_estimate", 0.1 * tgt, 0.1, 0.0, 1.1),
                                             ("other_grading", 0.1 * tgt, 0.2, 0.01, 1.3),
                                             ("cheaper", 0.9 * tgt, 0.5, 0.01, 1.1),
+                                            ("refused", 0.9 * tgt, 0.3, 0.01, 1.1),
+                                            ("slow_crack", 0.9 * tgt, 0.4, 0.01, 1.1),
                                             ("too_coarse", 2.0 * tgt, 0.05, 0.01, 1.1)):
-        rows += [{"scene": sc, "label": label, "err_pull_off": err, "err_crack_speed": err,
+        crack = 2.0 * CRACK_SPEED_TARGETS["balanced"] if label == "slow_crack" else err
+        rows += [{"scene": sc, "label": label, "err_pull_off": err, "err_crack_speed": crack,
                   "wall_s": wall, "pull_off_rtol": rtol, "grading": grading, "tail_gap": 60.0,
-                  "domain": None} for sc in ("s1", "s2")]
+                  "domain": None, "da_max": 2.0 if label == "refused" else 1.0}
+                 for sc in ("s1", "s2")]
     got = suggest_presets(rows)
     on = got["presets_on_front"]["balanced"]
     assert on["cheapest"] == "cheaper" and on["meets_target"]
