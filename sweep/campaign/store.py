@@ -638,9 +638,9 @@ class ResultStore:
                         f"wrote it, or use --out to write elsewhere")
                 if h != self.config_hash and text and text == self.meta.get("config_text"):
                     ran = recorded_numerics(self.path)
-                    what = (f" (its rows ran with other values: "
-                            f"{_numerics_diff(ran, self.config.numerics)})"
+                    diff = (_numerics_diff(ran, self.config.numerics)
                             if ran is not None and self.config is not None else "")
+                    what = f" (its rows ran with other values: {diff})" if diff else ""
                     raise InputError(
                         f"{where} was written by this same config when its numerics meant "
                         f"other values{what}; a preset or default changed since, the file's "
