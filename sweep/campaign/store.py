@@ -674,14 +674,13 @@ class ResultStore:
         if old.config_hash != old_hash:
             # a preset or default changed since: the file's scenes ran with the numerics
             # its rows record, and grow into a config that gives those explicitly
+            meant = ("its config's numerics meant other values when it was written (a "
+                     "preset or default changed since)")
             ran = recorded_numerics(self.path)
             if ran is None:
-                return ("its config's numerics meant other values when it was written (a "
-                        "preset or default changed since)")
+                return meant
             old = dataclasses.replace(old, numerics=ran)
-            changed = ("its config's numerics meant other values when it was written (a "
-                       "preset or default changed since) and its rows ran with other values "
-                       "than this config's (")
+            changed = f"{meant} and its rows ran with other values than this config's ("
         else:
             changed = "numerics differ ("
         new = self.config
