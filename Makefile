@@ -12,7 +12,7 @@ export NUMBA_NUM_THREADS ?= 1
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
         tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem \
         agreement agreement-high-mu extremes tip-convergence elastic-table calibrate-demo \
-        model-errors error-coverage random-sample docs-check
+        model-errors error-coverage crack-speed random-sample docs-check
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
@@ -36,6 +36,7 @@ help:
 	@echo "make model-errors - crack-front model and PB estimate vs the BEM over mu (the table auto reads)"
 	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem (results/random/)"
 	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
+	@echo "make crack-speed [QUICK=1] - the crack speed at pull-off per preset against a fine reference, per fit window (results/crack_speed/, ~6 min)"
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -185,6 +186,10 @@ model-errors: $(STAMP)
 # per preset, on a seeded random sample (QUICK=1: 6 scenes)
 error-coverage: $(STAMP)
 	$(BIN)/python -m sweep.bench.error_coverage $(if $(filter 1,$(QUICK)),--scenes 6 --out results/quick/error_coverage)
+
+# the crack speed's accuracy and its fit's window (sweep/bench/crack_speed.py)
+crack-speed: $(STAMP)
+	$(BIN)/python -m sweep.bench.crack_speed $(if $(filter 1,$(QUICK)),--quick --out results/quick/crack_speed)
 
 # issue 21: a random sample across the declared ranges through `sweep run`, model auto and the
 # default bem (configs/random/, written by `python -m sweep.bench.random_sample configs`);

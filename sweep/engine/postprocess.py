@@ -3,6 +3,7 @@ crack speed there (:func:`finish`, shared by every BEM mesh)."""
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -15,6 +16,25 @@ STATUS_TIME_BUDGET = -1
 #: a parabola refinement lowering the sampled minimum by more than this fraction must
 #: also predict the neighbouring samples (see :func:`refine_minimum`)
 VERTEX_RTOL = 1e-3
+
+
+#: where :func:`capture_fits` collects the crack-speed fits' inputs (None: not collecting)
+_FIT_LOG: list | None = None
+
+
+@contextmanager
+def capture_fits():
+    """Collect, in the yielded list, the inputs of every crack-speed fit :func:`finish`
+    makes in this process while the block runs: a dict per fit with the records ``t``,
+    ``a``, the pull-off instant ``t_star``, the fine ``spacing`` and the span ``lo:hi`` of
+    records computed on the minimum's mesh (the arguments of :func:`crack_speed_on_mesh`).
+    A diagnostic for studies of the fit (``python -m sweep.bench.crack_speed``)."""
+    global _FIT_LOG
+    outer, _FIT_LOG = _FIT_LOG, []
+    try:
+        yield _FIT_LOG
+    finally:
+        _FIT_LOG = outer
 
 
 def refine_minimum(t, P):
@@ -183,6 +203,9 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         speed = float((a[0] - a[1]) / (t[1] - t[0]))
     else:
         speed = float(crack_speed_on_mesh(t, a, t_star, spacing, lo, hi))
+        if _FIT_LOG is not None:
+            _FIT_LOG.append(dict(t=t.copy(), a=a.copy(), t_star=float(t_star),
+                                 spacing=float(spacing), lo=int(lo), hi=int(hi)))
     if speed < 0:
         res.reason = (f"negative crack speed at the pull-off ({speed:.4g} a_ref/tau0, the "
                       f"contact advancing at the load minimum P = {P_star:.6g}, a = "

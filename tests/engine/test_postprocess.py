@@ -131,3 +131,24 @@ def test_the_initial_state_speed_converges_with_the_step():
     fine = speeds[0.1].crack_speed
     for da in (0.3, 0.6):
         assert speeds[da].crack_speed == pytest.approx(fine, rel=0.03)
+
+
+def test_capture_fits_gives_the_inputs_of_the_reported_crack_speed():
+    """The fit's inputs collected by ``capture_fits`` reproduce the result's crack speed
+    bitwise (the crack-speed study reads them again under other windows); nothing is
+    collected outside the block."""
+    from sweep.engine.postprocess import capture_fits, crack_speed_on_mesh
+
+    traj = remeshed_trajectory(m=40, da=0.0, dP=0.0)
+    traj["P"] = (np.arange(80) - 50.3) ** 2 * 1e-3 - 95.0
+    traj["a"] = 2.62 - 3.0e4 * traj["t"] - 1e12 * traj["t"] ** 2     # an accelerating tip
+    with capture_fits() as fits:
+        res = run_finish(traj, remeshed=[20, 70])
+    run_finish(traj)
+    assert res.ok and len(fits) == 1
+    f = fits[0]
+    assert (f["lo"], f["hi"], f["spacing"]) == (20, 70, SPACING) and f["t_star"] == res.t_pulloff
+    assert crack_speed_on_mesh(f["t"], f["a"], f["t_star"], f["spacing"], f["lo"], f["hi"]) \
+        == res.crack_speed
+    # closed form: -da/dt = 3e4 + 2e12 t at the pull-off instant
+    assert res.crack_speed == pytest.approx(3.0e4 + 2e12 * res.t_pulloff, rel=1e-9)
