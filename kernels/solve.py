@@ -101,10 +101,13 @@ Physics = namedtuple("Physics", ["h0", "c", "weights", "times", "rate"])
 #: min_travel: crack-tip recession after the minimum required to stop (a_ref, see
 #:     :func:`stop_reached`);
 #: tip_lo, tip_hi: radii the crack tip must stay within (the well-resolved band of a graded
-#:     mesh); leaving them ends the run with STATUS_LEFT_BAND
+#:     mesh); leaving them ends the run with STATUS_LEFT_BAND;
+#: da_max_pulloff: the largest contact-radius change per step (a_ref) near the load minimum
+#:     (:func:`near_pulloff`), where the crack speed at pull-off is read (da_max: no change);
+#: pulloff_zone: the crack-tip travel (a_ref) within which the load minimum counts as near
 StepControl = namedtuple("StepControl", ["step_max", "step_min", "da_max", "step_tol", "tol",
                                          "max_iter", "max_steps", "stop_mode", "min_travel",
-                                         "tip_lo", "tip_hi"])
+                                         "tip_lo", "tip_hi", "da_max_pulloff", "pulloff_zone"])
 
 #: the run handed in (and, for q and step, back): h (N,) the gap at delta0 (the relaxed
 #: elastic LJ solution at the start, the last accepted state when resuming); delta0 its
@@ -811,14 +814,38 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
 
 
 @njit(cache=True, inline='always')
-def control_step(mesh, physics, control, work, run, hm, stats):
-    """-- control the step: the crack tip (at the gap ``hm``) may move by da_max at most; a
-    step that moves it further is halved until the motion, assumed proportional to the
-    step, is below REJECT_TARGET da_max (not below step_min). Returns (accepted, the new
-    contact radius, its change)."""
+def near_pulloff(records, n, zone):
+    """Whether the load minimum is near after record ``n - 1``: the load rose over the last
+    step (at or past a minimum), or the minimum predicted from the last three records (a
+    Newton step on dP/dt = 0 with the load's slope and curvature in time: exact for a
+    parabola) lies within a crack-tip travel of ``zone`` (a_ref) at the tip's present
+    speed."""
+    if n < 3:
+        return False
+    t0, t1, t2 = records.t[n - 3], records.t[n - 2], records.t[n - 1]
+    if not (t0 < t1 < t2):
+        return False
+    s0 = (records.P[n - 2] - records.P[n - 3]) / (t1 - t0)
+    s1 = (records.P[n - 1] - records.P[n - 2]) / (t2 - t1)
+    if s1 >= 0.0:
+        return True
+    curvature = (s1 - s0) / (0.5 * (t2 - t0))
+    speed = (records.a[n - 2] - records.a[n - 1]) / (t2 - t1)
+    if curvature <= 0.0 or speed <= 0.0:
+        return False
+    # s1 is the slope half a step back: the minimum lies -s1/curvature after that instant
+    return speed * (-s1 / curvature - 0.5 * (t2 - t1)) < zone
+
+
+@njit(cache=True, inline='always')
+def control_step(mesh, physics, control, work, run, hm, stats, da_max):
+    """-- control the step: the crack tip (at the gap ``hm``) may move by ``da_max`` at most
+    (a_ref); a step that moves it further is halved until the motion, assumed proportional
+    to the step, is below REJECT_TARGET da_max (not below step_min). Returns (accepted, the
+    new contact radius, its change)."""
     a_new = crossing_radius(work.hp, mesh.r, hm)
     da = abs(a_new - run[RUN_A])
-    dd, dd_min, da_max = run[RUN_DD], control.step_min * physics.h0, control.da_max
+    dd, dd_min = run[RUN_DD], control.step_min * physics.h0
     if da > da_max and dd > dd_min * (1.0 + STEP_RTOL):
         stats[STAT_REJECTED] += 1
         da_est = da
@@ -906,7 +933,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
     mesh : MeshArrays (A, r, wP).
     physics : Physics (h0, c, weights, times, rate).
     control : StepControl (step_max, step_min, da_max, step_tol, tol, max_iter, max_steps,
-        stop_mode, min_travel, tip_lo, tip_hi).
+        stop_mode, min_travel, tip_lo, tip_hi, da_max_pulloff, pulloff_zone).
     start : RunState (h, delta0, q, n, step); q and step are in/out.
     records : Records (t, delta, P, a, a_inner, h), written.
     cache : tuple
@@ -927,6 +954,9 @@ def unload(mesh, physics, control, start, records, cache, stats):
     easy = 0
     status = STATUS_STEP_LIMIT
     while n <= control.max_steps:
+        da_max = control.da_max
+        if control.da_max_pulloff < da_max and near_pulloff(records, n, control.pulloff_zone):
+            da_max = control.da_max_pulloff
         quadratic, cubic = predict_step(mesh, physics, work, run)
         outcome = solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats)
         if outcome != SOLVED:
@@ -937,7 +967,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
                 status = STATUS_NEWTON_FAILED
                 break
             quadratic = False
-        accepted, a_new, da = control_step(mesh, physics, control, work, run, hm, stats)
+        accepted, a_new, da = control_step(mesh, physics, control, work, run, hm, stats, da_max)
         if not accepted:
             easy = 0
             continue
@@ -951,7 +981,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
         if stop != STATUS_RUNNING:
             status = stop
             break
-        run[RUN_DD], easy = next_step(run[RUN_DD], easy, da, control.da_max, err,
+        run[RUN_DD], easy = next_step(run[RUN_DD], easy, da, da_max, err,
                                       control.step_max * h0, control.step_tol * h0)
     _copy(work.h, records.h)
     start.step[0] = run[RUN_DD] / h0

@@ -294,6 +294,13 @@ class Numerics:
         Smallest indentation step in units of h0 before a run is declared failed.
     da_max : float
         Largest change of the contact radius per step, in node spacings.
+    da_max_pulloff : float or None
+        Largest change of the contact radius per step, in node spacings, once the load
+        minimum is near (the load rose over the last step, or the minimum predicted from the
+        last three records lies within ``sweep.engine.bem.PULLOFF_ZONE_SPACINGS`` spacings of
+        crack-tip travel): the records the crack speed at pull-off is read from are as dense
+        as at this value, while the crack's travel before runs at ``da_max``. ``None``
+        (default): ``da_max`` throughout.
     prony_rtol : float
         Maximum relative error of the Prony approximation of Chat over the scene's time
         window (ignored with ``exact=True``).
@@ -334,6 +341,7 @@ class Numerics:
     max_nodes: int = 2000
     pull_off_rtol: float = 0.02
     time_budget_s: float = 300.0
+    da_max_pulloff: float | None = None
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
@@ -350,6 +358,8 @@ class Numerics:
         set_("step", check_range("step", self.step, 1e-4, 10.0))
         set_("min_step", check_range("min_step", self.min_step, 1e-9, self.step))
         set_("da_max", check_range("da_max", self.da_max, 0.01, 1e9))
+        if self.da_max_pulloff is not None:
+            set_("da_max_pulloff", check_range("da_max_pulloff", self.da_max_pulloff, 0.01, 1e9))
         set_("prony_rtol", check_range("prony_rtol", self.prony_rtol, 1e-9, 0.1))
         set_("tol", check_range("tol", self.tol, 1e-14, 1e-3))
         set_("max_steps", check_int("max_steps", self.max_steps, 10, 10_000_000))

@@ -112,6 +112,11 @@ def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Re
     return res
 
 
+#: the crack-tip travel (fine spacings) within which a predicted load minimum counts as near
+#: (``Numerics.da_max_pulloff`` then bounds the step): the crack-speed fit reads the records
+#: within three spacings of the pull-off radius
+PULLOFF_ZONE_SPACINGS = 10.0
+
 #: the unloading kernel runs in chunks of this many steps; the wall-time budget is checked
 #: between chunks (a resumed chunk restarts the step predictor: a few Newton iterations)
 CHUNK_STEPS = 2000
@@ -153,9 +158,13 @@ def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int
     numerics = pb.numerics
     h_out = np.empty(pb.mesh.nodes)
     limit = min(run.n + steps, numerics.max_steps)
+    da_max_pulloff = (numerics.da_max if numerics.da_max_pulloff is None
+                      else numerics.da_max_pulloff)
     control = StepControl(numerics.step, numerics.min_step, numerics.da_max * pb.mesh.spacing,
                           STEP_TOL, numerics.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
-                          STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *tip_range)
+                          STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *tip_range,
+                          da_max_pulloff * pb.mesh.spacing,
+                          PULLOFF_ZONE_SPACINGS * pb.mesh.spacing)
     status, run.n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
                            Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, pb.scene.rate),
                            control, RunState(run.h, run.delta0, run.q, run.n, run.step),

@@ -30,6 +30,18 @@ def test_coarser_halves_the_resolution_in_space_and_time():
     assert c.prony_rtol == num.prony_rtol and c.pull_off_rtol == 0.0 and c.zone_nodes == 0.0
 
 
+def test_coarser_takes_the_pull_off_bound_throughout_never_finer_than_the_solve():
+    """With a smaller radius change near the pull-off, the cheaper solve takes that bound
+    throughout, but not below da_max / factor of its spacings: in a_ref its radius change
+    per step stays at least the finer solve's."""
+    num = Numerics.preset("balanced", da_max=1.0, da_max_pulloff=0.6)
+    c = coarser(num)
+    assert (c.da_max, c.da_max_pulloff) == (0.6, None)
+    c = coarser(num, math.sqrt(2.0))
+    assert c.da_max == pytest.approx(1.0 / math.sqrt(2.0)) and c.da_max_pulloff is None
+    assert coarser(Numerics.preset("balanced", da_max=0.5, da_max_pulloff=0.6)).da_max == 0.5
+
+
 def test_estimate_is_the_change_plus_the_prony_error():
     num = Numerics.preset("balanced")
     res = _ok(num, 2.0)

@@ -34,7 +34,8 @@ def _run(chunk):
         limit = NUMERICS.max_steps if chunk is None else min(n + chunk, NUMERICS.max_steps)
         control = StepControl(NUMERICS.step, NUMERICS.min_step, NUMERICS.da_max * pb.mesh.spacing,
                               STEP_TOL, NUMERICS.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
-                              STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range)
+                              STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range,
+                              NUMERICS.da_max * pb.mesh.spacing, 0.0)
         status, n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
                            Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, SCENE.rate),
                            control, RunState(h, delta0, q, n, step), Records(*out, h_out),
