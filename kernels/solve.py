@@ -815,13 +815,14 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
 
 @njit(cache=True, inline='always')
 def near_pulloff(records, n, zone):
-    """Whether the load minimum is near after record ``n - 1``: the load rose over the last
-    step (at or past a minimum), or the minimum predicted from the last three records (a
-    Newton step on dP/dt = 0 with the load's slope and curvature in time: exact for a
-    parabola) lies within a crack-tip travel of ``zone`` (a_ref) at the tip's present
-    speed."""
+    """Whether the load minimum is near after record ``n - 1``: within the first two steps,
+    where the load rose over the last step (at or past a minimum), or where the minimum
+    predicted from the last three records (a Newton step on dP/dt = 0 with the load's slope
+    and curvature in time: exact for a parabola) lies within a crack-tip travel of ``zone``
+    (a_ref) at the tip's present speed."""
     if n < 3:
-        return False
+        return True         # the minimum may be the initial state (a contact starting at
+                            # or beyond its pull-off): its crack speed is the first step's
     t0, t1, t2 = records.t[n - 3], records.t[n - 2], records.t[n - 1]
     if not (t0 < t1 < t2):
         return False

@@ -23,7 +23,7 @@ def _ok(numerics, pull_off, prony_error=1e-5, spacing=0.01):
 
 
 def test_coarser_halves_the_resolution_in_space_and_time():
-    num = Numerics.preset("balanced")
+    num = Numerics.preset("balanced", da_max_pulloff=None)
     c = coarser(num)
     assert c.band_resolution == num.band_resolution / 2 and c.step == 2 * num.step
     assert c.da_max == num.da_max                # in spacings: doubles in a_ref with them

@@ -53,7 +53,7 @@ def test_near_pulloff_predicts_the_minimum_of_a_parabola():
     rec = _records(t, P, a)
     near = [near_pulloff(rec, n, 0.35) for n in range(3, 20)]   # after record n - 1
     assert near == [n - 1 >= 7 for n in range(3, 20)]
-    assert not near_pulloff(rec, 2, 1e9)                         # fewer than three records
+    assert near_pulloff(rec, 1, 0.0) and near_pulloff(rec, 2, 0.0)  # the first two steps
     # a tip at rest (or advancing) is never near by travel; a rising load always is
     still = _records(t, P, 0.0 * t + 5.0)
     assert not near_pulloff(still, 5, 1e9) and near_pulloff(still, 13, 0.0)
@@ -70,8 +70,9 @@ def test_finer_steps_near_the_pull_off_give_the_crack_speed_of_finer_steps(scene
     def run(**kw):
         return solver.simulate(scene, Numerics.preset("balanced", pull_off_rtol=0.0, **kw))
 
-    fine, coarse, near = run(da_max=0.1, step=0.05), run(da_max=1.0), run(da_max=1.0,
-                                                                          da_max_pulloff=0.6)
+    fine = run(da_max=0.1, step=0.05, da_max_pulloff=None)
+    coarse = run(da_max=1.0, da_max_pulloff=None)
+    near = run(da_max=1.0, da_max_pulloff=0.6)
     assert fine.ok and coarse.ok and near.ok
     err = {name: abs(r.crack_speed / fine.crack_speed - 1)
            for name, r in (("coarse", coarse), ("near", near))}
