@@ -301,11 +301,13 @@ class Numerics:
         Largest change of the contact radius per step, in node spacings.
     da_max_pulloff : float or None
         Largest change of the contact radius per step, in node spacings, once the load
-        minimum is near (the load rose over the last step, or the minimum predicted from the
-        last three records lies within ``sweep.engine.bem.PULLOFF_ZONE_SPACINGS`` spacings of
-        crack-tip travel): the records the crack speed at pull-off is read from are as dense
-        as at this value, while the crack's travel before runs at ``da_max``. ``None``
-        (default): ``da_max`` throughout.
+        minimum is near (the first two steps, where a contact that starts at or beyond its
+        pull-off reads its crack speed; the load rose over the last step; or the minimum
+        predicted from the last three records lies within
+        ``sweep.engine.bem.PULLOFF_ZONE_SPACINGS`` spacings of crack-tip travel,
+        ``kernels.solve.near_pulloff``): the records the crack speed at pull-off is read
+        from are as dense as at this value, while the crack's travel before runs at
+        ``da_max``. ``None`` (default): ``da_max`` throughout.
     prony_rtol : float
         Maximum relative error of the Prony approximation of Chat over the scene's time
         window (ignored with ``exact=True``).
