@@ -94,14 +94,8 @@ def coverage_scenes(path: Path = COVERAGE_FILE, max_reference_s: float = COVERAG
 def numerics_of(label: str) -> Numerics:
     """The numerics run under ``label`` (a preset, a :data:`VARIANTS` name or "reference"),
     without the error estimate's second solve (it does not change the crack speed)."""
-    if label == "reference":
-        preset, over = REFERENCE
-    elif label == "reference_finer_mesh":
-        preset, over = REFERENCE_FINER_MESH
-    elif label in VARIANTS:
-        preset, over = VARIANTS[label]
-    else:
-        preset, over = label, {}
+    preset, over = {"reference": REFERENCE, "reference_finer_mesh": REFERENCE_FINER_MESH,
+                    **VARIANTS}.get(label, (label, {}))
     return Numerics.preset(preset, pull_off_rtol=0.0, time_budget_s=600.0, **over)
 
 
@@ -130,6 +124,12 @@ def speed_under(row: dict, rule: str) -> float:
                                      width, fit["lo"], fit["hi"], window_nodes=1.0))
 
 
+def spread_over_rules(row: dict) -> float:
+    """The relative spread of ``row``'s crack speed over :data:`WINDOW_RULES`."""
+    v = [speed_under(row, rule) for rule in WINDOW_RULES]
+    return (max(v) - min(v)) / abs(float(np.median(v)))
+
+
 def _stats(errors) -> dict:
     e = np.asarray(errors, dtype=float)
     if e.size == 0:
@@ -148,11 +148,8 @@ def summarize(rows: list[dict]) -> dict:
             "coverage_sample": lambda n: n.startswith("coverage")}
     out = {}
     for set_name, member in sets.items():
-        spread = []
-        for name, ref in refs.items():
-            if member(name) and ref["fit"]:
-                v = [speed_under(ref, rule) for rule in WINDOW_RULES]
-                spread.append((max(v) - min(v)) / abs(float(np.median(v))))
+        spread = [spread_over_rules(ref) for name, ref in refs.items()
+                  if member(name) and ref["fit"]]
         change = [abs(speed_under(finer[n], REFERENCE_RULE) - speed_under(refs[n], REFERENCE_RULE))
                   / abs(speed_under(refs[n], REFERENCE_RULE)) for n in finer if n in refs and member(n)]
         block = {"reference_spread_over_rules": _stats(spread),
@@ -168,10 +165,10 @@ def summarize(rows: list[dict]) -> dict:
                     ref = refs.get(r["name"])
                     if r["label"] != lab or not member(r["name"]) or r["status"] != "ok" or not ref:
                         continue
-                    v_ref = speed_under(ref, REFERENCE_RULE)
-                    err = abs(speed_under(r, rule) - v_ref) / abs(v_ref)
+                    v, v_ref = speed_under(r, rule), speed_under(ref, REFERENCE_RULE)
+                    err = abs(v - v_ref) / abs(v_ref)
                     errors.append(err)
-                    signed.append(speed_under(r, rule) > v_ref)
+                    signed.append(v > v_ref)
                     if worst is None or err > worst[0]:
                         worst = (err, r["name"])
                 per_rule[rule] = {**_stats(errors), "above_target": int(np.sum(np.asarray(errors) > target)),
@@ -193,9 +190,8 @@ def per_scene(rows: list[dict]) -> list[dict]:
         entry = dict(scene_name=name, scene=ref["scene"], reference_status=ref["status"])
         if ref["status"] == "ok":
             v_ref = speed_under(ref, REFERENCE_RULE)
-            v = [speed_under(ref, rule) for rule in WINDOW_RULES]
             entry.update(reference_crack_speed=v_ref, pull_off_at_initial_state=ref["fit"] is None,
-                         reference_spread=(max(v) - min(v)) / abs(float(np.median(v))))
+                         reference_spread=spread_over_rules(ref))
             for r in rows:
                 if r["name"] == name and r["label"] != "reference":
                     entry[f"error_{r['label']}"] = ((speed_under(r, REFERENCE_RULE) - v_ref) / abs(v_ref)
