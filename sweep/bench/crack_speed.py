@@ -45,7 +45,10 @@ from .tradeoff import CRACK_SPEED_TARGETS, TRADEOFF_SCENES
 PRESET_NAMES = ("fast", "balanced", "accurate")
 #: numerics variants run beside the presets (name: preset and overrides)
 VARIANTS = {"balanced_da_max_1": ("balanced", dict(da_max=1.0, da_max_pulloff=None)),
-            "balanced_previous": ("balanced", dict(da_max=0.6, da_max_pulloff=None))}
+            "balanced_previous": ("balanced", dict(da_max=0.6, da_max_pulloff=None)),
+            "balanced_step_0.2": ("balanced", dict(step=0.2)),
+            "fast_step_0.5": ("fast", dict(step=0.5)),
+            "fast_step_0.5_pulloff_0.6": ("fast", dict(step=0.5, da_max_pulloff=0.6))}
 #: the reference: the accurate preset at 48 spacings per tip zone, a quarter of balanced's
 #: steps, Newton to 1e-9 h0; no error estimate
 REFERENCE = ("accurate", dict(band_resolution=48.0, step=0.05, da_max=0.15, tol=1e-9,

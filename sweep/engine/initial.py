@@ -42,6 +42,14 @@ def jkr_gap_guess(r: np.ndarray, delta: float, h0: float) -> np.ndarray:
     return np.maximum(gap, h0)
 
 
+def set_relaxed_cache_size(size: int) -> int:
+    """Keep up to ``size`` relaxed states in this process (RELAXED_CACHE_SIZE by default;
+    the least recently used is dropped first); returns the previous size."""
+    global RELAXED_CACHE_SIZE
+    previous, RELAXED_CACHE_SIZE = RELAXED_CACHE_SIZE, int(size)
+    return previous
+
+
 def clear_relaxed_cache() -> None:
     """Forget this process's relaxed initial states (a cold start, as in a new worker)."""
     _RELAXED.clear()

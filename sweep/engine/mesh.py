@@ -190,6 +190,15 @@ _MESH_CACHE: dict = {}
 _MESH_CACHE_SIZE = 32
 
 
+def set_mesh_cache_size(size: int) -> int:
+    """Keep up to ``size`` meshes' influence matrices in this process (32 by default; the
+    oldest is dropped first); returns the previous size. A benchmark timing many numerics in
+    rounds keeps them all."""
+    global _MESH_CACHE_SIZE
+    previous, _MESH_CACHE_SIZE = _MESH_CACHE_SIZE, int(size)
+    return previous
+
+
 def clear_mesh_cache() -> None:
     """Forget this process's influence matrices of meshes (not the unit matrix)."""
     _MESH_CACHE.clear()

@@ -122,6 +122,51 @@ def test_grid_has_the_presets_first_and_only_existing_fields():
     assert len(grid(quick=True)) < len(g)
 
 
+def test_grid_holds_each_presets_neighbours():
+    """Around fast and accurate, one field at a time (the front is searched beside each
+    preset as well as around balanced)."""
+    from sweep.bench.tradeoff import ACCURATE_ONE_AT_A_TIME, FAST_ONE_AT_A_TIME
+    have = {json.dumps(to_numerics(p["overrides"]).to_dict(), sort_keys=True) for p in grid()}
+    for preset, around in (("fast", FAST_ONE_AT_A_TIME), ("accurate", ACCURATE_ONE_AT_A_TIME)):
+        for k, values in around.items():
+            for v in values:
+                want = to_numerics({"preset": preset, k: v}).to_dict()
+                assert json.dumps(want, sort_keys=True) in have, (preset, k, v)
+
+
+def test_tradeoff_times_in_rounds_and_keeps_the_best(monkeypatch):
+    """Each numerics' runs are spread over the run (round after round over the grid), so a
+    slower minute of the machine does not fall on one numerics only; the quickest run is
+    kept, and the caches of meshes and starts are back to their sizes afterwards."""
+    import types
+
+    from sweep.bench import tradeoff as tr
+    from sweep.engine import initial, mesh
+    sizes = mesh.set_mesh_cache_size(32), initial.set_relaxed_cache_size(64)
+    mesh.set_mesh_cache_size(sizes[0]), initial.set_relaxed_cache_size(sizes[1])
+    calls = []
+
+    def fake_simulate(scene, num):
+        calls.append(json.dumps(num.to_dict(), sort_keys=True))
+        wall = 1.0 / len(calls)                 # later runs quicker: the last round's kept
+        return types.SimpleNamespace(status="ok", reason="", pull_off=1.0, crack_speed=1.0,
+                                     wall_s=wall, steps=1, newton_iterations=1)
+
+    monkeypatch.setattr(tr, "simulate", fake_simulate)
+    monkeypatch.setattr(tr, "warm_up", lambda: None)
+    monkeypatch.setattr(tr, "reference_for",
+                        lambda *a, **k: {"pull_off": 1.0, "crack_speed": 1.0})
+    report = tr.run_tradeoff(quick=True, repeat=3, progress=lambda m: None)
+    n = len(tr.grid(quick=True))
+    per_scene = 1 + 3 * n                       # the untimed warm-up, then three rounds
+    assert len(calls) == 2 * per_scene
+    first = calls[1:1 + n]
+    assert calls[1 + n:1 + 2 * n] == first and calls[1 + 2 * n:per_scene] == first
+    walls = [r["wall_s"] for r in report["rows"][:n]]
+    assert walls == [1.0 / (1 + 2 * n + i + 1) for i in range(n)]
+    assert (mesh.set_mesh_cache_size(sizes[0]), initial.set_relaxed_cache_size(sizes[1])) == sizes
+
+
 def test_table_and_pareto_png_are_written(tmp_path):
     rows = [{"scene": s, "label": lab, "err_pull_off": e, "err_crack_speed": 2 * e,
              "wall_s": w, "status": "ok"}
