@@ -909,6 +909,12 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
                              "status": best.status, "pull_off": best.pull_off,
                              "err_pull_off": relative_error(best.pull_off, ref["pull_off"]),
                              "steps": best.steps, "nodes": _nodes_used(best)}
+            if num.pull_off_rtol > 0:  # the share of the error estimate's second solve
+                single = dataclasses.replace(num, pull_off_rtol=0.0)
+                one = min((simulate(scene, single) for _ in range(max(plan.repeat, 1))),
+                          key=lambda r: r.wall_s)
+                engine[label]["without_estimate"] = {"wall_s": one.wall_s,
+                                                     "pull_off": one.pull_off}
             progress(f"vs_numpy {name} engine {label}: {best.wall_s:.3f} s, "
                      f"err {engine[label]['err_pull_off']:.2e}")
         target = min(e["err_pull_off"] for e in engine.values())
@@ -935,6 +941,9 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
             t_eq = plain_time_at(e["err_pull_off"], plain)
             e["plain_s_interpolated"] = t_eq
             e["ratio_interpolated"] = t_eq / e["wall_s"] if t_eq else None
+            if "without_estimate" in e:     # the same pull-off, without the row's error
+                e["ratio_without_estimate"] = (w["wall_s"] / e["without_estimate"]["wall_s"]
+                                               if w else None)
         out[name] = {"scene": sdict, "reference": {k: ref.get(k) for k in (
                          "pull_off", "source", "uncertainty_pull_off", "domain")},
                      "engine": engine, "plain_ladder": plain}
