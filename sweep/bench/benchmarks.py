@@ -1183,9 +1183,9 @@ def reference_cmd(only, out):
 @click.option("--quick", is_flag=True, help="A few points on two scenes (smoke test).")
 @click.option("--out", default="results/tradeoff", show_default=True, help="Output directory.")
 @click.option("--repeat", default=2, show_default=True, type=click.IntRange(1, 10),
-              help="Runs per numerics and scene, the best wall kept: the first pays the "
-                   "numerics' set-up (Prony fit, relaxed start on its mesh) that a campaign "
-                   "pays once per worker.")
+              help="Rounds over each scene's grid (every numerics once a round), the "
+                   "best wall kept: the first round pays each numerics' set-up (Prony fit, "
+                   "relaxed start on its mesh) that a campaign pays once per worker.")
 @click.option("--from-table", is_flag=True,
               help="Derive presets.json again from OUT/table.csv, running nothing.")
 def tradeoff_cmd(quick, out, repeat, from_table):

@@ -259,8 +259,9 @@ def reference_for(name: str, scene: dict, refs: dict, fallback: Numerics | None 
 def run_tradeoff(quick: bool = False, repeat: int = 1, progress=print,
                  partial: str | Path | None = None) -> dict:
     """Run the grid on the reference scenes; rows with errors against the references.
-    With ``partial``, the table so far is rewritten there after each scene (a long run
-    that is stopped keeps its finished scenes)."""
+    Each scene's grid runs ``repeat`` rounds (every numerics once per round) and each row
+    keeps its quickest run. With ``partial``, the table so far is rewritten there after
+    each scene (a long run that is stopped keeps its finished scenes)."""
     warm_up()
     refs = load_references()
     points = grid(quick)

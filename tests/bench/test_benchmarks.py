@@ -142,8 +142,11 @@ def test_tradeoff_times_in_rounds_and_keeps_the_best(monkeypatch):
 
     from sweep.bench import tradeoff as tr
     from sweep.engine import initial, mesh
-    sizes = mesh.set_mesh_cache_size(32), initial.set_relaxed_cache_size(64)
-    mesh.set_mesh_cache_size(sizes[0]), initial.set_relaxed_cache_size(sizes[1])
+    def sizes():                                # read by setting them back as they were
+        m, r = mesh.set_mesh_cache_size(0), initial.set_relaxed_cache_size(0)
+        mesh.set_mesh_cache_size(m), initial.set_relaxed_cache_size(r)
+        return m, r
+    before = sizes()
     calls = []
 
     def fake_simulate(scene, num):
@@ -164,7 +167,7 @@ def test_tradeoff_times_in_rounds_and_keeps_the_best(monkeypatch):
     assert calls[1 + n:1 + 2 * n] == first and calls[1 + 2 * n:per_scene] == first
     walls = [r["wall_s"] for r in report["rows"][:n]]
     assert walls == [1.0 / (1 + 2 * n + i + 1) for i in range(n)]
-    assert (mesh.set_mesh_cache_size(sizes[0]), initial.set_relaxed_cache_size(sizes[1])) == sizes
+    assert sizes() == before
 
 
 def test_table_and_pareto_png_are_written(tmp_path):
