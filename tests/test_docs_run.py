@@ -79,6 +79,29 @@ def test_failing_command_names_page_and_line(tmp_path):
         dc.run_step(shown, tmp_path, timeout=10)
 
 
+def test_quoted_numbers_compare_to_a_tolerance_words_exactly(tmp_path):
+    """A quoted number whose last digit moves with the processor passes; a changed status,
+    reason or a number off by more than NUMBER_RTOL fails (issue 34 item 1)."""
+    quoted = "failed (unresolved: the pull-off moves by 0.67"
+    printed = ("status  failed (unresolved: the pull-off moves by 0.68 on a mesh of 1/2 the "
+               "resolution (3.6602 vs 2.1802))")
+    assert dc.printed(quoted, printed)                                  # 1.5 % apart
+    assert dc.printed(quoted, printed.replace("0.68", "6.70e-01"))      # another format
+    assert not dc.printed(quoted, printed.replace("failed", "ok"))      # the status
+    assert not dc.printed(quoted, printed.replace("unresolved", "max_steps"))   # the reason
+    assert not dc.printed(quoted, printed.replace("0.68", "0.75"))      # 12 % off
+    assert not dc.printed(quoted, printed.replace("0.68", "-0.68"))     # the sign
+    assert not dc.printed("moves by 0", "moves by 1e-9")                # an exact zero
+    assert dc.printed("results: results/demo.h5", "results:  results/demo.h5\n")
+    block = dc.Block("README.md", 7, "inline", "x")
+    dc.run_step(dc.Step(block, "sh", f"echo '{printed}'; exit 1", "as written", [quoted],
+                        code=1), tmp_path, timeout=10)
+    wrong = printed.replace("failed", "ok")
+    with pytest.raises(dc.DocsCheckError, match=r"README\.md:7: .* did not print"):
+        dc.run_step(dc.Step(block, "sh", f"echo '{wrong}'; exit 1", "as written", [quoted],
+                            code=1), tmp_path, timeout=10)
+
+
 def test_commands_strip_comments_and_optional_groups():
     cmd, flags = dc._strip("sweep pb --n 0.4 --v 1e-2,1 [--json] [-j 2]   # Gamma_eff [mN]")
     assert cmd == "sweep pb --n 0.4 --v 1e-2,1" and flags == ["--json"]
