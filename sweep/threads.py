@@ -1,4 +1,5 @@
-"""One thread per process for BLAS, OpenMP and Numba: the one place that sets these limits.
+"""One thread per process for BLAS, OpenMP and Numba: the one place that sets these limits;
+and a worker process that ends with its parent (:func:`exit_with_parent`).
 
 A dense BEM step is a matrix-vector product of size N ~ 500, and a sweep runs one scene per
 core, so more threads per process only oversubscribe the cores (docs/design.md section 6).
@@ -8,6 +9,8 @@ Environment variables act only if they are set before the library that reads the
 from __future__ import annotations
 
 import os
+import threading
+import time
 
 #: BLAS/OpenMP variables set (unless the user set them) when ``sweep`` is imported.
 BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -35,3 +38,27 @@ def limit_loaded_pools():
         return threadpool_limits(limits=1)
     except Exception:  # pragma: no cover - threadpoolctl is a joblib dependency
         return None
+
+
+#: how often (s) a worker looks whether the process that started it is still there
+PARENT_POLL_S = 1.0
+
+
+def exit_with_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread:
+    """End this process as soon as its parent is gone (a ``sweep run`` killed with SIGKILL,
+    whose loky workers would otherwise compute their scenes on, orphaned, holding the cores):
+    a daemon thread compares ``os.getppid()`` with the parent's pid at the start every
+    ``poll_s`` seconds and ends the process (``os._exit``) when the parent changed. It runs
+    between the engine's compiled calls (one Newton solve or one chunk of unloading steps,
+    ``sweep.engine.budget.CHECK_SLACK_S`` at most), so an orphan stops within seconds."""
+    parent = os.getppid()
+
+    def watch():
+        while True:
+            time.sleep(poll_s)
+            if os.getppid() != parent:
+                os._exit(70)       # EX_SOFTWARE: nothing of the parent's is left to report to
+
+    thread = threading.Thread(target=watch, name="sweep-exit-with-parent", daemon=True)
+    thread.start()
+    return thread

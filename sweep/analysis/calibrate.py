@@ -85,7 +85,7 @@ from ..campaign.store import to_jsonable
 from ..engine import bem
 from ..errors import InputError, check_choice, check_int, check_range
 from ..scene import Numerics
-from ..threads import THREAD_VARS, limit_env, limit_loaded_pools
+from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
 from .plots import pyplot
 
 __all__ = ["Parameter", "Calibration", "load_calibration", "calibration_from_dict",
@@ -408,9 +408,11 @@ _WORKER_READY = False
 
 
 def _prepare_worker() -> None:
-    """Once per worker process: one BLAS/OpenMP/Numba thread (sweep.threads)."""
+    """Once per worker process: end with the parent, one BLAS/OpenMP/Numba thread
+    (sweep.threads)."""
     global _WORKER_READY
     if not _WORKER_READY:
+        exit_with_parent()
         limit_env(THREAD_VARS)
         limit_loaded_pools()
         _WORKER_READY = True

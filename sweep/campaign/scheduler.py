@@ -50,7 +50,7 @@ from .config import SweepConfig, as_config
 from ..errors import InputError, check_int, check_range
 from ..scene import Result
 from .store import ResultStore, StoreBusyError, plain_row
-from ..threads import THREAD_VARS, limit_env, limit_loaded_pools
+from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
 
 BACKENDS = ("loky", "dask")
 PROGRESS_MODES = ("auto", "bar", "log", "none")
@@ -111,12 +111,13 @@ class SweepReport:
 # ----------------------------------------------------------------------------- workers
 _WORKER_READY = False
 
-
 def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
-    """Once per process: one thread for BLAS/OpenMP/Numba, then warm the Numba cache."""
+    """Once per process: end with the parent (:func:`exit_with_parent`), one thread for
+    BLAS/OpenMP/Numba, then warm the Numba cache."""
     global _WORKER_READY
     if _WORKER_READY:
         return
+    exit_with_parent()
     if limit_threads:
         limit_env(THREAD_VARS)
         limit_loaded_pools()

@@ -33,6 +33,8 @@ from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_ST
                              unload)
 from ..errors import NUMERICAL_ERRORS, is_internal_error
 from ..scene import Numerics, Result, Scene
+from . import budget
+from .budget import OverBudget
 from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
 from .postprocess import STATUS_TIME_BUDGET, finish
@@ -77,11 +79,11 @@ def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
     if not isinstance(numerics, Numerics):
         raise TypeError("numerics must be a sweep.Numerics")
     t_start = time.perf_counter()
-    deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
-    res = _attempt(scene, numerics, deadline)
-    if not numerics.exact:
-        estimate_error(res, derive(scene, numerics).tip_zone,
-                       lambda coarse: _attempt(scene, coarse, deadline))
+    with budget.scene_budget(numerics.time_budget_s) as deadline:
+        res = _attempt(scene, numerics, deadline)
+        if not numerics.exact:
+            estimate_error(res, derive(scene, numerics).tip_zone,
+                           lambda coarse: _attempt(scene, coarse, deadline))
     res.wall_s = time.perf_counter() - t_start
     return res
 
@@ -93,9 +95,10 @@ def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Re
     for _ in range(3):
         res = Result(scene=scene, numerics=numerics)
         try:
+            budget.check("the BEM's " + ("retry with a wider band" if band else "mesh"))
             pb = prepare(scene, numerics, band)
             left = _simulate(pb, res, deadline)
-        except Refused as exc:
+        except (Refused, OverBudget) as exc:
             res.reason = str(exc)
             return res
         except NUMERICAL_ERRORS as exc:   # a bug (TypeError, ...) is not a result: it raises
@@ -189,6 +192,8 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
         # the unloading starts unfactorized whether or not the relaxed state was cached,
         # so a scene's result does not depend on what the process solved before
         invalidate(el.cache)
+    except OverBudget:
+        raise
     except RuntimeError as exc:
         res.reason = f"initial state: {exc}"
         return

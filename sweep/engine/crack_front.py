@@ -54,6 +54,7 @@ from functools import lru_cache
 import numpy as np
 
 from .. import units
+from . import budget
 from ..errors import (NUMERICAL_ERRORS, InputError, check_choice, check_positive, check_range,
                       is_internal_error)
 from ..scene import Numerics, Result
@@ -344,12 +345,12 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     def delta_of(t):
         return delta0 + ddot * t
 
-    deadline = time.perf_counter() + time_budget_s if time_budget_s > 0 else math.inf
+    deadline = budget.deadline(time_budget_s)     # the scene's, where one is running
 
     def rhs(t, y):
         if time.perf_counter() > deadline:
-            raise _OverBudget(f"time budget: {time_budget_s:g} s spent in the integrator at "
-                              f"a = {y[0]:.4g} (numerics time_budget_s)")
+            raise _OverBudget(f"time budget: {budget.budget_seconds(time_budget_s):g} s spent "
+                              f"in the integrator at a = {y[0]:.4g} (numerics time_budget_s)")
         a = max(y[0], 1e-300)
         g = (a * a - delta_of(t)) ** 2 / (2.0 * a)
         v, _ = law.speed(g)

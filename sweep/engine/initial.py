@@ -16,6 +16,7 @@ import numpy as np
 from ..kernels.interface import TIP_GAP, crossing_radius
 from ..kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton
 
+from . import budget
 from .problem import jkr_radius
 
 #: Newton iterations of the elastic solves of the initial state (poorer starting guesses)
@@ -66,6 +67,7 @@ class ElasticSolver:
         self.stats = np.zeros(N_STATS, dtype=np.int64)
 
     def solve(self, delta, guess):
+        budget.check("the relaxed start (elastic solves)")
         h = np.array(guess, dtype=float)
         g = -delta + self.h0 + 0.5 * self.r**2
         ok = newton(h, g, self.A, 1.0, self.zero, self.h0, self.c, self.tol * self.h0,
@@ -130,21 +132,29 @@ def relaxed_state(el: ElasticSolver, delta0=None, a0=None, mesh_key=None):
     if mesh_key is None:
         return _solve_relaxed(el, delta0, a0)
     return cached_state((mesh_key, el.h0, el.c, el.tol, delta0, a0),
-                        lambda: _solve_relaxed(el, delta0, a0))
+                        lambda: _solve_relaxed(el, delta0, a0), el.stats)
 
 
-def cached_state(key, solve):
+def cached_state(key, solve, stats=None):
     """The state (gap h, indentation delta) kept under ``key`` in this process's cache of
     relaxed states (RELAXED_CACHE_SIZE of them, least recently used dropped), else
     ``solve()``'s, kept; a copy of the gap either way. ``key`` must determine the state: the
     mesh, the LJ law, the tolerance and the initial state (and the method, where two give
-    different states)."""
+    different states).
+
+    ``stats`` (the solver's counters, :data:`sweep.kernels.solve.N_STATS`) grows by what the
+    solve counted, whether it ran now or when the state was kept: a row's Newton iterations
+    and factorizations do not depend on what its process solved before."""
     hit = _RELAXED.get(key)
     if hit is not None:
         _RELAXED.move_to_end(key)
+        if stats is not None:
+            stats += hit[2]
         return hit[0].copy(), hit[1]
+    before = None if stats is None else stats.copy()
     h, d = solve()
-    _RELAXED[key] = (h.copy(), d)
+    spent = np.zeros(N_STATS, dtype=np.int64) if stats is None else stats - before
+    _RELAXED[key] = (h.copy(), d, spent)
     if len(_RELAXED) > RELAXED_CACHE_SIZE:
         _RELAXED.popitem(last=False)
     return h, d

@@ -44,7 +44,7 @@ from ..errors import (NUMERICAL_ERRORS, check_choice, check_positive, is_interna
                       is_physical_refusal)
 from ..scene import Numerics, Result, Scene
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
-from . import bem
+from . import bem, budget
 from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
 from .mesh import band_nodes, window_nodes
 from .problem import BEM_MU_RANGE, derive
@@ -311,7 +311,10 @@ def _model_error(model: str, scene, res) -> float:
 def _run(model: str, scene, numerics) -> Result:
     """``MODELS[model]``; a numerical failure is a failed result, a bug raises."""
     try:
+        budget.check(f"the {NAMES[model]}'s start")
         return MODELS[model](scene, numerics)
+    except budget.OverBudget as exc:
+        return Result(scene=scene, numerics=numerics, status="failed", reason=str(exc))
     except NUMERICAL_ERRORS as exc:   # a numerical failure is a result; a bug (TypeError, ...)
         if is_internal_error(exc):     # raises: sweep run records it as status "error"
             raise
@@ -326,6 +329,13 @@ def simulate_model(scene, model: str = "bem", numerics=None):
     "crack" or "pb" row's ``error_estimate`` is the model's :func:`measured_error`."""
     check_choice("model", model, (*MODELS, "auto"))
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    with budget.scene_budget(numerics.time_budget_s):
+        return _simulate_model(scene, model, numerics)
+
+
+def _simulate_model(scene, model: str, numerics) -> Result:
+    """:func:`simulate_model` inside the scene's time budget (:mod:`sweep.engine.budget`):
+    every model it runs, first or as a fallback, shares the one deadline."""
     if model == "auto":
         choice = model_choice(scene, numerics)
     elif model == "bem" and wants_quasistatic(scene, numerics):
@@ -351,7 +361,7 @@ def simulate_model(scene, model: str = "bem", numerics=None):
         choice, res = Choice("bem", miss), run("bem")
     if model == "auto" and choice.model in ("bem", "elastic") and res.status == "failed":
         fallback = _fallback(scene, res, choice.model)
-        if fallback is not None:
+        if fallback is not None and budget.remaining() > 0:   # the scene's time left
             choice, res = fallback, run("crack")
     res.model_used = choice.model
     res.model_reason = choice.reason

@@ -44,6 +44,8 @@ from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER
 from ..kernels.interface import lj_traction
 
 from ..scene import Numerics, Result, Scene
+from . import budget
+from .budget import OverBudget
 from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, no_contact_reason, unload_chunk
 from .initial import ElasticSolver, cached_state, relaxed_state
 from .mesh import WINDOW_AHEAD_ZONES, WINDOW_BEHIND_ZONES, band_nodes, tip_window
@@ -410,6 +412,8 @@ def direct_initial_state(el: ElasticSolver, pb, scene: Scene):
         return None
     try:
         h, d = relaxed_state(el, a0=scene.a0, mesh_key=(pb.mesh.key, pb.mesh.spacing))
+    except OverBudget:
+        raise
     except RuntimeError:
         return None
     finally:
@@ -472,10 +476,10 @@ def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
     """
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t_start = time.perf_counter()
-    deadline = t_start + numerics.time_budget_s if numerics.time_budget_s > 0 else math.inf
-    res = _attempt(scene, numerics, ahead, behind, deadline)
-    estimate_error(res, derive(scene, numerics).tip_zone,
-                   lambda coarse: _attempt(scene, coarse, ahead, behind, deadline))
+    with budget.scene_budget(numerics.time_budget_s) as deadline:
+        res = _attempt(scene, numerics, ahead, behind, deadline)
+        estimate_error(res, derive(scene, numerics).tip_zone,
+                       lambda coarse: _attempt(scene, coarse, ahead, behind, deadline))
     res.wall_s = time.perf_counter() - t_start
     return res
 
@@ -522,13 +526,13 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                 from_branch = True
                 h_init, delta0 = cached_state(
                     ("branch", pb.mesh.key, pb.mesh.spacing, el.h0, el.c, el.tol, scene.a0,
-                     scene.delta0, numerics.band_resolution, domain), branch_start)
+                     scene.delta0, numerics.band_resolution, domain), branch_start, el.stats)
             a_init = el.radius(h_init)
             lo, hi = pb.tip_range
             if lo <= a_init <= hi or a_init <= 0.0:
                 break
             a_est = a_init
-    except Refused as exc:
+    except (Refused, OverBudget) as exc:
         res.reason = str(exc)
         return res
     except RuntimeError as exc:
@@ -570,9 +574,10 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
             a = run.records[3]
             direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1
             try:
+                budget.check(f"the tip-following mesh's re-meshing at a = {a[run.n - 1]:.4g}")
                 new = prepare(scene, numerics,
                               tip_window(a[run.n - 1], zone, ahead, behind, direction))
-            except Refused as exc:
+            except (Refused, OverBudget) as exc:
                 res.reason = f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"
                 return res
             transfer(run, pb, new)

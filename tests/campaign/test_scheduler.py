@@ -22,6 +22,8 @@ from sweep.campaign.scheduler import Progress, SweepRuntimeError, run_scene, run
 from sweep.engine.bem import simulate
 from sweep.campaign.store import load, load_trajectory, parts_dir, read_attrs
 
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
 
 def fake_simulate(scene, numerics):
     """Deterministic stand-in for the solver: a short sleep, fails for n > 1 at high rates."""
@@ -33,6 +35,17 @@ def fake_simulate(scene, numerics):
                   pull_off=scene.n * math.log10(scene.rate + 1.0) + 1.0, steps=4, wall_s=0.05,
                   trajectory={"t": t, "delta": -t, "P": -t * scene.n, "a": 2 - t,
                               "a_inner": 1.5 - t})
+
+
+def sleepy_simulate(scene, numerics):
+    """A scene that takes two minutes; it first writes its process id into the directory
+    ``$SWEEP_TEST_PID_DIR`` (the test of orphaned workers finds the workers there)."""
+    d = os.environ["SWEEP_TEST_PID_DIR"]
+    with open(os.path.join(d, f"{os.getpid()}.pid"), "w") as fh:
+        fh.write(str(os.getpid()))
+    for _ in range(1200):
+        time.sleep(0.1)
+    return fake_simulate(scene, numerics)
 
 
 def raising_simulate(scene, numerics):
@@ -324,6 +337,61 @@ def test_worker_crash_stops_sweep_keeps_results(tmp_path):
     rep = run_sweep(c, jobs=2, out=out, simulate=fake_simulate, progress="none")
     assert rep.skipped == len(df) and rep.ran == 6 - len(df)
     assert len(load(out)) == 6
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie, waiting to be reaped, does not)."""
+    try:
+        with open(f"/proc/{pid}/status") as fh:
+            return not any(line.startswith("State:") and "Z" in line.split()[1] for line in fh)
+    except FileNotFoundError:
+        return False
+
+
+_PARENT = """
+import sys
+from sweep.campaign.scheduler import run_sweep
+from tests.campaign.test_scheduler import cfg, sleepy_simulate
+run_sweep(cfg(), jobs=2, out=sys.argv[1], simulate=sleepy_simulate, progress="none")
+"""
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="reads /proc (Linux)")
+def test_a_killed_sweep_leaves_no_worker(tmp_path):
+    """SIGKILL the process of a running sweep: its loky workers, busy with two-minute
+    scenes, end within seconds (sweep.threads.exit_with_parent) instead of computing on,
+    orphaned (issue 33 item 3). 30 s allowed; without the watch they live 120 s."""
+    import signal
+    import subprocess
+    import sys
+
+    pids_dir = tmp_path / "pids"
+    pids_dir.mkdir()
+    env = dict(os.environ, SWEEP_TEST_PID_DIR=str(pids_dir),
+               PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    parent = subprocess.Popen([sys.executable, "-c", _PARENT, str(tmp_path / "r.h5")],
+                              env=env, cwd=ROOT)
+    try:
+        t0 = time.monotonic()
+        while len(list(pids_dir.glob("*.pid"))) < 2:
+            assert parent.poll() is None, "the sweep ended before its workers started"
+            assert time.monotonic() - t0 < 240, "the workers did not start"
+            time.sleep(0.2)
+        workers = [int(p.stem) for p in pids_dir.glob("*.pid")]
+        assert parent.pid not in workers
+        os.kill(parent.pid, signal.SIGKILL)
+        parent.wait()
+        t0 = time.monotonic()
+        while any(_alive(w) for w in workers) and time.monotonic() - t0 < 30:
+            time.sleep(0.2)
+        left = [w for w in workers if _alive(w)]
+    finally:
+        if parent.poll() is None:
+            parent.kill()
+        for w in [int(p.stem) for p in pids_dir.glob("*.pid")]:
+            if _alive(w):
+                os.kill(w, signal.SIGKILL)
+    assert not left, f"workers {left} outlived their killed sweep by 30 s"
 
 
 def test_dask_without_address_starts_local_cluster(tmp_path):

@@ -257,7 +257,7 @@ def test_the_step_estimate_is_below_the_steps_a_run_takes():
     assert all(0 <= e.steps < res.steps for e in later)
 
 
-def test_a_scene_beyond_its_budget_is_refused_after_the_probe_with_what_it_needs():
+def test_a_scene_beyond_its_budget_is_refused_after_the_probe_with_what_it_needs(monkeypatch):
     """mu = 10, a0 = 15, rate 1e-4: the indentation falls by about 220 d_ref and the crack
     tip recedes by 13.7 a_ref (balanced: at least 11700 and 12900 steps at the probe's
     largest steps; 47000 at da_max 0.6, whose steps grew less); with a 60 s budget it used
@@ -266,7 +266,11 @@ def test_a_scene_beyond_its_budget_is_refused_after_the_probe_with_what_it_needs
     well below what the run needs on any machine: the engine has become fast enough (0.2 ms
     per step after warm-up here, 11 s for the least number of steps; a 2x faster CI machine
     ran two chunks within a 10 s budget and was refused only after the third) that the
-    budget is 1 s, about ten times below that estimate on this machine."""
+    budget is 1 s, about ten times below that estimate on this machine. The relaxed start,
+    which the budget also covers (about 1.2 s of it here), is not what this test measures:
+    its check is off (tests/engine/test_budget.py tests it), so the probe meets the same
+    budget on every machine as before."""
+    monkeypatch.setattr(tf.budget, "check", lambda where: None)
     res = tf.simulate_tip_following(Scene(n=0.2, k=0.5, mu=10.0, a0=15.0, rate=1e-4),
                                     Numerics.preset("balanced", time_budget_s=1.0))
     assert res.status == "failed"

@@ -1,0 +1,90 @@
+"""The time budget of one scene (``Numerics.time_budget_s``): one deadline for all of it.
+
+:func:`sweep.engine.models.simulate`, the front door, opens the scene's budget
+(:func:`scene_budget`); every model, retry and stage of the scene then reads the same deadline
+(:func:`deadline`) and checks it (:func:`check`): the auto chooser's fallbacks, the error
+estimate's coarser solve, the relaxed start's Newton solves, the tip-following mesh's
+re-meshings, the unloading's kernel chunks and the crack-front integrator. A scene that runs
+past it ends as a failed row whose reason starts ``time budget:``, within the budget plus the
+longest stretch between two checks (:data:`CHECK_SLACK_S`, measured by
+``tests/engine/test_budget.py`` on the scene that hung a sweep before).
+
+Called outside :func:`scene_budget` (a model's simulate function called directly), each
+function that reads the deadline starts a budget of its own, as before.
+
+The budget ends computations, never changes one: where a check passes, the solve goes on
+exactly as without it, so a scene's numbers do not depend on the machine's speed.
+"""
+from __future__ import annotations
+
+import math
+import time
+from contextlib import contextmanager
+from contextvars import ContextVar
+
+__all__ = ["OverBudget", "scene_budget", "deadline", "remaining", "check", "CHECK_SLACK_S"]
+
+#: (deadline in time.perf_counter() seconds, the budget in seconds) of the scene being run
+_BUDGET: ContextVar[tuple[float, float] | None] = ContextVar("scene_budget", default=None)
+
+#: the slack a scene may run past its budget: the longest stretch between two checks (one
+#: kernel chunk of unloading steps, one Newton solve of the relaxed start), a bound of what
+#: tests/engine/test_budget.py measures on the scene of issue 33 (the wall asserted there)
+CHECK_SLACK_S = 10.0
+
+
+class OverBudget(RuntimeError):
+    """The scene's time budget ran out; the message is the failed row's reason."""
+
+
+def _deadline_of(seconds: float) -> float:
+    return time.perf_counter() + seconds if seconds > 0 else math.inf
+
+
+@contextmanager
+def scene_budget(seconds: float):
+    """The budget of one scene: ``seconds`` from now (0: none). Nested, the earlier deadline
+    holds (a model run inside a scene never gets more time than the scene has left).
+
+    Yields
+    ------
+    float
+        The deadline (``time.perf_counter()`` seconds; ``inf`` without a budget).
+    """
+    outer = _BUDGET.get()
+    mine = (_deadline_of(seconds), float(seconds))
+    if outer is not None and outer[0] <= mine[0]:
+        mine = outer
+    token = _BUDGET.set(mine)
+    try:
+        yield mine[0]
+    finally:
+        _BUDGET.reset(token)
+
+
+def deadline(seconds: float) -> float:
+    """The deadline of the running scene, or ``seconds`` from now where no scene budget is
+    open (a model's simulate function called directly); the earlier of the two otherwise."""
+    own = _deadline_of(seconds)
+    outer = _BUDGET.get()
+    return own if outer is None else min(own, outer[0])
+
+
+def remaining(seconds: float = 0.0) -> float:
+    """Seconds left of the running scene's budget (``inf`` without one)."""
+    return deadline(seconds) - time.perf_counter()
+
+
+def budget_seconds(default: float = 0.0) -> float:
+    """The running scene's budget in seconds (``default`` outside a scene)."""
+    outer = _BUDGET.get()
+    return default if outer is None else outer[1]
+
+
+def check(where: str) -> None:
+    """Raise :class:`OverBudget` naming ``where`` when the running scene's deadline passed."""
+    outer = _BUDGET.get()
+    if outer is not None and time.perf_counter() > outer[0]:
+        raise OverBudget(f"time budget: {outer[1]:g} s spent in {where}; give it more "
+                         f"(numerics time_budget_s) or cheaper numerics (preset fast, lower "
+                         f"band_resolution, or model crack)")
