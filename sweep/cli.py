@@ -26,7 +26,7 @@ from click.core import ParameterSource
 
 from .errors import (InputError, as_float, check_array, check_choice, check_int, check_positive,
                      check_range)
-from .scene import AXES, PRESETS, Numerics, Scene
+from .scene import AXES, PRESETS, REFINEMENTS_ON_REQUEST, Numerics, Scene
 
 #: exit code of ``sweep run`` when scenes hit an internal error (the sweep itself finished)
 EXIT_INTERNAL_ERROR = 3
@@ -242,13 +242,17 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
 @click.option("--speed", "speed", type=str, default=None, help="[--si] unloading speed [m/s].")
 @click.option("--preset", type=click.Choice(list(PRESETS)), default="balanced",
               show_default=True)
+@click.option("--pull-off-rtol", "pull_off_rtol", type=str, default=None,
+              help="Ask for this relative pull-off accuracy: the cheapest preset that meets it "
+                   "(or --preset's), refined where a scene's error estimate says no.")
 @click.option("--nodes", type=str, default=None, help="Override the preset's node count.")
 @click.option("--domain", type=str, default=None, help="Mesh radius (a_ref); default automatic.")
 @click.option("--step", type=str, default=None, help="Largest indentation step (units of h0).")
 @click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
-def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, **values):
+def scene_command(preset, pull_off_rtol, nodes, domain, step, exact, as_json, trajectory, si,
+                  **values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .engine.models import simulate
 
@@ -277,7 +281,7 @@ def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, *
         overrides["step"] = as_float("step", step)
     if exact:
         overrides["exact"] = True
-    num = Numerics.preset(preset, **overrides)
+    num = _scene_numerics(preset, pull_off_rtol, overrides)
     res = simulate(sc, num)
     if as_json:
         echo_json(res.to_dict(trajectory=trajectory))
@@ -300,6 +304,20 @@ def scene_command(preset, nodes, domain, step, exact, as_json, trajectory, si, *
                    f"factorizations={res.factorizations} wall={res.wall_s:.3f} s")
     if not res.ok:
         raise SystemExit(1)
+
+
+def _scene_numerics(preset: str, pull_off_rtol: str | None, overrides: dict) -> Numerics:
+    """The numerics of ``sweep scene``: the preset, or with ``--pull-off-rtol`` an accuracy
+    asked for (:meth:`Numerics.for_tolerance`; with ``--preset`` given, that preset at the
+    tolerance, with the same refinements)."""
+    if pull_off_rtol is None:
+        return Numerics.preset(preset, **overrides)
+    rtol = check_range("pull_off_rtol", pull_off_rtol, 0.0, 1.0, lo_open=True)
+    source = click.get_current_context().get_parameter_source("preset")
+    if source is ParameterSource.COMMANDLINE:
+        return Numerics.preset(preset, pull_off_rtol=rtol, refinements=REFINEMENTS_ON_REQUEST,
+                               **overrides)
+    return Numerics.for_tolerance(rtol, **overrides)
 
 
 def _scene_si(axes, as_json, values):

@@ -255,6 +255,24 @@ PRESETS = {
 }
 
 
+#: the most refinements a scene may ask for
+MAX_REFINEMENTS = 6
+#: refinements of :meth:`Numerics.for_tolerance` (an accuracy asked for, not a preset)
+REFINEMENTS_ON_REQUEST = 3
+#: numerics given by these keys alone, ``pull_off_rtol`` among them, ask for an accuracy:
+#: :meth:`Numerics.from_dict` resolves them with :meth:`Numerics.for_tolerance`
+TOLERANCE_REQUEST_KEYS = frozenset({"pull_off_rtol", "time_budget_s", "max_nodes", "max_steps",
+                                    "refinements"})
+
+
+def preset_for_tolerance(pull_off_rtol: float) -> str:
+    """The cheapest preset whose own ``pull_off_rtol`` is at most ``pull_off_rtol`` (the
+    finest, "accurate", below all of them: its refinements do the rest)."""
+    fits = [name for name in ("fast", "balanced", "accurate")
+            if PRESETS[name]["pull_off_rtol"] <= pull_off_rtol]
+    return fits[0] if fits else "accurate"
+
+
 @dataclass(frozen=True, kw_only=True)
 class Numerics:
     """Discretization and solver settings of one scene.
@@ -332,6 +350,15 @@ class Numerics:
         (docs/design.md section 2). A coarser mesh traps the crack tip between nodes (jagged
         P(t), spurious minima, failed Newton solves), so such a scene is refused with a
         ``failed`` status that says how many nodes it needs.
+    refinements : int
+        How many times the BEM may solve a scene again at a finer resolution where its error
+        estimate exceeds ``pull_off_rtol`` (0: never; the row is then "unresolved"). Each
+        refinement divides the spacing and the indentation step by the factor the estimate
+        asks for (its second-order convergence, between sqrt 2 and 2) and the Prony
+        tolerance by 10 where the Prony error takes half the tolerance
+        (:func:`sweep.engine.resolution.refined`), within ``max_nodes`` and the time budget.
+        The row records what it took (``Result.refinements``, ``band_resolution_used``,
+        ``step_used``). :meth:`for_tolerance` sets it.
     """
 
     nodes: int | None = None
@@ -352,6 +379,7 @@ class Numerics:
     pull_off_rtol: float = 0.02
     time_budget_s: float = 300.0
     da_max_pulloff: float | None = None
+    refinements: int = 0
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
@@ -378,6 +406,7 @@ class Numerics:
             raise InputError(f"exact must be true or false (got {self.exact!r})")
         set_("exact", bool(self.exact))
         set_("zone_nodes", check_range("zone_nodes", self.zone_nodes, 0.0, 100.0))
+        set_("refinements", check_int("refinements", self.refinements, 0, MAX_REFINEMENTS))
 
     @property
     def uniform_nodes(self) -> int:
@@ -385,6 +414,25 @@ class Numerics:
         place that resolves ``nodes=None`` on a uniform mesh, e.g. numerics given by fields
         without a preset)."""
         return self.nodes if self.nodes is not None else UNIFORM_NODES
+
+    @classmethod
+    def for_tolerance(cls, pull_off_rtol: float, **overrides) -> "Numerics":
+        """Numerics that deliver a pull-off within ``pull_off_rtol`` (relative, as the
+        row's ``error_estimate`` measures it) at the least cost: the cheapest preset whose
+        own tolerance meets it (:func:`preset_for_tolerance`; the presets are the measured
+        front of ``make tradeoff``), with ``pull_off_rtol`` and up to
+        :data:`REFINEMENTS_ON_REQUEST` refinements where a scene's estimate says no.
+
+        Parameters
+        ----------
+        pull_off_rtol : float
+            Relative pull-off tolerance, in (0, 1].
+        **overrides
+            Other :class:`Numerics` fields (``time_budget_s``, ``max_nodes``, ...).
+        """
+        rtol = check_range("pull_off_rtol", pull_off_rtol, 0.0, 1.0, lo_open=True)
+        fields = {"pull_off_rtol": rtol, "refinements": REFINEMENTS_ON_REQUEST, **overrides}
+        return cls.preset(preset_for_tolerance(rtol), **fields)
 
     @classmethod
     def preset(cls, name: str = "balanced", **overrides) -> "Numerics":
@@ -406,6 +454,8 @@ class Numerics:
                              f"(allowed: preset, {', '.join(sorted(names))})")
         if preset is not None:
             return cls.preset(preset, **d)
+        if "pull_off_rtol" in d and set(d) <= TOLERANCE_REQUEST_KEYS:
+            return cls.for_tolerance(d.pop("pull_off_rtol"), **d)
         return cls(**d)
 
 
@@ -513,6 +563,13 @@ class Result:
     model_reason : str
         Why that model ran, in a few words (the scene asked for it; or what "auto" weighed:
         e.g. "auto: crack-front model, measured error 0.4 % <= pull_off_rtol 1 % at mu = 40").
+    refinements : int
+        How many times the BEM solved the scene again at a finer resolution because its
+        error estimate exceeded ``pull_off_rtol`` (``Numerics.refinements`` allows it).
+    band_resolution_used, step_used : float
+        The BEM's resolution behind the row: spacings per process zone (the graded mesh's
+        band resolution; NaN on a mesh given by its node count, whose ``nodes_used`` says it)
+        and the largest indentation step (h0). NaN for the other models.
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
     """
@@ -544,6 +601,9 @@ class Result:
     wall_s: float = 0.0
     model_used: str = ""
     model_reason: str = ""
+    refinements: int = 0
+    band_resolution_used: float = math.nan
+    step_used: float = math.nan
     trajectory: dict = field(default_factory=dict)
 
     @property

@@ -87,3 +87,21 @@ def test_plot_of_a_sweep_with_trajectories(tmp_path, capsys):
     png = tmp_path / "tiny.png"
     assert main(["plot", str(tmp_path / "tiny.h5"), "--out", str(png)]) == 0
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+
+
+def test_scene_asked_for_an_accuracy(capsys):
+    """`--pull-off-rtol` (issue 33 item 1): the cheapest preset that meets it, refinements
+    allowed; with --preset, that preset at the tolerance; a bad value is one line, exit 2."""
+    base = [a for a in SCENE if a not in ("--preset", "fast")]
+    assert main(base + ["--pull-off-rtol", "0.01", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["num_pull_off_rtol"] == 0.01 and out["num_refinements"] == 3
+    assert out["num_band_resolution"] == 16.0                   # balanced's resolution
+    assert out["error_estimate"] <= 0.01 and out["band_resolution_used"] >= 16.0
+    assert main(SCENE + ["--pull-off-rtol", "0.01", "--json"]) in (0, 1)
+    out = json.loads(capsys.readouterr().out)
+    assert out["num_band_resolution"] == 9.0 and out["num_refinements"] == 3
+    assert out["status"] == "ok" or out["reason"].startswith("unresolved")
+    assert main(base + ["--pull-off-rtol", "2"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["error: pull_off_rtol must be in (0, 1] (got 2)"]

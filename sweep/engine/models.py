@@ -48,6 +48,7 @@ from . import bem, budget
 from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
 from .mesh import band_nodes, window_nodes
 from .problem import BEM_MU_RANGE, derive
+from .resolution import refined, unresolved
 from .quasistatic import simulate_elastic
 
 __all__ = ["MODELS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
@@ -114,7 +115,40 @@ def simulate_pb(scene, numerics=None):
 
 
 def _bem(scene, numerics=None):
+    """The BEM, refined where its error estimate exceeds ``pull_off_rtol`` and
+    ``numerics.refinements`` allows (:func:`sweep.engine.resolution.refined`), each solve on
+    the mesh that fits it (graded, or tip-following beyond ``max_nodes``), within the scene's
+    time budget. The row keeps the requested numerics (its id) and records the resolution
+    behind it (``refinements``, ``band_resolution_used``, ``step_used``); a refinement that
+    fails for another reason (the mesh too large, the budget spent) leaves the finest
+    unresolved row, its reason saying so."""
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    t_start = time.perf_counter()
+    res, used, count = _bem_once(scene, numerics), numerics, 0
+    while unresolved(res) and count < numerics.refinements and budget.remaining() > 0:
+        finer = refined(used, res)
+        if finer is None:
+            break
+        attempt = _bem_once(scene, finer)
+        if not (attempt.ok or unresolved(attempt)):
+            res.reason += (f"; refined to band_resolution {finer.band_resolution:.4g}, step "
+                           f"{finer.step:.3g}: {attempt.reason[:160]}")
+            break
+        res, used, count = attempt, finer, count + 1
+    if count:
+        note = (f"refined {count} time{'s' if count > 1 else ''} to band_resolution "
+                f"{used.band_resolution:.4g}, step {used.step:.3g} h0")
+        res.reason = f"{res.reason}; {note}" if res.reason else note
+    res.numerics, res.refinements = numerics, count
+    graded = used.mesh == "graded" and used.nodes is None
+    res.band_resolution_used = used.band_resolution if graded else math.nan
+    res.step_used = used.step
+    res.wall_s = time.perf_counter() - t_start
+    return res
+
+
+def _bem_once(scene, numerics):
+    """One BEM solve with its error estimate, on the mesh that fits ``numerics``."""
     if wants_tip_following(scene, numerics):
         from .tip_following import simulate_tip_following  # lazy: scipy.interpolate, optimize
 

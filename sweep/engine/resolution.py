@@ -68,6 +68,52 @@ def coarser(numerics: Numerics, factor: float = 2.0) -> Numerics:
                                step=step, zone_nodes=0.0, pull_off_rtol=0.0, **da)
 
 
+#: the smallest and largest factor of one refinement (:func:`refined`), and the margin on the
+#: factor the estimate asks for (a second-order error falls by the factor squared)
+REFINE_FACTORS = (math.sqrt(2.0), 2.0)
+REFINE_MARGIN = 1.2
+
+
+def unresolved(res: Result) -> bool:
+    """Whether ``res`` failed only because its error estimate exceeds ``pull_off_rtol``."""
+    return res.status == "failed" and res.reason.startswith("unresolved:")
+
+
+def refined(numerics: Numerics, res: Result) -> Numerics | None:
+    """The numerics of the next solve of the unresolved result ``res`` (solved with
+    ``numerics``), or None where nothing is left to refine.
+
+    The estimate's discretization part (the estimate less the Prony error) falls by f^2 when
+    the spacing and the indentation step are divided by f (second order; the estimate's own
+    pair measures it, first order would only make it conservative): f is
+    ``REFINE_MARGIN sqrt(discretization part / its share of the tolerance)``, kept within
+    :data:`REFINE_FACTORS`. The band resolution (or the node count of a mesh given by it) is
+    multiplied by f and the step divided by it; the Prony tolerance is divided by 10 where
+    the Prony error takes half the tolerance or more.
+    """
+    tol = numerics.pull_off_rtol
+    prony = res.prony_error if math.isfinite(res.prony_error) else 0.0
+    estimate = res.error_estimate if math.isfinite(res.error_estimate) else math.inf
+    disc = max(estimate - prony, 0.0)
+    share = tol - min(prony, 0.5 * tol)          # what the discretization may take
+    lo, hi = REFINE_FACTORS
+    f = min(max(REFINE_MARGIN * math.sqrt(disc / share), lo), hi) if math.isfinite(disc) else hi
+    changes = {}
+    if prony >= 0.5 * tol and numerics.prony_rtol > 1e-9:
+        changes["prony_rtol"] = max(numerics.prony_rtol / 10.0, 1e-9)
+    if disc > 0.0:
+        step = max(numerics.step / f, numerics.min_step, 1e-4)
+        if step < numerics.step:
+            changes["step"] = step
+        if numerics.nodes is not None or numerics.mesh == "uniform":
+            nodes = min(int(math.ceil(numerics.uniform_nodes * f)), 5000)
+            if nodes > numerics.uniform_nodes:
+                changes["nodes"] = nodes
+        elif numerics.band_resolution < 500.0:
+            changes["band_resolution"] = min(numerics.band_resolution * f, 500.0)
+    return dataclasses.replace(numerics, **changes) if changes else None
+
+
 #: resolution ratios of the cheaper solve, tried in turn until one succeeds (a mesh of half
 #: the resolution may not hold a small initial contact that a finer one holds)
 COARSER_FACTORS = (2.0, math.sqrt(2.0))

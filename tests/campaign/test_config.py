@@ -345,3 +345,12 @@ def test_shipped_pdms_config_is_the_papers_case():
     assert all(si.preload == pytest.approx(pv["preload_mN"] * 1e-3) for si in sis)
     assert {s.model for s in cfg.scenes()} <= {"crack", "pb", "auto"}
     assert cfg.scenes()[0].mu == pytest.approx(103, abs=0.5)
+
+
+def test_numerics_asked_as_an_accuracy_resolve_to_the_cheapest_preset_with_refinements():
+    """`numerics: {pull_off_rtol: ...}` alone (issue 33 item 1): Numerics.for_tolerance."""
+    from sweep.scene import Numerics
+    cfg = config_from_dict({"name": "t", "grid": {"n": 0.4, "rate": 1.0, "a0": 2.0},
+                            "numerics": {"pull_off_rtol": 0.01, "max_nodes": 800}})
+    assert cfg.numerics == Numerics.for_tolerance(0.01, max_nodes=800)
+    assert cfg.numerics.refinements > 0 and cfg.numerics.mesh == "graded"
