@@ -184,8 +184,11 @@ model-errors: $(STAMP)
 
 # issue 21: coverage and looseness of the per-row error estimate against a much finer run,
 # per preset, on a seeded random sample (QUICK=1: 6 scenes)
+# then the accuracy asked for (Numerics.for_tolerance) at three tolerances on the same scenes
+# against the same references (issue 33 item 6)
 error-coverage: $(STAMP)
 	$(BIN)/python -m sweep.bench.error_coverage $(if $(filter 1,$(QUICK)),--scenes 6 --out results/quick/error_coverage)
+	$(BIN)/python -m sweep.bench.error_coverage --tolerance 3e-2 --tolerance 1e-2 --tolerance 1e-3 $(if $(filter 1,$(QUICK)),--out results/quick/error_coverage)
 
 # the crack speed's accuracy and its fit's window (sweep/bench/crack_speed.py)
 crack-speed: $(STAMP)

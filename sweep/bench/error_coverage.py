@@ -76,15 +76,9 @@ def run_preset(d: dict, name: str, reference: dict, budget_s: float = 30.0,
                probe: bool = False) -> dict:
     """One preset on one scene: its pull-off, estimate and true error against
     ``reference`` (the reference entry of a row: status and pull-off)."""
-    scene = Scene(**d)
-    res = simulate(scene, Numerics.preset(name, time_budget_s=budget_s))
-    ok = res.ok and reference["status"] == "ok"
-    true = abs(res.pull_off / reference["pull_off"] - 1.0) if ok else math.nan
-    out = {"status": res.status, "reason": res.reason, "pull_off": res.pull_off,
-           "error_estimate": res.error_estimate, "true_error": true,
-           "wall_s": res.wall_s, "nodes": res.nodes_used, "spacing": res.spacing,
-           "steps": res.steps, "prony_error": res.prony_error, "model": res.model_used}
+    out = run_numerics(d, Numerics.preset(name, time_budget_s=budget_s), reference)
     if probe:
+        scene = Scene(**d)
         num = Numerics.preset(name, time_budget_s=budget_s, pull_off_rtol=0.0)
         for key, n2 in (("plain", num), ("coarse", coarser(num))):
             r2 = simulate(scene, n2)
@@ -93,13 +87,36 @@ def run_preset(d: dict, name: str, reference: dict, budget_s: float = 30.0,
     return out
 
 
+def tolerance_key(rtol: float) -> str:
+    """The key of a row's entry for the accuracy request ``rtol`` (``--tolerance``)."""
+    return f"rtol_{rtol:g}"
+
+
+def run_numerics(d: dict, numerics: Numerics, reference: dict) -> dict:
+    """``numerics`` on one scene: its pull-off, estimate, the resolution it took and the
+    true error against ``reference`` (the reference entry of a row)."""
+    res = simulate(Scene(**d), numerics)
+    ok = res.ok and reference["status"] == "ok"
+    true = abs(res.pull_off / reference["pull_off"] - 1.0) if ok else math.nan
+    out = {"status": res.status, "reason": res.reason, "pull_off": res.pull_off,
+           "error_estimate": res.error_estimate, "true_error": true,
+           "wall_s": res.wall_s, "nodes": res.nodes_used, "spacing": res.spacing,
+           "steps": res.steps, "prony_error": res.prony_error, "model": res.model_used,
+           "refinements": res.refinements}
+    return out
+
+
 def summarize(rows: list[dict]) -> dict:
-    """Coverage and looseness of the estimate per preset, over scenes where both the preset
-    and the reference are ok (a true error below 1e-12 counts as covered)."""
+    """Coverage and looseness of the estimate per preset and per accuracy request
+    (``rtol_*`` entries), over scenes where both it and the reference are ok (a true error
+    below 1e-12 counts as covered); for a request also the share of the scenes with a
+    reference that it delivered (ok, true error within the tolerance)."""
     out = {}
-    for name in PRESET_NAMES:
+    requests = sorted({k for r in rows for k in r if k.startswith("rtol_")},
+                      key=lambda k: -float(k[5:]))
+    for name in (*PRESET_NAMES, *requests):
         pairs = [(r[name]["error_estimate"], r[name]["true_error"]) for r in rows
-                 if r[name]["status"] == "ok" and r["reference"]["status"] == "ok"]
+                 if name in r and r[name]["status"] == "ok" and r["reference"]["status"] == "ok"]
         if not pairs:
             continue
         est = np.array([p[0] for p in pairs], float)
@@ -111,9 +128,21 @@ def summarize(rows: list[dict]) -> dict:
                      "median_true_error": float(np.median(true)),
                      "median_estimate": float(np.median(est)),
                      "max_true_error": float(np.max(true)),
-                     "within_pull_off_rtol": float(np.mean(
-                         true <= Numerics.preset(name).pull_off_rtol))}
+                     "within_pull_off_rtol": float(np.mean(true <= _tolerance(name)))}
+        if name.startswith("rtol_"):
+            tol = _tolerance(name)
+            asked = [r for r in rows if name in r and r["reference"]["status"] == "ok"]
+            out[name].update(
+                requested=len(asked),
+                delivered=float(np.mean([r[name]["status"] == "ok"
+                                         and r[name]["true_error"] <= tol for r in asked])),
+                refined=int(sum(r[name].get("refinements", 0) > 0 for r in asked)),
+                wall_s=float(sum(r[name]["wall_s"] for r in asked)))
     return out
+
+
+def _tolerance(name: str) -> float:
+    return float(name[5:]) if name.startswith("rtol_") else Numerics.preset(name).pull_off_rtol
 
 
 def _main(argv=None) -> int:
@@ -133,6 +162,9 @@ def _main(argv=None) -> int:
     p.add_argument("--rerun", choices=PRESET_NAMES, action="append", default=[],
                    help="run this preset again on every scene of OUT/coverage.json, the "
                         "references kept (after the preset changed); repeatable")
+    p.add_argument("--tolerance", type=float, action="append", default=[],
+                   help="ask for this pull-off accuracy (Numerics.for_tolerance) on every "
+                        "scene of OUT/coverage.json, the references kept; repeatable")
     args = p.parse_args(argv)
     from joblib import Parallel, delayed
 
@@ -140,9 +172,10 @@ def _main(argv=None) -> int:
     out = Path(args.out)
     rows, wall, commands = [], 0.0, []
     path = out / "coverage.json"
-    if args.rerun and not path.exists():
-        raise SystemExit(f"error: --rerun: no {path} to take the scenes and references from")
-    if (args.grow or args.rerun) and path.exists():
+    if (args.rerun or args.tolerance) and not path.exists():
+        raise SystemExit(f"error: --rerun/--tolerance: no {path} to take the scenes and "
+                         f"references from")
+    if (args.grow or args.rerun or args.tolerance) and path.exists():
         old = json.loads(path.read_text())
         if args.grow and old["seed"] != args.seed:
             raise SystemExit(f"error: --grow: {path} has seed {old['seed']}, not {args.seed}")
@@ -154,8 +187,16 @@ def _main(argv=None) -> int:
                                     args.probe) for i, name in jobs)):
             rows[i][name] = got
         print(f"reran {', '.join(args.rerun)} on {len(rows)} scenes")
+    if args.tolerance:
+        jobs = [(i, t) for i, _ in enumerate(rows) for t in args.tolerance]
+        for (i, t), got in zip(jobs, Parallel(n_jobs=args.jobs)(
+                delayed(run_numerics)(rows[i]["scene"],
+                                      Numerics.for_tolerance(t, time_budget_s=args.budget),
+                                      rows[i]["reference"]) for i, t in jobs)):
+            rows[i][tolerance_key(t)] = got
+        print(f"asked for {', '.join(f'{t:g}' for t in args.tolerance)} on {len(rows)} scenes")
     have = [r["scene"] for r in rows]
-    scenes = [] if args.rerun else [d for d in sample(args.scenes, args.seed) if d not in have]
+    scenes = [] if (args.rerun or args.tolerance) else [d for d in sample(args.scenes, args.seed) if d not in have]
     for row in Parallel(n_jobs=args.jobs, return_as="generator_unordered")(
             delayed(run_scene)(d, args.budget, args.probe) for d in scenes):
         rows.append(row)
@@ -166,9 +207,11 @@ def _main(argv=None) -> int:
                          for n in PRESET_NAMES), flush=True)
     summary = summarize(rows)
     for name, s in summary.items():
+        delivered = (f", delivered {s['delivered']:.2f} of {s['requested']} ({s['refined']} "
+                     f"refined, {s['wall_s']:.0f} s)" if "delivered" in s else "")
         print(f"{name:9} {s['scenes']} scenes: coverage {s['coverage']:.2f}, median "
               f"looseness {s['median_looseness']:.3g}, median true error "
-              f"{s['median_true_error']:.2g}")
+              f"{s['median_true_error']:.2g}{delivered}")
     out.mkdir(parents=True, exist_ok=True)
     command = " ".join(["python -m sweep.bench.error_coverage",
                         *(sys.argv[1:] if argv is None else argv)])

@@ -67,3 +67,23 @@ def test_rerun_replaces_one_presets_rows_and_keeps_the_references(tmp_path):
     fast = row["fast"]
     assert fast["status"] == "ok"
     assert fast["true_error"] == pytest.approx(abs(fast["pull_off"] - 1.0))
+
+
+def test_tolerance_asks_for_an_accuracy_on_the_kept_scenes(tmp_path):
+    """--tolerance T (issue 33 item 6) runs Numerics.for_tolerance(T) on every scene of an
+    earlier file against its kept reference; the summary adds what was delivered."""
+    scene = dict(n=0.8, k=0.5, mu=3.24, a0=1.5, rate=10.0, material="mpl")
+    ok = error_coverage.run_numerics(scene, error_coverage.Numerics.preset("accurate"),
+                                     {"status": "ok", "pull_off": 1.0})
+    reference = {"status": "ok", "pull_off": ok["pull_off"]}   # accurate as the reference
+    doc = {"rows": [{"scene": scene, "reference": reference}], "seed": 7, "wall_s": 1.0,
+           "command": "python -m sweep.bench.error_coverage"}
+    (tmp_path / "coverage.json").write_text(json.dumps(doc))
+    assert error_coverage._main(["--tolerance", "0.03", "--tolerance", "1e-3",
+                                 "--out", str(tmp_path), "-j", "1"]) == 0
+    saved = json.loads((tmp_path / "coverage.json").read_text())
+    for key, tol in (("rtol_0.03", 0.03), ("rtol_0.001", 1e-3)):
+        got = saved["rows"][0][key]
+        assert got["status"] == "ok" and got["true_error"] <= tol, got
+        s = saved["summary"][key]
+        assert s["requested"] == 1 and s["delivered"] == 1.0 and s["within_pull_off_rtol"] == 1.0
