@@ -55,6 +55,14 @@ def _provenance(path) -> dict:
     return {"results": str(path), **{k: a.get(k) for k in keep}}
 
 
+def _engine_check(runs) -> dict:
+    """What the campaign's rows were computed with and a sample of them
+    (:mod:`sweep.paper.engine_check`), which ``make test`` computes again."""
+    from .engine_check import record
+
+    return record(runs)
+
+
 def _cost(df) -> dict:
     """Scene counts and costs of a runs table (seconds)."""
     ok = df["status"] == "ok"
@@ -86,7 +94,7 @@ def _fit_campaign(runs, outdir, analyze):
     OUTDIR/fit.json; returns (runs table, fit dict, OUTDIR as a Path)."""
     df = _load_results(runs)
     fit = analyze(df)
-    fit.update(provenance=_provenance(runs), cost=_cost(df))
+    fit.update(provenance=_provenance(runs), cost=_cost(df), engine_check=_engine_check(runs))
     out = Path(outdir)
     _write_json(fit, out / "fit.json")
     return df, fit, out
@@ -164,6 +172,7 @@ def fig3_cmd(runs, outdir):
     fig3_figure(df, trajs, out / "fig3.png")
     ok = df[df["status"] == "ok"]
     _write_json({"provenance": _provenance(runs), "cost": _cost(df),
+                 "engine_check": _engine_check(runs),
                  "pull_off": [{"n": r.n, "a0": r.a0, "rate": r.rate, "pull_off": r.pull_off}
                               for r in ok.itertuples()]}, out / "fig3.json")
     click.echo(str(out / "fig3.png"))
@@ -181,6 +190,7 @@ def aconv_cmd(runs, outdir):
     aconv_figure(df, out / "aconv.png")
     ok = df[df["status"] == "ok"].sort_values(["a0", "rate"])
     _write_json({"provenance": _provenance(runs), "cost": _cost(df),
+                 "engine_check": _engine_check(runs),
                  "pull_off": [{"a0": r.a0, "rate": r.rate, "pull_off": r.pull_off}
                               for r in ok.itertuples()]}, out / "aconv.json")
     click.echo(str(out / "aconv.png"))

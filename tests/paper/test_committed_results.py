@@ -1,0 +1,75 @@
+"""Committed results are main's results (issue 33 item 4): every committed campaign result
+records its config and a sample of its rows (sweep.paper.engine_check); its config must still
+resolve to the same scenes and numerics, and main must still compute the sample's rows within
+the stated tolerances. A failure here means: regenerate the result (the make target named in
+the message) and commit it, or undo the change of numerics."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from sweep.paper import engine_check as ec
+
+ROOT = Path(__file__).resolve().parents[2]
+
+#: the make target that writes each committed result
+TARGET = {"results/threshold/fit.json": "make threshold", "results/vr/fit.json": "make vr",
+          "results/fig3/fig3.json": "make fig3", "results/aconv/aconv.json": "make figures"}
+
+
+def test_every_committed_result_has_a_target():
+    assert set(TARGET) == set(ec.COMMITTED)
+
+
+@pytest.mark.parametrize("path", ec.COMMITTED)
+def test_committed_result_is_what_main_computes(path):
+    doc = json.loads((ROOT / path).read_text())
+    check = doc.get("engine_check")
+    assert check and check["rows"], f"{path} records no engine_check: run {TARGET[path]}"
+    prov = doc["provenance"]
+    cfg = ec.config_for(prov["config_name"], ROOT / "configs")
+    assert cfg is not None, f"{path}: no config named {prov['config_name']!r} in configs/"
+    assert cfg.config_hash == prov["config_hash"], (
+        f"{path}: its config {prov['config_name']!r} now gives other scenes or numerics than "
+        f"the result was computed with: run {TARGET[path]}")
+    assert cfg.numerics.to_dict() == check["numerics"], path
+    computed = ec.rerun(check)
+    diffs = ec.differences(check["rows"], computed)
+    assert not diffs, (f"{path}: main computes other numbers than the committed result "
+                       f"(run {TARGET[path]}):\n" + "\n".join(diffs))
+
+
+def _rows(statuses, pull_offs, speeds=None):
+    speeds = speeds or [1.0] * len(pull_offs)
+    return [{"scene": {"n": 0.4 + i}, "status": s, "pull_off": p, "crack_speed": v}
+            for i, (s, p, v) in enumerate(zip(statuses, pull_offs, speeds))]
+
+
+def test_differences_within_and_beyond_the_tolerances():
+    rec = _rows(["ok", "ok", "failed"], [2.0, 3.0, None], [1.0, 5.0, None])
+    assert ec.differences(rec, _rows(["ok", "ok", "failed"], [2.0 * (1 + 5e-6), 3.0, None],
+                                     [1.0, 5.0 * (1 + 5e-4), None])) == []
+    lines = ec.differences(rec, _rows(["ok", "ok", "ok"], [2.0 * (1 + 2e-5), 3.0, 1.0],
+                                      [1.0, 5.0 * (1 + 2e-3), 1.0]))
+    assert len(lines) == 3
+    assert "pull-off" in lines[0] and "crack speed" in lines[1]
+    assert "status ok (committed failed)" in lines[2]
+
+
+def test_the_sample_is_cheap_spread_and_keeps_failed_rows():
+    n = 40
+    df = pd.DataFrame({"scene_id": [f"{i:04x}" for i in range(n)][::-1],
+                       "status": ["failed" if i % 10 == 3 else "ok" for i in range(n)],
+                       "wall_s": [float(i) for i in range(n)]})
+    picks = ec.sample_rows(df, size=5, failed=2)
+    shuffled = df.sample(frac=1.0, random_state=1).reset_index(drop=True)
+    again = ec.sample_rows(shuffled, size=5, failed=2)          # the same scenes, any order
+    assert [df.scene_id[i] for i in picks] == [shuffled.scene_id[i] for i in again]
+    ok, bad = picks[:5], picks[5:]
+    assert len(set(ok)) == 5 and all(df.status[i] == "ok" for i in ok)
+    median = df.wall_s[df.status == "ok"].median()
+    assert all(df.wall_s[i] <= median for i in ok)
+    assert len(bad) == 2 and all(df.status[i] == "failed" for i in bad)
