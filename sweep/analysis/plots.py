@@ -285,8 +285,8 @@ def sweep_figure(df, title: str = "", trajectory=None):
                     ax.plot(g[lay.x], g["pull_off"], ls=ls, marker=marker, ms=3, lw=1.1,
                             color=colour_of[str(ckey)])
         _mark_failed(ax, sub, lay.x)
-        ax.set_title(", ".join(_text(a, v) for a, v in zip(lay.panels, key))
-                     + _fixed_text(sub, lay.fixed), fontsize=8)
+        ax.set_title(", ".join([_text(a, v) for a, v in zip(lay.panels, key)]
+                               + _fixed_text(sub, lay.fixed)), fontsize=8)
         ax.set_xscale("log" if lay.x == "rate" or _log_scale(df[lay.x]) else "linear")
         # axis labels on the grid's outer panels (x ticks below the lowest panel of each
         # column; each panel keeps its y ticks: the panels of different k differ in range)
@@ -345,10 +345,10 @@ def _missing(value) -> bool:
     return value is None or (isinstance(value, float) and math.isnan(value))
 
 
-def _fixed_text(sub, fixed: tuple) -> str:
-    """``, a0 = 11`` for each axis fixed by the others that is constant in the panel."""
-    parts = [_text(a, sub[a].iloc[0]) for a in fixed if len(sub) and sub[a].nunique() == 1]
-    return (", " if parts else "") + ", ".join(parts)
+def _fixed_text(sub, fixed: tuple) -> list:
+    """``a0 = 11`` for each axis fixed by the others that has one value in the panel."""
+    return [_text(a, sub[a].iloc[0]) for a in fixed
+            if len(sub) and sub[a].nunique(dropna=False) == 1 and not _missing(sub[a].iloc[0])]
 
 
 def _line(colour, ls, marker):

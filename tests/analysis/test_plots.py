@@ -12,11 +12,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from sweep.analysis.plots import (JKR_PULL_OFF, mark_failed, plot_layout, pyplot,
-                                  sweep_figure)
+from sweep.analysis.plots import (JKR_PULL_OFF, mark_failed, plot_layout, plot_sweep,
+                                  pyplot, sweep_figure)
 from sweep.campaign.config import load_config
 from sweep.campaign.scheduler import run_sweep
-from sweep.campaign.store import load
+from sweep.campaign.store import load, load_trajectory
 from sweep.cli import main
 from sweep.scene import Result
 from sweep.theory import jkr_load
@@ -181,3 +181,20 @@ def test_every_campaign_renders_without_warning(config):
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert (f"failed ({n_failed})" in labels) == (n_failed > 0)
     pyplot().close(fig)
+
+
+def test_an_older_results_file_plots(tmp_path):
+    """tests/data/results_v1.h5 (visco-sweep 0.1.0: a0 and delta0 scenes, mpl and sls, with
+    trajectories) plots without warning; no title names a missing value."""
+    v1 = Path(__file__).resolve().parents[1] / "data" / "results_v1.h5"
+    df = load(v1)
+    lay = plot_layout(df)
+    assert (lay.colour, lay.styles) == ("n", ("material",))
+    fig = render(df, lambda sid: load_trajectory(v1, sid))
+    assert_legend_outside_the_data_inside_the_figure(fig)
+    assert not [ax.get_title() for ax in all_axes(fig) if "nan" in ax.get_title()]
+    pyplot().close(fig)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        png = plot_sweep(v1, tmp_path / "v1.png")
+    assert png.read_bytes()[:4] == b"\x89PNG"
