@@ -8,14 +8,17 @@ from a results frame (:func:`sweep.load`).
 A campaign varies several axes at once (the threshold campaign: n, a0 and the rate, 936
 scenes), so one line per group in a colour cycle does not read. :func:`plot_layout` gives each
 varying axis one role: the abscissa (the rate, or the numeric axis with the most values when
-the rate is fixed); the colour (the numeric axis with the most values, on a colour bar with
-one colour per value; a categorical axis such as the model gets a legend instead); the panels
-(up to two further axes, a panel per combination); line styles for any axis left that still
-splits the lines. An axis fixed by the others (a0 by k in configs/v_vs_r.yaml) splits nothing
+the rate is fixed); the colour (the numeric axis with the most values, on a colour bar with a
+labelled band per value, or a continuous scale beyond :data:`BANDS_MAX` values; a categorical
+axis such as the model gets legend entries instead); the panels (up to two further axes: a
+row of panels, or rows x columns); line styles for a category or any axis left that still
+splits the lines. A number fixed by the others (a0 by k in configs/v_vs_r.yaml) splits nothing
 and is named in the panel titles. The legend sits below the panels, outside every plot; the
-reference lines (JKR's relaxed pull-off 1.5, and the glassy 1.5/k where the data reach
-towards it) lie inside the plotted range, drawn black and dashed, and are labelled. Failed
-scenes are red crosses, at the bottom edge when they have no pull-off (never dropped).
+reference lines (JKR's relaxed pull-off 1.5 dashed, and the glassy 1.5/k dotted where the
+data reach half of it) lie inside the plotted range, in black, and are labelled. Panels of one
+k share their y range; pull-offs over :data:`LOG_PULL_OFF` times apart are drawn on a
+logarithmic axis. Failed scenes are red crosses, at the bottom edge when they have no
+pull-off (never dropped).
 """
 from __future__ import annotations
 
