@@ -13,6 +13,7 @@ the ``reproduce`` group (:mod:`sweep.paper.reproduce`) is imported when it is in
 """
 from __future__ import annotations
 
+import inspect
 import json
 import math
 import shlex
@@ -26,6 +27,7 @@ from click.core import ParameterSource
 
 from .errors import (InputError, as_float, check_array, check_choice, check_int, check_positive,
                      check_range)
+from ._version import __version__
 from .scene import AXES, PRESETS, REFINEMENTS_ON_REQUEST, Numerics, Scene
 
 #: exit code of ``sweep run`` when scenes hit an internal error (the sweep itself finished)
@@ -83,7 +85,9 @@ class LazyGroup(click.Group):
              lazy={"reproduce": ("sweep.paper.reproduce:cli",
                                  "Fits, figures and the report of the paper's campaigns (called "
                                  "by the Makefile).")})
-@click.version_option(package_name="visco-sweep")
+# the source's version, not the installed metadata (which an editable install keeps at the
+# version it was installed with)
+@click.version_option(__version__, prog_name="sweep")
 def cli():
     """Viscoelastic adhesive contact of a sphere: BEM scenes, sweeps and theory."""
 
@@ -288,20 +292,9 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, exact, as_json, tr
     else:
         click.echo(f"scene      n={sc.n:g} k={sc.k:g} mu={sc.mu:g} rate={sc.rate:g} "
                    f"{'a0=' + format(sc.a0, 'g') if sc.a0 is not None else 'delta0=' + format(sc.delta0, 'g')}"
-                   f" material={sc.material}")
-        click.echo(f"numerics   preset={preset} mesh={num.mesh} nodes={res.nodes_used} spacing={res.spacing:.4g} "
-                   f"domain={res.domain_used:.4g} prony_terms={res.prony_terms}")
-        click.echo(f"status     {res.status}{' (' + res.reason + ')' if res.reason else ''}")
-        click.echo(f"model      {res.model_used}")
-        click.echo(f"initial    a0={res.a0_result:.6g} a0_inner={res.a0_inner:.6g} "
-                   f"delta0={res.delta0_result:.6g}")
-        if res.ok:
-            click.echo(f"pull-off   P={res.pull_off:.6g} (pi dg R)  a={res.a_pulloff:.6g}  "
-                       f"a_inner={res.a_inner_pulloff:.6g}  delta={res.delta_pulloff:.6g}")
-            click.echo(f"crack      v_a={res.crack_speed:.6g} (a_ref/tau0)  vhat={res.vhat:.6g}  "
-                       f"rhat_pb={res.rhat_pb:.6g}")
-        click.echo(f"cost       steps={res.steps} newton={res.newton_iterations} "
-                   f"factorizations={res.factorizations} wall={res.wall_s:.3f} s")
+                   f" material={sc.material} model={sc.model}")
+        for line in scene_text(res, preset):
+            click.echo(line)
     if not res.ok:
         raise SystemExit(1)
 
@@ -318,6 +311,76 @@ def _scene_numerics(preset: str, pull_off_rtol: str | None, overrides: dict) -> 
         return Numerics.preset(preset, pull_off_rtol=rtol, refinements=REFINEMENTS_ON_REQUEST,
                                **overrides)
     return Numerics.for_tolerance(rtol, **overrides)
+
+
+def _finite(**values) -> str:
+    """``name=value`` (6 significant digits) for each finite value, space separated: the
+    fields a model does not compute (NaN) are left out."""
+    return "  ".join(f"{name}={v:.6g}" for name, v in values.items() if math.isfinite(v))
+
+
+def scene_numerics(res, preset: str) -> tuple[str, str]:
+    """The numerics and the cost of ``res`` in the terms of the model that ran it.
+
+    bem: the mesh (graded, uniform or tip-following), its nodes, fine spacing and radius,
+    the Prony terms; elastic: the quasi-static branch's mesh; crack: the Radau integration
+    of the crack front with the Persson-Brener Gamma(v) of the scene's spectrum (or the
+    nearly elastic closed form); pb: the paper's closed-form estimate, which has none.
+    """
+    from .engine import crack_front
+    from .engine.models import pb_estimate, wants_tip_following
+
+    sc, num = res.scene, res.numerics
+    model = res.model_used or sc.model
+    wall = f"wall={res.wall_s:.3f} s"
+    if model == "pb":
+        fit = inspect.signature(pb_estimate).parameters
+        return (f"PB estimate, closed form: vhat = {fit['prefactor'].default:g} "
+                f"rhat_PB^{fit['exponent'].default:g} (the paper's fit), P = 1.5 "
+                f"Gamma_PB(vhat) of the {sc.material} spectrum; no mesh, no time steps",
+                wall)
+    if model == "crack":
+        cost = (f"steps={res.steps} rhs_evaluations={res.newton_iterations} "
+                f"lu={res.factorizations} {wall}")
+        if 1.0 / sc.k - 1.0 <= crack_front.NEARLY_ELASTIC * (1.0 + 1e-12):
+            return (f"crack-front model, nearly elastic (1/k - 1 = {1.0 / sc.k - 1.0:.3g} <= "
+                    f"{crack_front.NEARLY_ELASTIC:g}): JKR at constant Gamma = "
+                    f"{1.0 / math.sqrt(sc.k):.6g} dg, closed form", wall)
+        budget = f" time_budget={num.time_budget_s:g} s" if num.time_budget_s > 0 else ""
+        return (f"crack-front model: Radau integration rtol="
+                f"{crack_front.unload.__kwdefaults__['rtol']:g}, Persson-Brener Gamma(v) of "
+                f"the {sc.material} spectrum (no mesh){budget}", cost)
+    nodes = f"nodes={res.nodes_used} spacing={res.spacing:.4g} domain={res.domain_used:.4g}"
+    if model == "elastic":
+        return (f"elastic branch, quasi-static (k = 1, no hereditary integral): "
+                f"preset={preset} {nodes}",
+                f"solves={res.steps} newton={res.newton_iterations} {wall}")
+    mesh = "tip-following" if wants_tip_following(sc, num) else num.mesh
+    return (f"BEM: preset={preset} mesh={mesh} {nodes} prony_terms={res.prony_terms}",
+            f"steps={res.steps} newton={res.newton_iterations} "
+            f"factorizations={res.factorizations} {wall}")
+
+
+def scene_text(res, preset: str) -> list[str]:
+    """The lines of ``sweep scene``'s text output after the scene line: the model's own
+    numerics, the status, the model, the initial state, pull-off and crack speed (the fields
+    the model computes) and the cost."""
+    numerics, cost = scene_numerics(res, preset)
+    why = f"  ({res.model_reason})" if res.model_used != res.scene.model else ""  # auto
+    lines = [f"numerics   {numerics}",
+             f"status     {res.status}{' (' + res.reason + ')' if res.reason else ''}",
+             f"model      {res.model_used}{why}"]
+    initial = _finite(a0=res.a0_result, a0_inner=res.a0_inner, delta0=res.delta0_result)
+    if initial:
+        lines.append(f"initial    {initial}")
+    if res.ok:
+        lines.append(f"pull-off   P={res.pull_off:.6g} (pi dg R)  " + _finite(
+            a=res.a_pulloff, a_inner=res.a_inner_pulloff, delta=res.delta_pulloff,
+            error_estimate=res.error_estimate))
+        lines.append(f"crack      v_a={res.crack_speed:.6g} (a_ref/tau0)  "
+                     + _finite(vhat=res.vhat, rhat_pb=res.rhat_pb))
+    lines.append(f"cost       {cost}")
+    return lines
 
 
 def _scene_si(axes, as_json, values):

@@ -35,6 +35,44 @@ def test_scene_trajectory_and_text_output(capsys):
     assert main(SCENE) == 0
     text = capsys.readouterr().out
     assert "pull-off" in text and "crack" in text
+    numerics = _line(text, "numerics")
+    assert numerics.startswith("numerics   BEM: preset=fast mesh=graded nodes=")
+    assert "nodes=0 " not in numerics and "nan" not in numerics
+    assert "factorizations=" in _line(text, "cost")
+
+
+def _line(text: str, head: str) -> str:
+    """The line of ``sweep scene``'s text output that starts with ``head``."""
+    lines = [ln for ln in text.splitlines() if ln.startswith(head)]
+    assert len(lines) == 1, text
+    return lines[0]
+
+
+# each model shows its own numerics (issue 34 item 7): none of the BEM's mesh fields, no NaN
+@pytest.mark.parametrize("model, k, numerics, cost", [
+    ("crack", "0.1", "crack-front model: Radau integration rtol=", "steps="),
+    ("crack", "0.99", "crack-front model, nearly elastic (1/k - 1 = 0.0101 <= 0.05): JKR at "
+                      "constant Gamma = 1.00504 dg, closed form", "wall="),
+    ("pb", "0.1", "PB estimate, closed form: vhat = 2.887 rhat_PB^1.171", "wall="),
+])
+def test_scene_text_shows_the_models_own_numerics(model, k, numerics, cost, capsys):
+    assert main(["scene", "--model", model, "--n", "0.8", "--k", k, "--a0", "3",
+                 "--rate", "10"]) == 0
+    text = capsys.readouterr().out
+    assert _line(text, "numerics").startswith("numerics   " + numerics)
+    assert _line(text, "model").split() == ["model", model]
+    assert "mesh=" not in text and "nodes=" not in text and "nan" not in text
+    assert _line(text, "cost").startswith("cost       " + cost)   # closed forms: no steps
+    assert ("initial" in text) == (model != "pb")       # the estimate has no initial state
+
+
+def test_scene_text_says_why_auto_chose_its_model(capsys):
+    # mu = 200 is beyond the BEM's range: auto runs the crack-front model and says so
+    assert main(["scene", "--model", "auto", "--n", "0.8", "--a0", "3", "--mu", "200",
+                 "--rate", "10"]) == 0
+    text = capsys.readouterr().out
+    assert _line(text, "model").startswith("model      crack  (auto: crack-front model")
+    assert "Radau" in _line(text, "numerics")
 
 
 @pytest.mark.parametrize("args, name", [

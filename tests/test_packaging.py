@@ -47,3 +47,28 @@ def test_the_package_data_is_declared():
     for path in (ROOT / "sweep").rglob("*.json"):
         pkg = ".".join(path.parent.relative_to(ROOT).parts)
         assert re.search(rf'^"{re.escape(pkg)}"\s*=\s*\[[^\]]*"{path.name}"', text, re.M), path
+
+
+def test_one_version_everywhere_and_sweep_version_prints_it():
+    """pyproject, sweep.__version__, ``sweep --version`` (the source's, not the installed
+    metadata's), CITATION.cff and the CHANGELOG's latest release name the same version."""
+    from click.testing import CliRunner
+
+    from sweep import __version__
+    from sweep.cli import cli
+
+    assert re.search(r'^version = "([^"]+)"', (ROOT / "pyproject.toml").read_text(),
+                     re.M).group(1) == __version__
+    out = CliRunner().invoke(cli, ["--version"])
+    assert out.exit_code == 0 and out.output.strip() == f"sweep, version {__version__}"
+    cff = (ROOT / "CITATION.cff").read_text()
+    assert re.search(r"^version: \"?([\w.]+)\"?$", cff, re.M).group(1) == __version__
+    releases = re.findall(r"^## \[?([0-9][\w.]*)\]?", (ROOT / "CHANGELOG.md").read_text(), re.M)
+    assert releases and releases[0] == __version__
+
+
+def test_the_license_file_is_the_license_pyproject_names():
+    assert 'license = {text = "MIT"}' in (ROOT / "pyproject.toml").read_text()
+    text = (ROOT / "LICENSE").read_text()
+    assert text.startswith("MIT License") and "the visco-sweep developers" in text
+    assert "THE SOFTWARE IS PROVIDED \"AS IS\"" in text

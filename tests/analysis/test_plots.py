@@ -1,11 +1,27 @@
-"""`sweep plot`: failed scenes are marked, never dropped silently."""
+"""`sweep plot`: failed scenes are marked, never dropped silently; the figure of every campaign
+in configs/ reads at a glance (issue 34 item 6): no matplotlib warning, the legend outside the
+panels and inside the figure, the colour on one axis, the reference lines inside the range."""
 from __future__ import annotations
 
-from sweep.analysis.plots import mark_failed, pyplot
+import io
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from sweep.analysis.plots import (JKR_PULL_OFF, mark_failed, plot_layout, plot_sweep,
+                                  pyplot, sweep_figure)
+from sweep.campaign.config import load_config
 from sweep.campaign.scheduler import run_sweep
-from sweep.campaign.store import load
+from sweep.campaign.store import load, load_trajectory
 from sweep.cli import main
 from sweep.scene import Result
+from sweep.theory import jkr_load
+
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 CFG = {"name": "p", "grid": {"n": [0.4, 0.8], "rate": [1, 10, 100], "a0": 2.0},
        "numerics": {"preset": "fast", "nodes": 60}}
@@ -50,3 +66,135 @@ def test_no_failures_nothing_marked(tmp_path):
 
 def _ok(scene, numerics):
     return Result(scene=scene, numerics=numerics, status="ok", pull_off=2.0)
+
+
+# ------------------------------------------------------------------ figures that read
+
+def synthetic_frame(config: Path) -> pd.DataFrame:
+    """A results frame with the scenes of ``config`` (its axes, as :func:`sweep.load` gives
+    them) and synthetic pull-offs of the right shape: 1.5 at slow unloading, rising with the
+    rate towards 1.5/k, less for small a0; every 37th scene failed (alternately with and
+    without a pull-off)."""
+    rows = []
+    for i, (sid, sc) in enumerate(load_config(config).tasks()):
+        a0 = sc.a0 if sc.a0 is not None else 1.0 + math.sqrt(max(sc.delta0, 0.0))
+        reach = 1.0 - math.exp(-(a0 / 3.0) ** 2)
+        rise = sc.rate ** 0.4 / (sc.rate ** 0.4 + 10.0)
+        po = 1.5 + (1.5 / sc.k - 1.5) * reach * rise * (0.7 + 0.2 * min(sc.n, 1.5))
+        status = "failed" if i % 37 == 36 else "ok"
+        rows.append({"scene_id": sid, **sc.to_dict(), "status": status,
+                     "pull_off": po if status == "ok" or i % 74 == 36 else math.nan,
+                     "a0_result": a0})
+    return pd.DataFrame(rows)
+
+
+def synthetic_trajectory(scene_id: str) -> dict:
+    a = np.linspace(2.5, 1.0, 40)
+    return {"a": a, "P": jkr_load(a) - 2.0 * (2.5 - a)}
+
+
+def render(df, trajectory=None):
+    """The figure of ``df``, drawn and saved with every warning an error; returns it."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = sweep_figure(df, "synthetic", trajectory)
+        fig.savefig(io.BytesIO(), format="png", dpi=50)     # lays the figure out
+    return fig
+
+
+def all_axes(fig) -> list:
+    """The visible axes of ``fig`` and of its subfigures (panels and colour bars)."""
+    found = list(fig.axes)
+    for sub in fig.subfigs:
+        found += all_axes(sub)
+    return [ax for ax in found if ax.get_visible()]
+
+
+def assert_legend_outside_the_data_inside_the_figure(fig):
+    renderer = fig.canvas.get_renderer()
+    (legend,) = fig.legends
+    box = legend.get_window_extent(renderer)
+    page = fig.bbox
+    assert page.x0 <= box.x0 and box.x1 <= page.x1 and page.y0 <= box.y0 and box.y1 <= page.y1
+    for ax in all_axes(fig):
+        assert not box.overlaps(ax.get_window_extent(renderer)), ax.get_title()
+
+
+def reference_lines(ax) -> list:
+    """The horizontal reference lines of a pull-off panel (axhline: black, dashed or dotted)."""
+    return [ln for ln in ax.get_lines() if ln.get_color() == "black"
+            and len(set(ln.get_ydata())) == 1 and ln.get_linestyle() in ("--", ":")]
+
+
+def test_the_threshold_campaign_reads_at_a_glance():
+    """936 scenes over n, a0 and rate: a panel per n, a0 on a colour bar, so each panel has
+    18 lines (one per a0) instead of 72 series in a 10-colour cycle on one plot."""
+    df = synthetic_frame(CONFIGS / "threshold.yaml")
+    assert len(df) == 936
+    lay = plot_layout(df)
+    assert (lay.x, lay.colour, lay.panels, lay.styles) == ("rate", "a0", ("n",), ())
+    fig = render(df)
+    assert_legend_outside_the_data_inside_the_figure(fig)
+    panels = [ax for ax in all_axes(fig) if ax.get_title().startswith("n = ")]
+    assert sorted(ax.get_title() for ax in panels) == [f"n = {n}" for n in
+                                                        ("0.4", "0.6", "0.8", "1.6")]
+    for ax in panels:
+        data = [ln for ln in ax.get_lines() if ln.get_marker() == "o"]
+        assert len(data) == 18                           # one line per a0
+        assert len({ln.get_color() for ln in data}) == 18
+    (bar,) = [ax for ax in all_axes(fig) if ax not in panels]
+    assert len(bar.get_yticklabels()) == 18 and bar.get_ylabel() == r"$\hat a_0$"
+    pyplot().close(fig)
+
+
+@pytest.mark.parametrize("name", ["threshold.yaml", "demo.yaml"])
+def test_the_reference_lines_lie_inside_the_plotted_range(name):
+    """The JKR line at 1.5 sits inside the y range with a margin, not on the frame (the demo
+    figure's pull-offs all lie above 1.5), and is named in the legend."""
+    df = synthetic_frame(CONFIGS / name)
+    assert df["pull_off"].min() > JKR_PULL_OFF
+    fig = render(df, synthetic_trajectory if load_config(CONFIGS / name).trajectories else None)
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert [x for x in labels if x.startswith("JKR relaxed") and "pull-off" in x and "1.5" in x]
+    panels = [ax for ax in all_axes(fig) if reference_lines(ax)]
+    assert panels
+    for ax in panels:
+        lo, hi = ax.get_ylim()
+        for line in reference_lines(ax):
+            y = line.get_ydata()[0]
+            assert lo + 0.02 * (hi - lo) < y < hi - 0.02 * (hi - lo), (y, lo, hi)
+    pyplot().close(fig)
+
+
+#: every sweep config in configs/ (configs/calibrate/ holds calibration configs, no sweeps)
+SWEEP_CONFIGS = [p for folder in ("", "quick/", "random/")
+                 for p in sorted(CONFIGS.glob(folder + "*.yaml"))]
+
+
+@pytest.mark.parametrize("config", SWEEP_CONFIGS, ids=lambda p: str(p.relative_to(CONFIGS)))
+def test_every_campaign_renders_without_warning(config):
+    cfg = load_config(config)
+    df = synthetic_frame(config)
+    fig = render(df, synthetic_trajectory if cfg.trajectories else None)
+    assert_legend_outside_the_data_inside_the_figure(fig)
+    n_failed = int((df["status"] != "ok").sum())
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert (f"failed ({n_failed})" in labels) == (n_failed > 0)
+    pyplot().close(fig)
+
+
+def test_an_older_results_file_plots(tmp_path):
+    """tests/data/results_v1.h5 (visco-sweep 0.1.0: a0 and delta0 scenes, mpl and sls, with
+    trajectories) plots without warning; no title names a missing value."""
+    v1 = Path(__file__).resolve().parents[1] / "data" / "results_v1.h5"
+    df = load(v1)
+    lay = plot_layout(df)
+    assert (lay.colour, lay.styles) == ("n", ("material",))
+    fig = render(df, lambda sid: load_trajectory(v1, sid))
+    assert_legend_outside_the_data_inside_the_figure(fig)
+    assert not [ax.get_title() for ax in all_axes(fig) if "nan" in ax.get_title()]
+    pyplot().close(fig)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        png = plot_sweep(v1, tmp_path / "v1.png")
+    assert png.read_bytes()[:4] == b"\x89PNG"
