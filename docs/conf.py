@@ -52,7 +52,7 @@ myst_heading_anchors = 3
 # -- API reference (numpy-style docstrings through napoleon) ------------------------------------
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"          # the docstrings state types with their units
-autodoc_default_options = {"members": True, "show-inheritance": False}
+autodoc_default_options = {"members": True}
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 napoleon_use_rtype = False

@@ -21,6 +21,12 @@ res = simulate(Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=10**2.5), Numerics.pre
 print(res.status, f"pull-off {res.pull_off:.4f} at a = {res.a_pulloff:.3f}, "
       f"error estimate {res.error_estimate:.1e}")
 
+# %%
+# The trajectory holds the unloading curve: time ``t``, indentation ``delta``, load ``P``
+# and the contact radius ``a``. Against the radius, the unloading curve leaves the relaxed
+# JKR curve: the material stiffens as the crack runs faster, so the contact holds to a far
+# larger tension.
+
 tr = res.trajectory
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9, 3.6), layout="constrained")
 ax1.plot(tr["delta"], tr["P"], color="C0")

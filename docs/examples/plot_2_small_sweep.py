@@ -27,11 +27,18 @@ config = {
 }
 sweep.run_sweep(config, jobs=1, progress="none")
 
+# %%
+# One row per scene: the scene's axes, the status, the pull-off with its error estimate, the
+# crack speed, the model that answered and the numerics (:doc:`/results` lists every column).
+
 df = sweep.load(out)
-print(df[["n", "rate", "status", "pull_off", "error_estimate", "crack_speed"]])
+print(df.sort_values(["n", "rate"])[["n", "rate", "status", "pull_off", "error_estimate"]])
+
+# %%
+# Pandas does the rest: here one curve per exponent.
 
 fig, ax = plt.subplots(figsize=(5.5, 3.8), layout="constrained")
-for n, rows in df.groupby("n"):
+for n, rows in df.sort_values("rate").groupby("n"):
     ax.plot(rows["rate"], rows["pull_off"], "o-", label=f"n = {n:g}")
 ax.set(xscale="log", xlabel="unloading rate r-hat", ylabel="pull-off [pi dg R]",
        title="k = 0.1, mu = 3.24, a0 = 2.5 (fast preset)")

@@ -21,9 +21,17 @@ root = Path(sweep.__file__).resolve().parents[1]
 out = Path(tempfile.mkdtemp()) / "threshold.h5"
 sweep.run_sweep(root / "configs" / "quick" / "threshold.yaml", out=out, jobs=2,
                 progress="none")
+# %%
+# The threshold per (n, rate): the first a0 whose local slope of the pull-off falls below
+# 0.1, from a spline through the points (the paper's rule).
+
 df = sweep.load(out)
 table = fits.threshold_table(df)
 print(table)
+
+# %%
+# The pull-off against a0 per (n, rate), the threshold dotted. The full campaign's collapse
+# P_po = A a0t^B is ``sweep fit threshold``.
 
 fig, ax = plt.subplots(figsize=(6, 4), layout="constrained")
 for i, ((n, rate), rows) in enumerate(df.groupby(["n", "rate"])):

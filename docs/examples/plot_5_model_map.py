@@ -38,6 +38,9 @@ by_tol = np.array([[code(model_choice(Scene(n=0.8, k=0.1, mu=mu, a0=3.0, rate=1e
                                       Numerics.preset("balanced", pull_off_rtol=tol)))
                     for mu in mus] for tol in tols])
 
+# %%
+# Draw both maps with one colour per choice.
+
 cmap = ListedColormap(["C1", "C0", "C3", "C4"])
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8), layout="constrained")
 ax1.pcolormesh(mus, a0s, by_a0, cmap=cmap, vmin=-0.5, vmax=3.5, shading="nearest")

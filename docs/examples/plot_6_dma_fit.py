@@ -25,10 +25,14 @@ fit = fit_mpl(data)
 truth = {"E0": 1.458e6, "Einf": 3.089e9, "n": 0.2207, "tau0": 0.01876}
 for name, true in truth.items():
     value, err = getattr(fit, name), fit.stderr[name]
-    print(f"{name:5s} {value:.5g} +- {err:.2g} (truth {true:g}, {abs(value - true) / err:.1f} sigma)")
+    print(f"{name:5s} {value:.5g} +- {err:.2g} (truth {true:g}, "
+          f"{abs(value - true) / err:.1f} sigma)")
 kk = kramers_kronig_check(data, noise=0.02)
 print(f"Kramers-Kronig: rms {kk.rms_modulus:.3f} of |E*| against the tolerance "
       f"{kk.threshold:.3f}: {'consistent' if kk.consistent else 'INCONSISTENT'}")
+
+# %%
+# The fitted model against the data over the whole range.
 
 w = np.logspace(np.log10(data.omega.min()), np.log10(data.omega.max()), 300)
 E = MPLRetardation(E0=fit.E0, Einf=fit.Einf, n=fit.n, tau0=fit.tau0).complex_modulus(w)

@@ -17,16 +17,22 @@ from sweep.campaign.si import SIScene, run_si
 
 pdms = dict(R=5.19e-3, E0=1.458e6, Einf=3.089e9, nu=0.5, n=0.2207, tau0=0.01876,
             dg=0.1523, h0=30.8e-9, preload=1.5e-3)
-speeds = np.logspace(-6, -2, 9)
+speeds = np.logspace(-6, -2, 9)                       # 1 um/s .. 1 cm/s
+rows = {model: [run_si(SIScene(speed=v, **pdms), model=model) for v in speeds]
+        for model in ("crack", "pb")}
+first = rows["crack"][0]
+print(f"mu = {first['mu']:.0f}, l0 = {1e9 * first['l0_m']:.0f} nm")
+for model, results in rows.items():
+    print(f"{model:5s} pull-off [mN]:", " ".join(f"{1e3 * r['pull_off_N']:.1f}" for r in results))
+
+# %%
+# The relaxed elastic (JKR) pull-off of the same lens, 1.5 pi dg R in SI, is the slow limit.
+
+jkr = 1e3 * first["jkr_pull_off_N"]
 fig, ax = plt.subplots(figsize=(6, 4), layout="constrained")
-for model, style in [("crack", "o-"), ("pb", "s--")]:
-    rows = [run_si(SIScene(speed=v, **pdms), model=model) for v in speeds]
-    pull = [1e3 * r["pull_off_N"] for r in rows]
-    ax.plot(1e6 * speeds, pull, style, label={"crack": "crack-front model",
-                                              "pb": "Persson-Brener estimate"}[model])
-    print(model, f"mu = {rows[0]['mu']:.0f}, l0 = {1e9 * rows[0]['l0_m']:.0f} nm,",
-          "pull-off [mN]:", " ".join(f"{p:.1f}" for p in pull))
-jkr = 1e3 * rows[0]["jkr_pull_off_N"]
+for model, style, label in [("crack", "o-", "crack-front model"),
+                            ("pb", "s--", "Persson-Brener estimate")]:
+    ax.plot(1e6 * speeds, [1e3 * r["pull_off_N"] for r in rows[model]], style, label=label)
 ax.axhline(jkr, color="0.3", ls=":", lw=1.5, label=f"JKR, relaxed: {jkr:.2f} mN")
 ax.set(xscale="log", yscale="log", xlabel="unloading speed [um/s]", ylabel="pull-off [mN]",
        title="glass lens on PDMS, 1.5 mN preload")
