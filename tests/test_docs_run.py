@@ -145,6 +145,7 @@ def test_speed_page_bench_table_is_results_bench_json():
     """docs/speed.md's `make bench` table quotes results/bench.json (the committed run)."""
     bench = json.loads((ROOT / "results" / "bench.json").read_text())
     text = _page("docs/speed.md")
+    assert f"`wall_s` = {bench['wall_s']:.0f} s in the committed `results/bench.json`" in text
     som = bench["step_over_matvec"]
     assert f"{som['500']:.3g}" in text                                      # 4.35
     assert f"| `compile_s` cold / cached | {bench['compile_s']['cold']:.0f} s" in text
