@@ -1,4 +1,4 @@
-"""The docs run (issue 25 item 4): every block and command of README.md and docs/*.md, in the
+"""The docs run (issue 25 item 4): every block and command of README.md and docs/**.md, in the
 quick form of tests/docs_check.py (``make docs-check`` runs the full form), and the runner's own
 rules: unmarked blocks it cannot run fail, markers are visible, the table names only commands
 the docs still give."""
