@@ -12,11 +12,12 @@ export NUMBA_NUM_THREADS ?= 1
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
         tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem \
         agreement agreement-high-mu extremes tip-convergence elastic-table calibrate-demo \
-        model-errors error-coverage crack-speed random-sample docs-check
+        model-errors error-coverage crack-speed random-sample docs-check docs
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
 	@echo "make test   - create/update .venv and run the test suite"
+	@echo "make docs   - build the site into docs/_build/html (warnings are errors; runs the gallery)"
 	@echo "make docs-check [QUICK=1] - run every command and snippet of README.md and docs/"
 	@echo "               (QUICK=1: the quick form that make test runs, tests/test_docs_run.py)"
 	@echo "make bench  - speed benchmarks of issues 9 and 24 (results/bench.json, ~5 min)"
@@ -46,6 +47,12 @@ $(STAMP): pyproject.toml constraints.txt | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -c constraints.txt -e ".[plot,cluster,test]"
 	@touch $(STAMP)
 
+# the site's own packages (the docs extra), only for `make docs`: `make test` never waits for them
+DOCS_STAMP := $(VENV)/.installed-docs
+$(DOCS_STAMP): pyproject.toml constraints.txt | $(STAMP)
+	$(BIN)/python -m pip install --quiet -c constraints.txt -e ".[plot,cluster,test,docs]"
+	@touch $(DOCS_STAMP)
+
 venv: $(STAMP)
 
 demo: $(STAMP)
@@ -62,6 +69,16 @@ test: $(STAMP)
 
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow tests
+
+# issue 34: the documentation site (docs/conf.py): the Markdown pages of docs/, the API
+# reference from the docstrings, the CLI reference from the click commands and the gallery
+# of docs/examples/, each example executed (sphinx-gallery skips one unchanged since the last
+# build). -W: a warning fails the build (Sphinx reports them all, then exits 1); -E: every
+# page is read again, so a warning is never hidden by an earlier build. Offline: no
+# intersphinx, no link check. .ci/run runs it after make test.
+docs: $(DOCS_STAMP)
+	$(BIN)/python -m sphinx -W -E -b html docs docs/_build/html
+	@echo "site: docs/_build/html/index.html"
 
 # issue 25: every shell command and Python snippet of README.md and docs/*.md runs
 # (tests/docs_check.py: what runs as written, what maps to a quick equivalent and why, the

@@ -1,4 +1,4 @@
-"""Run the commands and snippets of README.md and docs/*.md (issue 25 item 4, "Docs that run").
+"""Run the commands and snippets of README.md and the site's Markdown pages (issue 25 item 4).
 
 Usage::
 
@@ -58,8 +58,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-PAGES = ("README.md", "docs/cluster.md", "docs/configs.md", "docs/design.md",
-         "docs/performance.md", "docs/results.md")
+# every Markdown page: the README and the site's pages (docs/, recursively; the site's own
+# build folders are generated, not pages)
+PAGES = ("README.md", "docs/getting-started.md", "docs/units.md", "docs/scenes.md",
+         "docs/models.md", "docs/numerics.md", "docs/sweeps.md", "docs/configs.md",
+         "docs/results.md", "docs/si.md", "docs/cluster.md", "docs/calibration.md",
+         "docs/reproducing.md", "docs/speed.md", "docs/history.md", "docs/design.md",
+         "docs/performance.md")
 SKIP = re.compile(r"<!--\s*docs-check:\s*skip\s*\((.+)\)\s*-->")
 SHELL_LANGS = {"", "bash", "sh", "shell", "console"}
 # an inline code span that is a command: sweep/make/python with arguments, or a venv binary
@@ -68,57 +73,66 @@ INLINE_CMD = re.compile(r"^(time\s+)?(sweep|make|python3?|\.venv/bin/[\w-]+)(\s+
 # ---------------------------------------------------------------------------------------
 # THE table. (page, command as the page gives it, comment and [optional] groups removed)
 # -> (quick form, full form, why). None: the command itself. The quick form is what
-# `make test` runs (about 70 s for all pages); the full form `make docs-check` (about 12 min).
+# `make test` runs (210 s for the 17 pages, one run, 2026-11-26); the full form `make docs-check`.
 # ---------------------------------------------------------------------------------------
 _R = "README.md"
+_REPRO = "docs/reproducing.md"
 MAP: dict[tuple[str, str], tuple[str | None, str | None, str]] = {
     (_R, "make test"): (
         "make -n test", "make -n test",
         "the docs check runs inside `make test`: running it here would run itself"),
-    (_R, "sweep run configs/threshold.yaml"): (
-        "sweep run configs/quick/threshold.yaml --out results/quick/threshold/runs.h5 "
-        "--progress none", None,
-        "936 scenes: the quick form runs configs/quick/'s thinned grid into the file that "
-        "make threshold QUICK=1 then resumes"),
-    # the campaigns: the quick form runs the two whose files the lines below read on the
-    # Makefile's thinned grids (QUICK=1, about 7 s each); the fits, figures and report of the
-    # pipeline run on synthetic files in tests/paper/test_reproduce.py
+    (_R, "make docs"): (
+        "make -n docs", "make -n docs",
+        "builds the whole site and runs the gallery (about 2-4 min); .ci/run runs it"),
     (_R, "make reproduce"): (
-        "make -n reproduce QUICK=1", "make reproduce JOBS=1",
-        "about 5 min (QUICK=1: 30 s); its steps are the lines below"),
-    (_R, "make threshold"): ("make threshold QUICK=1 JOBS=1", None, "the thinned grid"),
-    (_R, "make vr"): ("make vr QUICK=1 JOBS=1", None, "the thinned grid"),
-    (_R, "make fig3"): ("make -n fig3 QUICK=1", None,
-                        "about 30 s (QUICK=1: 6 s); no later line reads its output"),
-    (_R, "make figures"): ("make -n figures QUICK=1", None,
-                           "about 20 s (QUICK=1: 10 s); no later line reads its output"),
-    (_R, "make report"): ("make -n report QUICK=1", None,
-                          "the report of the campaigns; tests/paper/test_reproduce.py runs it "
-                          "on synthetic files"),
+        "make -n reproduce QUICK=1", "make -n reproduce QUICK=1",
+        "about 5 min; docs/reproducing.md runs its steps (quick: the thinned campaigns)"),
     (_R, "make reproduce QUICK=1"): (
-        "make -n reproduce QUICK=1", None,
-        "30 s; its threshold and vr campaigns ran above (make threshold / vr QUICK=1)"),
-    (_R, "make pdms"): ("make -n pdms", None,
-                        "about 15 s; tests/paper/test_pdms.py covers sweep.paper.pdms"),
-    (_R, "make pdms-bem"): (
-        "make -n pdms-bem", None,
-        "about 20 s when it resumes the committed results/pdms/bem.json (30 min without it)"),
-    (_R, "make agreement"): (
-        "python -m sweep.bench.agreement --table-only", None,
-        "about a minute: the quick form rewrites its tables from the committed JSON"),
+        "make -n reproduce QUICK=1", "make reproduce QUICK=1 JOBS=1",
+        "30 s; docs/reproducing.md runs its threshold and vr campaigns"),
     (_R, "make calibrate-demo"): (
         "make -n calibrate-demo", None,
         "about 5 min; the line above runs sweep calibrate on a tiny FILE.yaml"),
-    (_R, "sweep scene --n 0.8 --k 0.5 --mu 30 --a0 15 --rate 1"): (
+    ("docs/sweeps.md", "sweep run configs/threshold.yaml"): (
+        "sweep run configs/quick/threshold.yaml --out results/quick/threshold/runs.h5 "
+        "--progress none", None,
+        "936 scenes: the quick form runs configs/quick/'s thinned grid"),
+    # the campaigns: the quick form runs the two whose files the lines below read on the
+    # Makefile's thinned grids (QUICK=1, about 7 s each); the fits, figures and report of the
+    # pipeline run on synthetic files in tests/paper/test_reproduce.py
+    (_REPRO, "make reproduce"): (
+        "make -n reproduce QUICK=1", "make reproduce JOBS=1",
+        "about 5 min (QUICK=1: 30 s); its steps are the lines below"),
+    (_REPRO, "make threshold"): ("make threshold QUICK=1 JOBS=1", None, "the thinned grid"),
+    (_REPRO, "make vr"): ("make vr QUICK=1 JOBS=1", None, "the thinned grid"),
+    (_REPRO, "make fig3"): ("make -n fig3 QUICK=1", None,
+                            "about 30 s (QUICK=1: 6 s); no later line reads its output"),
+    (_REPRO, "make figures"): ("make -n figures QUICK=1", None,
+                               "about 20 s (QUICK=1: 10 s); no later line reads its output"),
+    (_REPRO, "make report"): ("make -n report QUICK=1", None,
+                              "the report of the campaigns; tests/paper/test_reproduce.py runs "
+                              "it on synthetic files"),
+    (_REPRO, "make reproduce QUICK=1"): (
+        "make -n reproduce QUICK=1", None,
+        "30 s; its threshold and vr campaigns ran above (make threshold / vr QUICK=1)"),
+    ("docs/si.md", "make pdms"): ("make -n pdms", None,
+                                  "about 15 s; tests/paper/test_pdms.py covers sweep.paper.pdms"),
+    ("docs/si.md", "make pdms-bem"): (
+        "make -n pdms-bem", None,
+        "about 20 s when it resumes the committed results/pdms/bem.json (30 min without it)"),
+    ("docs/calibration.md", "make calibrate-demo"): (
+        "make -n calibrate-demo", None,
+        "about 5 min; the line above runs sweep calibrate on a tiny FILE.yaml"),
+    ("docs/models.md", "sweep scene --n 0.8 --k 0.5 --mu 30 --a0 15 --rate 1"): (
         "sweep scene --n 0.8 --k 0.5 --mu 100 --a0 15 --rate 1", None,
         "about 65 s: the quick form is a scene refused for too many steps before any solve"),
 }
 
 # the quick form reads the QUICK=1 campaign outputs where a page reads the full campaign's
 QUICK_SUBST = {
-    _R: [("results/threshold/runs.h5", "results/quick/threshold/runs.h5"),
-         ("results/threshold.h5", "results/quick/threshold/runs.h5"),
-         ("results/vr/runs.h5", "results/quick/vr/runs.h5")],
+    "docs/sweeps.md": [("results/threshold.h5", "results/quick/threshold/runs.h5")],
+    _REPRO: [("results/threshold/runs.h5", "results/quick/threshold/runs.h5"),
+             ("results/vr/runs.h5", "results/quick/vr/runs.h5")],
 }
 
 # files a page names as placeholders or inputs, made in its directory before its blocks run
@@ -142,15 +156,18 @@ with open("master.csv", "w") as fh:
 """
 SETUP: dict[str, list[tuple[str, str]]] = {
     # (kind, text): kind "file:NAME" writes NAME, "python" runs the text, "sh" runs it
-    _R: [("file:FILE.yaml", _TINY_CALIBRATION), ("python", _MASTER_CSV)],
+    _R: [("file:FILE.yaml", _TINY_CALIBRATION)],
+    "docs/calibration.md": [("file:FILE.yaml", _TINY_CALIBRATION)],
+    "docs/si.md": [("python", _MASTER_CSV)],
     "docs/results.md": [("sh", "sweep run configs/demo.yaml --out results/x.h5 --progress none")],
 }
 
 # yaml blocks: the loader of the format each page shows ({path}: the block written to a file)
 YAML_CHECKS = {
-    _R: "from sweep.analysis.calibrate import load_calibration\n"
-        "import shutil; shutil.copy('configs/calibrate/pulloff.csv', 'pulloff.csv')\n"
-        "cal = load_calibration('{path}'); print(cal)",
+    "docs/calibration.md": "from sweep.analysis.calibrate import load_calibration\n"
+                           "import shutil; shutil.copy('configs/calibrate/pulloff.csv', "
+                           "'pulloff.csv')\n"
+                           "cal = load_calibration('{path}'); print(cal)",
     "docs/configs.md": "from sweep.campaign.config import load_config\n"
                        "cfg = load_config('{path}'); print(cfg.name, len(cfg.scenes()), 'scenes')",
 }
@@ -158,7 +175,8 @@ YAML_CHECKS = {
 # inline spans that run (not only checked to exist): what their output must contain, and
 # their exit status (`sweep scene` exits 1 when the scene failed)
 INLINE_RUN: dict[tuple[str, str], tuple[tuple[str, ...], int]] = {
-    (_R, "sweep scene --n 0.4 --k 0.1 --mu 3.24 --a0 2 --rate 1 --preset fast --nodes 60"):
+    ("docs/numerics.md",
+     "sweep scene --n 0.4 --k 0.1 --mu 3.24 --a0 2 --rate 1 --preset fast --nodes 60"):
         (("failed (unresolved: the pull-off moves by 0.67",), 1),
 }
 
@@ -167,9 +185,12 @@ INLINE_RUN: dict[tuple[str, str], tuple[tuple[str, ...], int]] = {
 CHECKS: dict[tuple[str, str], tuple[str, ...]] = {
     # "prints where results and figure are"
     (_R, "make demo"): ("results: results/demo.h5", "figure: results/demo.png"),
+    ("docs/getting-started.md", "make demo"): ("results: results/demo.h5",
+                                               "figure: results/demo.png"),
     # ends on max_steps after 22603 steps when the machine is idle, on its time budget first
-    # when it is loaded (README: both outputs are shown)
-    (_R, "sweep scene --n 0.8 --k 0.5 --mu 30 --a0 15 --rate 1"): ("status failed (",),
+    # when it is loaded (the page shows both outputs)
+    ("docs/models.md", "sweep scene --n 0.8 --k 0.5 --mu 30 --a0 15 --rate 1"):
+        ("status failed (",),
 }
 
 

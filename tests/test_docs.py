@@ -54,7 +54,7 @@ def test_setup_says_how_to_reach_the_sweep_command():
     """`sweep` lives in .venv/bin, which is not on PATH: the README's set-up and the end of
     `make demo` say so (both ways: the full path, and activating the environment)."""
     readme = ROOT.joinpath("README.md").read_text()
-    setup = readme[: readme.index("## Units")]
+    setup = readme[: readme.index("## One scene")]
     assert ".venv/bin/sweep" in setup and "source .venv/bin/activate" in setup
     demo = ROOT.joinpath("Makefile").read_text().split("\ndemo:", 1)[1].split("\n\n", 1)[0]
     echoed = "\n".join(ln for ln in demo.splitlines() if "@echo" in ln)

@@ -1,4 +1,4 @@
-"""The docs run (issue 25 item 4): every block and command of README.md and docs/*.md, in the
+"""The docs run (issue 25 item 4): every block and command of README.md and docs/**.md, in the
 quick form of tests/docs_check.py (``make docs-check`` runs the full form), and the runner's own
 rules: unmarked blocks it cannot run fail, markers are visible, the table names only commands
 the docs still give."""
@@ -28,7 +28,11 @@ def test_page_runs_quick(page):
 
 
 def test_every_page_is_checked():
-    pages = {"README.md", *(f"docs/{p.name}" for p in (ROOT / "docs").glob("*.md"))}
+    """Every Markdown page of the README and the site (docs/, recursively; not the site's
+    generated build folders) is run by the docs check."""
+    generated = {"_build", "auto_examples"}
+    pages = {"README.md", *(p.relative_to(ROOT).as_posix() for p in (ROOT / "docs").rglob("*.md")
+                            if not generated & set(p.relative_to(ROOT / "docs").parts))}
     assert pages == set(dc.PAGES), f"tests/docs_check.py PAGES misses {pages - set(dc.PAGES)}"
 
 
@@ -109,16 +113,39 @@ def test_commands_strip_comments_and_optional_groups():
     assert dc._commands(b) == [("sweep scene --a0 2 --rate 1   # 3 s", ["status  ok 2.1"])]
 
 
-# -- numbers the README quotes from committed results files ----------------------------------
+# -- numbers the README and the site quote from committed results files --------------------
+
+def _page(name: str = "README.md") -> str:
+    return " ".join((ROOT / name).read_text().split())
+
 
 def _readme() -> str:
-    return " ".join((ROOT / "README.md").read_text().split())
+    return _page("README.md")
 
 
-def test_readme_bench_table_is_results_bench_json():
-    """The `make bench` table quotes results/bench.json (the committed run)."""
+def test_readme_headline_table_is_results_bench_json():
+    """The README's short speed table and docs/speed.md's quote results/bench.json: the cold
+    compile, the paper scene's wall and error, the balanced ratios over the plain solver, the
+    v0.1 threshold grid's wall."""
     bench = json.loads((ROOT / "results" / "bench.json").read_text())
-    text = _readme()
+    vs = bench["vs_numpy"]
+    ratios = " / ".join(f"{vs[s]['balanced']['ratio']:.1f}" for s in vs)      # 24.6 / 52.0 / 26.4
+    paper = vs[next(s for s in vs if s.startswith("n0.8_delta11"))]["balanced"]
+    for text in (_readme(), _page("docs/speed.md")):
+        assert f"`compile_s` {bench['compile_s']['cold']:.0f} s" in text
+        assert f"| {ratios} " in text
+        assert f"| {bench['campaign_balanced_s']:.0f} s |" in text
+        m = re.search(r"([\d.]+) s, pull-off error ([\d.e+-]+)", text)
+        assert m, "no paper-scene row"
+        assert m.group(1) == f"{paper['engine_s']:.2f}"
+        assert float(m.group(2)) == pytest.approx(paper["engine_err"], rel=0.01)
+
+
+def test_speed_page_bench_table_is_results_bench_json():
+    """docs/speed.md's `make bench` table quotes results/bench.json (the committed run)."""
+    bench = json.loads((ROOT / "results" / "bench.json").read_text())
+    text = _page("docs/speed.md")
+    assert f"`wall_s` = {bench['wall_s']:.0f} s in the committed `results/bench.json`" in text
     som = bench["step_over_matvec"]
     assert f"{som['500']:.3g}" in text                                      # 4.35
     assert f"| `compile_s` cold / cached | {bench['compile_s']['cold']:.0f} s" in text
@@ -130,26 +157,29 @@ def test_readme_bench_table_is_results_bench_json():
 
 
 def test_readme_tradeoff_counts_are_results_tradeoff():
-    """`make tradeoff`'s figures: 57 numerics x 3 scenes (results/tradeoff/table.csv)."""
+    """`make tradeoff`'s figures: 67 numerics x 3 scenes (results/tradeoff/table.csv), quoted
+    in docs/history.md."""
     import pandas as pd
 
     table = pd.read_csv(ROOT / "results" / "tradeoff" / "table.csv")
     scenes = table["scene"].nunique() if "scene" in table else 3
-    assert f"{len(table) // scenes} numerics x {scenes} scenes" in _readme()
+    assert f"{len(table) // scenes} numerics x {scenes} scenes" in _page("docs/history.md")
 
 
-def test_readme_calibration_table_is_results_calibrate():
-    """`make calibrate-demo`'s table and cost quote results/calibrate/calibration.json."""
+def test_calibration_table_is_results_calibrate():
+    """`make calibrate-demo`'s table and cost in docs/calibration.md quote
+    results/calibrate/calibration.json."""
     cal = json.loads((ROOT / "results" / "calibrate" / "calibration.json").read_text())
-    text = _readme()
+    text = _page("docs/calibration.md")
     for name, p in cal["parameters"].items():
         row = re.search(rf"\| {name} [^|]*\| [^|]+ \| ([\d.]+) \| \[([\d.]+), ([\d.]+)[^|]*\] "
                         rf"\| ([\w ]+) \|", text)
-        assert row, f"README.md: no calibration row for {name}"
+        assert row, f"docs/calibration.md: no calibration row for {name}"
         for i, value in zip((1, 2, 3), (p["estimate"], *p["interval"])):
             q = row.group(i)                 # equal to the digits quoted
             half = 0.5 * 10.0 ** -len(q.partition(".")[2]) * 1.0001
-            assert abs(float(q) - value) <= half, f"README.md: {name} quotes {q}, JSON {value}"
+            assert abs(float(q) - value) <= half, \
+                f"docs/calibration.md: {name} quotes {q}, JSON {value}"
         assert row.group(4).strip() == p["status"], name
     assert f"RMS log residual {cal['fit']['rms_log_residual']:.2g}" in text
     assert f"{cal['scenes_run']} scenes ({cal['failed_scenes']} failed" in text
@@ -157,17 +187,18 @@ def test_readme_calibration_table_is_results_calibrate():
 
 
 def test_scene_counts_the_docs_quote_are_the_configs():
-    """Scene counts quoted in README.md and docs/configs.md are those the configs expand to."""
+    """Scene counts quoted in README.md and the site's pages are those the configs expand to."""
     from sweep.campaign.config import load_config
 
     def count(name):
         return len(load_config(ROOT / "configs" / f"{name}.yaml").scenes())
 
-    readme, configs = _readme(), " ".join((ROOT / "docs" / "configs.md").read_text().split())
+    readme, configs = _readme(), _page("docs/configs.md")
+    speed, history = _page("docs/speed.md"), _page("docs/history.md")
     assert f"runs a {count('demo')}-scene sweep" in readme
     thr = count("threshold")
-    assert f"every 5th of its {thr} scenes ({len(range(0, thr, 5))}," in readme
-    assert f"{thr} scenes, none failed, **14.0 s**" in readme
-    assert f"({count('scale'):,} scenes:" in readme and f"{count('scale'):,} scenes, none" in readme
+    assert f"every 5th of its {thr} scenes ({len(range(0, thr, 5))}," in speed
+    assert f"{thr} scenes, none failed, **14.0 s**" in history
+    assert f"({count('scale'):,} scenes:" in speed and f"{count('scale'):,} scenes, none" in history
     assert f"`make demo`: {count('demo')} fast scenes" in configs
     assert f"`units: si`; {count('pdms')} scenes" in configs
