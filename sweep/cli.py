@@ -501,6 +501,9 @@ def info_cmd(results, slowest, as_si, csv_out):
         # the SI inputs that vary over the file (besides the speed) get a column each
         varied = [c for c in df.columns if c.startswith("si_") and c != "si_speed"
                   and df[c].nunique(dropna=True) > 1]
+        if "si_pz_law" in df and (df["si_pz_law"] != "none").any():   # a process zone's
+            varied += [c for c in ("si_pz_law", "si_pz_v0", "si_pz_xi")  # law and parameters
+                       if c in df and c not in varied]
         heads = [f"{c[3:]}[{_si_unit(c[3:])}]" if _si_unit(c[3:]) else c[3:] for c in varied]
         click.echo("scene_id          requested  used   status  "
                    + "".join(f"{h:<11} " for h in heads)
@@ -510,7 +513,8 @@ def info_cmd(results, slowest, as_si, csv_out):
             cs = r["crack_speed_m_s"]
             click.echo(f"{r['scene_id']}  {r['model'] or '?':<9}  {r['model_used'] or '-':<5}  "
                        f"{r['status']:<6}  "
-                       + "".join(f"{r[c]:<11.4g} " for c in varied)
+                       + "".join(f"{r[c]:<11} " if isinstance(r[c], str) else
+                                 f"{r[c]:<11.4g} " for c in varied)
                        + f"{r['si_speed'] * 1e6:<11.4g}  {r['mu']:<7.4g}  "
                        f"{r['l0_m'] * 1e9:<6.4g}  "
                        f"{(r['pull_off_N'] or math.nan) * 1e3:<12.5g}  "
