@@ -201,15 +201,17 @@ def scene_options(func):
     """One option per Scene field, from its metadata (sweep.scene.AXES): name, default,
     allowed values and help are declared once, in sweep/scene.py."""
     for a in reversed(list(AXES.values())):
+        # --pz_law and --pz-law alike
+        names = dict.fromkeys((f"--{a.name}", f"--{a.name.replace('_', '-')}"))
         if a.numeric:
             default = a.cli_default if a.required else a.default
             option = click.option(
-                f"--{a.name}", a.name, type=str,
+                *names, a.name, type=str,
                 default=None if default is None else format(default, "g"),
                 show_default=default is not None,
                 help=a.describe() + ".")
         else:
-            option = click.option(f"--{a.name}", a.name, type=click.Choice(list(a.choices)),
+            option = click.option(*names, a.name, type=click.Choice(list(a.choices)),
                                   default=a.default, show_default=True, help=a.describe() + ".")
         func = option(func)
     return func
@@ -342,14 +344,20 @@ def scene_numerics(res, preset: str) -> tuple[str, str]:
     if model == "crack":
         cost = (f"steps={res.steps} rhs_evaluations={res.newton_iterations} "
                 f"lu={res.factorizations} {wall}")
-        if 1.0 / sc.k - 1.0 <= crack_front.NEARLY_ELASTIC * (1.0 + 1e-12):
+        nearly_elastic = 1.0 / sc.k - 1.0 <= crack_front.NEARLY_ELASTIC * (1.0 + 1e-12)
+        if nearly_elastic and sc.pz_law == "none":
             return (f"crack-front model, nearly elastic (1/k - 1 = {1.0 / sc.k - 1.0:.3g} <= "
                     f"{crack_front.NEARLY_ELASTIC:g}): JKR at constant Gamma = "
                     f"{1.0 / math.sqrt(sc.k):.6g} dg, closed form", wall)
         budget = f" time_budget={num.time_budget_s:g} s" if num.time_budget_s > 0 else ""
+        bulk = (f"the constant bulk factor {1.0 / math.sqrt(sc.k):.6g} (nearly elastic)"
+                if nearly_elastic else f"Persson-Brener Gamma(v) of the {sc.material} spectrum")
+        if sc.pz_law != "none":
+            bulk = (f"process zone ({sc.pz_law}, pz_v0={sc.pz_v0:g}, pz_xi={sc.pz_xi:g}) "
+                    + ("alone (k = 1)" if sc.k == 1.0 else f"times {bulk}"))
         return (f"crack-front model: Radau integration rtol="
-                f"{crack_front.unload.__kwdefaults__['rtol']:g}, Persson-Brener Gamma(v) of "
-                f"the {sc.material} spectrum (no mesh){budget}", cost)
+                f"{crack_front.unload.__kwdefaults__['rtol']:g}, {bulk} (no mesh){budget}",
+                cost)
     nodes = f"nodes={res.nodes_used} spacing={res.spacing:.4g} domain={res.domain_used:.4g}"
     if model == "elastic":
         return (f"elastic branch, quasi-static (k = 1, no hereditary integral): "
