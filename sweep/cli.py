@@ -232,7 +232,7 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
 @click.option("--si", "si", is_flag=True,
               help="Give the scene in SI units: --n --R --E0 --Einf --nu --tau0 --dg --h0, one "
                    "of --preload/--a0-si/--indentation, and --speed (instead of --k --mu --a0 "
-                   "--delta0 --rate).")
+                   "--delta0 --rate); a process zone's --pz-v0 is then in m/s.")
 @click.option("--R", "R", type=str, default=None, help="[--si] sphere radius [m].")
 @click.option("--E0", "E0", type=str, default=None, help="[--si] relaxed Young's modulus [Pa].")
 @click.option("--Einf", "Einf", type=str, default=None, help="[--si] glassy Young's modulus [Pa].")
@@ -411,7 +411,9 @@ def _scene_si(axes, as_json, values):
     kw = {name: as_float(name, v) for name, v in values.items() if v is not None}
     if "a0_si" in kw:
         kw["a0"] = kw.pop("a0_si")
-    out = run_si(SIScene(n=as_float("n", n), material=material, **kw), model)
+    pz = {"pz_law": axes["pz_law"], **{name: as_float(name, axes[name])
+                                       for name in ("pz_v0", "pz_xi") if axes[name] is not None}}
+    out = run_si(SIScene(n=as_float("n", n), material=material, **pz, **kw), model)
     if as_json:
         echo_json(out)
     else:

@@ -106,6 +106,19 @@ def test_cli_scene_si_json(capsys):
     assert d["scene"]["rate"] == pytest.approx(0.60909, rel=1e-4)
 
 
+def test_cli_scene_si_process_zone_in_m_s(capsys):
+    """`sweep scene --si --pz-law gent-schultz --pz-v0 V --pz-xi X`: V in m/s, the same
+    pull-off as run_si's, above the scene without a process zone."""
+    pz = ["--pz-law", "gent-schultz", "--pz-v0", "213.5e-6", "--pz-xi", "0.4154"]
+    assert main(SI_ARGS + ["--model", "crack", "--json"] + pz) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["scene"]["pz_law"] == "gent-schultz"
+    assert d["scene"]["pz_v0"] == pytest.approx(213.5e-6 * d["si"]["tau0"] / d["a_ref_m"],
+                                                rel=1e-12)
+    assert main(SI_ARGS + ["--model", "crack", "--json"]) == 0
+    assert d["pull_off"] > json.loads(capsys.readouterr().out)["pull_off"]
+
+
 @pytest.mark.parametrize("extra, message", [
     ([], "mu must be in"),                                   # bem at mu = 103
     (["--model", "crack", "--rate", "1"], "--rate: dimensionless options cannot"),
