@@ -201,15 +201,17 @@ def scene_options(func):
     """One option per Scene field, from its metadata (sweep.scene.AXES): name, default,
     allowed values and help are declared once, in sweep/scene.py."""
     for a in reversed(list(AXES.values())):
+        # --pz_law and --pz-law alike
+        names = dict.fromkeys((f"--{a.name}", f"--{a.name.replace('_', '-')}"))
         if a.numeric:
             default = a.cli_default if a.required else a.default
             option = click.option(
-                f"--{a.name}", a.name, type=str,
+                *names, a.name, type=str,
                 default=None if default is None else format(default, "g"),
                 show_default=default is not None,
                 help=a.describe() + ".")
         else:
-            option = click.option(f"--{a.name}", a.name, type=click.Choice(list(a.choices)),
+            option = click.option(*names, a.name, type=click.Choice(list(a.choices)),
                                   default=a.default, show_default=True, help=a.describe() + ".")
         func = option(func)
     return func
@@ -230,7 +232,7 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
 @click.option("--si", "si", is_flag=True,
               help="Give the scene in SI units: --n --R --E0 --Einf --nu --tau0 --dg --h0, one "
                    "of --preload/--a0-si/--indentation, and --speed (instead of --k --mu --a0 "
-                   "--delta0 --rate).")
+                   "--delta0 --rate); a process zone's --pz-v0 is then in m/s.")
 @click.option("--R", "R", type=str, default=None, help="[--si] sphere radius [m].")
 @click.option("--E0", "E0", type=str, default=None, help="[--si] relaxed Young's modulus [Pa].")
 @click.option("--Einf", "Einf", type=str, default=None, help="[--si] glassy Young's modulus [Pa].")
@@ -342,14 +344,20 @@ def scene_numerics(res, preset: str) -> tuple[str, str]:
     if model == "crack":
         cost = (f"steps={res.steps} rhs_evaluations={res.newton_iterations} "
                 f"lu={res.factorizations} {wall}")
-        if 1.0 / sc.k - 1.0 <= crack_front.NEARLY_ELASTIC * (1.0 + 1e-12):
+        nearly_elastic = 1.0 / sc.k - 1.0 <= crack_front.NEARLY_ELASTIC * (1.0 + 1e-12)
+        if nearly_elastic and sc.pz_law == "none":
             return (f"crack-front model, nearly elastic (1/k - 1 = {1.0 / sc.k - 1.0:.3g} <= "
                     f"{crack_front.NEARLY_ELASTIC:g}): JKR at constant Gamma = "
                     f"{1.0 / math.sqrt(sc.k):.6g} dg, closed form", wall)
         budget = f" time_budget={num.time_budget_s:g} s" if num.time_budget_s > 0 else ""
+        bulk = (f"the constant bulk factor {1.0 / math.sqrt(sc.k):.6g} (nearly elastic)"
+                if nearly_elastic else f"Persson-Brener Gamma(v) of the {sc.material} spectrum")
+        if sc.pz_law != "none":
+            bulk = (f"process zone ({sc.pz_law}, pz_v0={sc.pz_v0:g}, pz_xi={sc.pz_xi:g}) "
+                    + ("alone (k = 1)" if sc.k == 1.0 else f"times {bulk}"))
         return (f"crack-front model: Radau integration rtol="
-                f"{crack_front.unload.__kwdefaults__['rtol']:g}, Persson-Brener Gamma(v) of "
-                f"the {sc.material} spectrum (no mesh){budget}", cost)
+                f"{crack_front.unload.__kwdefaults__['rtol']:g}, {bulk} (no mesh){budget}",
+                cost)
     nodes = f"nodes={res.nodes_used} spacing={res.spacing:.4g} domain={res.domain_used:.4g}"
     if model == "elastic":
         return (f"elastic branch, quasi-static (k = 1, no hereditary integral): "
@@ -403,7 +411,9 @@ def _scene_si(axes, as_json, values):
     kw = {name: as_float(name, v) for name, v in values.items() if v is not None}
     if "a0_si" in kw:
         kw["a0"] = kw.pop("a0_si")
-    out = run_si(SIScene(n=as_float("n", n), material=material, **kw), model)
+    pz = {"pz_law": axes["pz_law"], **{name: as_float(name, axes[name])
+                                       for name in ("pz_v0", "pz_xi") if axes[name] is not None}}
+    out = run_si(SIScene(n=as_float("n", n), material=material, **pz, **kw), model)
     if as_json:
         echo_json(out)
     else:
@@ -501,6 +511,9 @@ def info_cmd(results, slowest, as_si, csv_out):
         # the SI inputs that vary over the file (besides the speed) get a column each
         varied = [c for c in df.columns if c.startswith("si_") and c != "si_speed"
                   and df[c].nunique(dropna=True) > 1]
+        if "si_pz_law" in df and (df["si_pz_law"] != "none").any():   # a process zone's
+            varied += [c for c in ("si_pz_law", "si_pz_v0", "si_pz_xi")  # law and parameters
+                       if c in df and c not in varied]
         heads = [f"{c[3:]}[{_si_unit(c[3:])}]" if _si_unit(c[3:]) else c[3:] for c in varied]
         click.echo("scene_id          requested  used   status  "
                    + "".join(f"{h:<11} " for h in heads)
@@ -510,7 +523,8 @@ def info_cmd(results, slowest, as_si, csv_out):
             cs = r["crack_speed_m_s"]
             click.echo(f"{r['scene_id']}  {r['model'] or '?':<9}  {r['model_used'] or '-':<5}  "
                        f"{r['status']:<6}  "
-                       + "".join(f"{r[c]:<11.4g} " for c in varied)
+                       + "".join(f"{r[c]:<11} " if isinstance(r[c], str) else
+                                 f"{r[c]:<11.4g} " for c in varied)
                        + f"{r['si_speed'] * 1e6:<11.4g}  {r['mu']:<7.4g}  "
                        f"{r['l0_m'] * 1e9:<6.4g}  "
                        f"{(r['pull_off_N'] or math.nan) * 1e3:<12.5g}  "

@@ -32,6 +32,12 @@ UNIFORM_NODES = 500
 STOPS = ("pulloff", "separation")
 #: Models a scene can ask for (sweep.engine.models maps each to its simulate function).
 MODEL_NAMES = ("bem", "crack", "pb", "elastic", "auto")
+#: Process-zone laws of the interface: none (the rate-independent work of adhesion dg) or
+#: Gent-Schultz, Gamma_pz(v) = dg (1 + (v/pz_v0)^pz_xi) at crack speed v > 0
+#: (:mod:`sweep.engine.crack_front`)
+PZ_LAWS = ("none", "gent-schultz")
+#: the Scene fields of a process zone's parameters (given exactly when ``pz_law`` is not none)
+PZ_PARAMETERS = ("pz_v0", "pz_xi")
 
 
 def axis(default=dataclasses.MISSING, *, help: str, unit: str = "", limits=None,
@@ -64,6 +70,21 @@ def axis(default=dataclasses.MISSING, *, help: str, unit: str = "", limits=None,
             "choices": choices, "label": label, "order": order, "plot_group": plot_group,
             "cli_default": cli_default}
     return field(default=default, metadata={"axis": meta})
+
+
+def check_process_zone(pz_law, pz_v0, pz_xi, speed_unit: str) -> None:
+    """InputError unless the process-zone parameters are given exactly with a law:
+    ``pz_v0`` (a crack speed in ``speed_unit``) and ``pz_xi`` with a ``pz_law`` other than
+    "none", neither without one (their ranges are checked on their own)."""
+    values = {"pz_v0": pz_v0, "pz_xi": pz_xi}
+    given = [p for p in PZ_PARAMETERS if values[p] is not None]
+    if pz_law == "none" and given:
+        raise InputError(f"{'/'.join(given)}: a process-zone parameter needs a pz_law "
+                         f"({', '.join(PZ_LAWS[1:])}; got pz_law none)")
+    if pz_law != "none" and len(given) < len(PZ_PARAMETERS):
+        missing = [p for p in PZ_PARAMETERS if p not in given]
+        raise InputError(f"{'/'.join(missing)}: pz_law {pz_law} needs pz_v0 > 0 "
+                         f"({speed_unit}) and pz_xi > 0 (missing {', '.join(missing)})")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -103,6 +124,20 @@ class Scene:
         Which model runs the scene (:mod:`sweep.engine.models`): the BEM (default), the crack-front
         model, the paper's closed-form PB estimate, or "auto" (the BEM where its mesh fits the
         numerics' node count, else the crack-front model); ``Result.model_used`` records it.
+    pz_law : {"none", "gent-schultz"}
+        Rate-dependent process zone of the interface: "none" (default; the work of adhesion
+        dg is rate independent, the BEM's Lennard-Jones law) or "gent-schultz",
+        Gamma_pz(v) = dg (1 + (v/pz_v0)^pz_xi) at an opening crack speed v > 0 and dg at
+        v <= 0. The crack-front model multiplies it with the bulk's Persson-Brener factor
+        (:mod:`sweep.engine.crack_front`); the BEM and the pb estimate refuse it, "auto"
+        sends it to the crack-front model.
+    pz_v0 : float, optional
+        Crack speed at which the process zone doubles the work of adhesion, in a_ref/tau0
+        (the crack-speed unit of docs/design.md section 2), > 0; given exactly when
+        ``pz_law`` is not "none".
+    pz_xi : float, optional
+        Exponent of the Gent-Schultz law, in (0, 10]; given exactly when ``pz_law`` is not
+        "none".
     """
 
     n: float = axis(help="MPL exponent (spectrum broadness); unused by sls", limits=(0.0, 5.0),
@@ -135,6 +170,17 @@ class Scene:
                       "elastic branch (k = 1, mu 0.01-100); auto, the cheapest whose measured "
                       "error meets pull_off_rtol (every scene)",
                       choices=MODEL_NAMES, order=-1)
+    pz_law: str = axis("none", help="rate-dependent process zone: none (rate-independent dg, "
+                       "the LJ law) or gent-schultz, Gamma_pz(v) = dg (1 + (v/pz_v0)^pz_xi) "
+                       "(models crack and auto; bem and pb refuse it)", choices=PZ_LAWS,
+                       order=-4)
+    pz_v0: float | None = axis(None, help="process zone: crack speed at which it doubles the "
+                               "work of adhesion (with pz_law gent-schultz)",
+                               unit="a_ref/tau0", limits=(0.0, 1e30), lo_open=True,
+                               label=r"$v_0$", order=-3)
+    pz_xi: float | None = axis(None, help="process zone: exponent of Gamma_pz(v) (with pz_law "
+                               "gent-schultz)", limits=(0.0, 10.0), lo_open=True,
+                               label=r"$\xi$", order=-2)
 
     def __post_init__(self):
         info = _axes_of(type(self))
@@ -143,6 +189,7 @@ class Scene:
                 raise InputError("a0/delta0: give exactly one of a0 (initial contact radius) "
                                  "and delta0 (initial indentation)")
             object.__setattr__(self, f.name, info[f.name].check(getattr(self, f.name)))
+        check_process_zone(self.pz_law, self.pz_v0, self.pz_xi, "a_ref/tau0")
 
     def to_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -617,16 +664,19 @@ class Result:
     def __repr__(self) -> str:
         """A one-line summary: status (and reason), pull-off (pi dg R), crack speed
         (a_ref/tau0), model, steps, the trajectory's length (never its arrays) and the
-        scene's axes; the full rows are :meth:`to_row` and :meth:`to_dict`."""
+        scene's axes (the process zone where there is one); the full rows are
+        :meth:`to_row` and :meth:`to_dict`."""
         points = len(next(iter(self.trajectory.values()), ()))
         reason = self.reason if len(self.reason) <= 80 else self.reason[:77] + "..."
         sc = self.scene
         start = f"a0={sc.a0:g}" if sc.a0 is not None else f"delta0={sc.delta0:g}"
+        pz = (f" pz_law={sc.pz_law} pz_v0={sc.pz_v0:g} pz_xi={sc.pz_xi:g}"
+              if sc.pz_law != "none" else "")
         return (f"Result({self.status}{' (' + reason + ')' if reason else ''}: "
                 f"pull_off={self.pull_off:.6g} crack_speed={self.crack_speed:.6g} "
                 f"model={self.model_used or sc.model} steps={self.steps} "
                 f"trajectory={points} points; scene {sc.material} n={sc.n:g} k={sc.k:g} "
-                f"mu={sc.mu:g} rate={sc.rate:g} {start})")
+                f"mu={sc.mu:g} rate={sc.rate:g} {start}{pz})")
 
     __str__ = __repr__
 

@@ -27,8 +27,9 @@ combine a ``preset`` with explicit overrides (``{preset: fast, nodes: 120}``).
 ``output`` defaults to ``results/<name>.h5``.
 
 ``units: si``: the grid holds the SI fields of :data:`sweep.campaign.si.SI_AXES` (``R, E0, Einf, nu,
-n, tau0, dg, h0, speed`` and one of ``preload``, ``a0``, ``indentation``) besides ``model``,
-``material``, ``stop``; every point becomes a :class:`sweep.campaign.si.SIScene` and its
+n, tau0, dg, h0, speed``, one of ``preload``, ``a0``, ``indentation``, and ``pz_v0`` [m/s],
+``pz_xi`` with a ``pz_law``) besides ``model``, ``material``, ``stop``, ``pz_law``; every
+point becomes a :class:`sweep.campaign.si.SIScene` and its
 dimensionless :class:`Scene` (the one hashed, stored and run; :meth:`SweepConfig.si_tasks`
 maps ids back to the SI points, :func:`sweep.campaign.store.si_table` gives stored rows in SI).
 
@@ -62,7 +63,9 @@ TOP_KEYS = ("name", "description", "units", "grid", "numerics", "store", "output
 #: Values of ``units``: the grid in the dimensionless Scene axes, or in SI (sweep.campaign.si.SI_AXES).
 UNITS = ("dimensionless", "si")
 #: Categorical Scene axes an SI grid takes as they are.
-SI_SCENE_AXES = ("model", "material", "stop")
+SI_SCENE_AXES = ("model", "material", "stop", "pz_law")
+#: Of those, the ones the SI scene holds (the rest pass to the Scene as they are).
+SI_SCENE_FIELDS = ("material", "pz_law")
 #: Grid axes, in the order the Cartesian product iterates them (last varies fastest).
 #: Grid axes in the order of expansion (the last varies fastest): the Scene fields by their
 #: ``order`` metadata.
@@ -332,13 +335,13 @@ def _si_order(name: str) -> int:
 
 def _si_point(point: dict, where: str):
     """The SIScene and the Scene of one point of an SI grid (InputError naming the point)."""
-    extra = {a: point[a] for a in SI_SCENE_AXES if a in point and a != "material"}
+    extra = {a: point[a] for a in SI_SCENE_AXES if a in point and a not in SI_SCENE_FIELDS}
     phys = {a: v for a, v in point.items() if a not in SI_SCENE_AXES}
     try:
-        si = SIScene(**phys, material=point.get("material", "mpl"))
+        si = SIScene(**phys, **{a: point[a] for a in SI_SCENE_FIELDS if a in point})
         return si, si.to_scene(**extra)
     except InputError as exc:
-        desc = ", ".join(f"{a}={v:g}" for a, v in phys.items())
+        desc = ", ".join(f"{a}={v:g}" for a, v in phys.items() if v is not None)
         raise InputError(f"{where} (SI point {desc}): {exc}") from None
 
 

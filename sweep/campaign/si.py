@@ -7,7 +7,10 @@ Poisson's ratio ``nu``; MPL exponent ``n`` and time ``tau0`` [s]; work of adhesi
 [J/m^2]; LJ equilibrium distance ``h0`` [m]; the initial state as exactly one of a preload
 force ``preload`` [N] (compressive, reached after full relaxation: the relaxed JKR contact at
 that load), a contact radius ``a0`` [m] or an indentation ``indentation`` [m]; the unloading
-speed ``speed`` [m/s].
+speed ``speed`` [m/s]; optionally a rate-dependent process zone, ``pz_law`` ("none" or
+"gent-schultz"), ``pz_v0`` [m/s] (the crack speed at which it doubles the work of adhesion)
+and ``pz_xi`` (its exponent), converted to ``pz_v0`` in a_ref/tau0
+(:meth:`sweep.units.PhysicalScale.crack_speed_hat`).
 
 Derived: ``k = E0/Einf``, ``mu`` (Tabor), ``rate = speed tau0 / h0`` (the paper's r-hat), the
 initial ``a0_hat`` (a_ref) or ``delta0_hat`` (d_ref). The dimensionless scene holds everything
@@ -20,10 +23,10 @@ import math
 from dataclasses import asdict, dataclass
 
 from .. import units
-from ..engine.crack_front import pb_law_for_scene, unload
-from ..engine.models import choose_model, pb_estimate, simulate_model
+from ..engine.crack_front import scene_law, unload
+from ..engine.models import PROCESS_ZONE_REFUSALS, choose_model, pb_estimate, simulate_model
 from ..errors import InputError, check_choice, check_positive, check_range
-from ..scene import SCENE_LIMITS, Axis, Scene
+from ..scene import AXES, PZ_LAWS, SCENE_LIMITS, Axis, Scene, check_process_zone
 from ..theory import jkr_contact_radius, jkr_pull_off
 from ..units import PhysicalScale
 
@@ -57,6 +60,10 @@ SI_AXES = {a.name: a for a in (
     _si_axis("indentation", "m", "initial indentation (or preload or a0)", lo=None,
              lo_open=False, required=False, order=13),
     _si_axis("speed", "m/s", "unloading speed", order=14),
+    _si_axis("pz_v0", "m/s", "process zone: crack speed at which it doubles the work of "
+             "adhesion (with pz_law gent-schultz)", required=False, order=2),
+    _si_axis("pz_xi", "", "process zone: exponent of Gamma_pz(v) (with pz_law gent-schultz)",
+             hi=AXES["pz_xi"].limits[1], required=False, order=2),
 )}
 #: The initial-state fields of an SI grid: exactly one is given.
 SI_INITIAL = ("preload", "a0", "indentation")
@@ -79,6 +86,9 @@ class SIScene:
     a0: float | None = None
     indentation: float | None = None
     material: str = "mpl"
+    pz_law: str = "none"
+    pz_v0: float | None = None
+    pz_xi: float | None = None
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
@@ -99,6 +109,12 @@ class SIScene:
         if self.indentation is not None:
             set_("indentation", check_range("indentation", self.indentation))
         check_choice("material", self.material, ("mpl", "sls"))
+        check_choice("pz_law", self.pz_law, PZ_LAWS)
+        if self.pz_v0 is not None:
+            set_("pz_v0", check_positive("pz_v0", self.pz_v0))
+        if self.pz_xi is not None:
+            set_("pz_xi", AXES["pz_xi"].check(self.pz_xi))
+        check_process_zone(self.pz_law, self.pz_v0, self.pz_xi, "m/s")
 
     # ---- scales ------------------------------------------------------------------------------
     @property
@@ -119,13 +135,17 @@ class SIScene:
         return float(self.scale.rate_hat(self.speed, self.tau0))
 
     def dimensionless(self) -> dict:
-        """``n, k, mu, rate, material`` and ``a0`` (a_ref) or ``delta0`` (d_ref).
+        """``n, k, mu, rate, material``, ``a0`` (a_ref) or ``delta0`` (d_ref), and the process
+        zone ``pz_law``, ``pz_v0`` (a_ref/tau0), ``pz_xi`` (None without one).
 
         A preload becomes the relaxed JKR contact radius at that load.
         """
         sc = self.scale
         d = {"n": self.n, "k": self.k, "mu": sc.mu, "rate": self.rate, "material": self.material,
-             "a0": None, "delta0": None}
+             "a0": None, "delta0": None, "pz_law": self.pz_law,
+             "pz_v0": (None if self.pz_v0 is None
+                       else float(sc.crack_speed_hat(self.pz_v0, self.tau0))),
+             "pz_xi": self.pz_xi}
         if self.preload is not None:
             d["a0"] = float(jkr_contact_radius(load=float(sc.load_hat(self.preload))))
         elif self.a0 is not None:
@@ -238,8 +258,12 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
                "a_pulloff": r.a_pulloff, "delta_pulloff": r.delta_pulloff,
                "t_pulloff": r.t_pulloff, "crack_speed": r.crack_speed, "vhat": r.vhat,
                "a0": r.a0_result, "delta0": r.delta0_result}
+    elif model == "pb" and d["pz_law"] != "none":
+        dim = {"status": "failed", "reason": PROCESS_ZONE_REFUSALS["pb"].format(**d),
+               "a0": d["a0"], "delta0": d["delta0"]}
     elif model == "crack":
-        law = pb_law_for_scene(d["n"], d["k"], d["mu"], d["material"])
+        law = scene_law(d["n"], d["k"], d["mu"], d["material"], d["pz_law"], d["pz_v0"],
+                        d["pz_xi"])
         s = unload(law, rate=d["rate"], mu=d["mu"], a0=d["a0"], delta0=d["delta0"])
         dim = {"status": s.status, "reason": s.reason, "pull_off": s.pull_off,
                "a_pulloff": s.a_pulloff, "delta_pulloff": s.delta_pulloff,

@@ -40,9 +40,25 @@ closed form is ``1.5 c`` for ``a0 >= 1.040 c^(1/3)`` and
 ``2 sqrt(2c) a0^(3/2) - 4/3 a0^3`` (the load at depinning) for ``a0/c^(1/3)`` in
 ``[1/2, 1.040]``: tested in ``tests/engine/test_crack_front.py``.
 
-Rate laws (:class:`GentSchultzLaw`, :class:`PerssonBrenerLaw`) map ``v`` to ``Gamma`` and
-back; :func:`unload` runs one unloading; :func:`simulate_crack` runs a :class:`sweep.Scene`
-with the Persson-Brener law of its material and returns a :class:`sweep.Result` row.
+Rate laws (:class:`GentSchultzLaw`, :class:`PerssonBrenerLaw`, :class:`ProcessZoneLaw`) map
+``v`` to ``Gamma`` and back; :func:`unload` runs one unloading; :func:`simulate_crack` runs a
+:class:`sweep.Scene` with the law of its material and interface (:func:`scene_law`) and returns
+a :class:`sweep.Result` row.
+
+Bulk and process zone together. A scene with a process zone (``pz_law`` "gent-schultz",
+``Gamma_pz(v) = dg (1 + (v/pz_v0)^pz_xi)`` for ``v > 0``, ``dg`` for ``v <= 0``) opens with
+the product
+
+.. math:: \Gamma(v) = \Gamma_{pz}(v)\,\hat\Gamma_{PB}(\hat v), \qquad \hat v = v/l_0,
+
+the process zone's work of separation times the bulk's Persson-Brener amplification of the
+scene's material (:class:`ProcessZoneLaw`). The product is the Persson-Brener argument with
+the rate-independent dg of the crack tip replaced by the process zone's ``Gamma_pz``: the bulk
+multiplies whatever energy the tip consumes (the form of Gent-Schultz's own factorization,
+``Gamma = dg_0 (1 + phi(a_T v))``, and of Persson-Brener's eq. with a rate-dependent
+``dg_0``); it holds where the process zone is small against the bulk's dissipative region,
+and the length l0 in ``vhat`` stays that of the rate-independent LJ zone (a first-order
+model). An elastic bulk (k = 1) gives ``Gamma = Gamma_pz`` (:class:`GentSchultzLaw`).
 """
 from __future__ import annotations
 
@@ -61,9 +77,9 @@ from ..scene import Numerics, Result
 from ..theory import (A_PULL_OFF_FORCE, jkr_contact_radius, jkr_indentation, pb_gamma_eff,
                      pb_gamma_eff_spectrum)
 
-__all__ = ["GentSchultzLaw", "PerssonBrenerLaw", "CrackFrontSolution", "unload",
-           "energy_release_rate", "crack_front_load", "pb_law_for_scene", "simulate_crack",
-           "constant_gamma_pull_off", "FIXED_GRIP_A_MIN"]
+__all__ = ["GentSchultzLaw", "PerssonBrenerLaw", "ProcessZoneLaw", "CrackFrontSolution",
+           "unload", "energy_release_rate", "crack_front_load", "pb_law_for_scene", "scene_law",
+           "simulate_crack", "constant_gamma_pull_off", "FIXED_GRIP_A_MIN"]
 
 #: 1/k - 1 at or below which the crack-front model is the elastic JKR contact at the constant
 #: Gamma = dg / sqrt(k), the geometric middle of Gamma(v) in [dg, dg/k]: its pull-off is then
@@ -71,6 +87,11 @@ __all__ = ["GentSchultzLaw", "PerssonBrenerLaw", "CrackFrontSolution", "unload",
 #: integration of a law that steep stalls (k = 0.998 at rate 1e9) or steps over the load
 #: minimum (k = 0.98 at rate 1e-4, a0 = 15: 1.452 for at least 1.5)
 NEARLY_ELASTIC = 0.05
+#: a process zone on a (nearly) elastic bulk whose term (v/pz_v0)^pz_xi at ten times the crack
+#: speed of the constant-Gamma contact is at most this is none: the closed form answers the
+#: scene, the term added to its error estimate (the Gent-Schultz law alone stiffens as pz_v0
+#: grows: at pz_v0 = 1e25 a_ref/tau0 the integrator stalled until the time budget ended it)
+NEGLIGIBLE_PROCESS_ZONE = 1e-9
 #: smallest initial contact radius (a_ref) of the crack-front model: below it a JKR contact
 #: is not stable under fixed grip (the model's physical limit, not a numerical one)
 FIXED_GRIP_A_MIN = 0.5
@@ -129,7 +150,8 @@ class GentSchultzLaw:
         self.g_max = math.inf
 
     def gamma(self, v):
-        v = np.asarray(v, dtype=float)
+        """``Gamma(v)``; ``c`` at ``v <= 0`` (a closing crack consumes no rate term)."""
+        v = np.maximum(np.asarray(v, dtype=float), 0.0)
         return (self.c * (1.0 + (v / self.v0) ** self.xi))[()]
 
     def speed(self, g):
@@ -157,7 +179,9 @@ def _pb_table(kind: str, n: float, k: float, weights: tuple, times: tuple):
     vh, g = vh[keep], g[keep]
     x, y = np.log(g - 1.0), np.log(vh)
     ok = np.concatenate([[True], np.diff(x) > 1e-12])     # strictly increasing abscissa
-    return PchipInterpolator(x[ok], y[ok]), float(g[0]), float(g[-1]), float(vh[0]), float(vh[-1])
+    vh.flags.writeable = g.flags.writeable = False        # shared by every law of the cache
+    return (PchipInterpolator(x[ok], y[ok]), float(g[0]), float(g[-1]), float(vh[0]),
+            float(vh[-1]), vh, g)
 
 
 class PerssonBrenerLaw:
@@ -190,7 +214,7 @@ class PerssonBrenerLaw:
             tab = _pb_table("mpl", self.n, self.k, (), ())
         else:
             tab = _pb_table("sls", 0.0, self.k, (1.0,), (1.0,))
-        self._spline, self._g_lo, self._g_hi, self._v_lo, self._v_hi = tab
+        self._spline, self._g_lo, self._g_hi, self._v_lo, self._v_hi, self._vh, self._g = tab
         self._dspline = self._spline.derivative()
         self._q = (self._g_lo - 1.0) / self._v_lo      # linear-regime slope (Gamma-1)/vhat
         self.g_threshold = 1.0
@@ -222,14 +246,129 @@ class PerssonBrenerLaw:
         v[top] = self._v_hi
         return (v * self.l0)[()], (dv * self.l0)[()]
 
+    def table(self):
+        """The law's table: crack speeds (in the law's unit, ``vhat l0``) and ``Gamma`` there,
+        with the slope ``(Gamma - 1)/v`` of the linear regime below it (read only)."""
+        return self._vh * self.l0, self._g, self._q / self.l0
+
     def __repr__(self):
         return (f"PerssonBrenerLaw(material={self.material!r}, n={self.n:g}, k={self.k:g}, "
                 f"l0={self.l0:g})")
 
 
+#: points per decade of crack speed of :class:`ProcessZoneLaw`'s table, and the most decades it
+#: extends beyond the Persson-Brener table to hold the process zone's own range
+PZ_TABLE_PER_DECADE = 20
+PZ_TABLE_MAX_DECADES = 200
+
+
+class ProcessZoneLaw:
+    r"""A process zone in a viscoelastic bulk: :math:`\Gamma(v) = \Gamma_{pz}(v)\,
+    \hat\Gamma_{PB}(v/l_0)` (normalized by dg; the module docstring argues the product).
+
+    The inverse ``V(g)`` is a monotone (PCHIP) interpolation of ``ln v`` against
+    ``ln(Gamma - 1)`` on the bulk's table (:meth:`PerssonBrenerLaw.table`), extended below it
+    with the bulk's linear regime and above it with its last value (~1/k) until the process
+    zone's term spans ``(v/v0)^xi`` from 1e-10 to 1e8 (at most
+    :data:`PZ_TABLE_MAX_DECADES` decades); beyond the table ``ln v`` continues linearly in
+    ``ln(Gamma - 1)`` with the end slopes (the power laws both terms tend to). ``Gamma(0) = 1``:
+    the edge is never pinned; no speed cap.
+
+    Parameters
+    ----------
+    process_zone : GentSchultzLaw
+        ``Gamma_pz(v)`` with ``c = 1`` (the rate-independent dg at zero speed).
+    bulk : PerssonBrenerLaw
+        The bulk's Persson-Brener law (same speed unit).
+    """
+
+    def __init__(self, process_zone, bulk):
+        if process_zone.c != 1.0:
+            raise InputError(f"c must be 1 for a process zone in a viscoelastic bulk "
+                             f"(got {process_zone.c:g})")
+        self.process_zone, self.bulk = process_zone, bulk
+        self.g_threshold = 1.0
+        self.g_max = math.inf
+        self._spline, self._dspline, self._ends = _product_table(
+            process_zone.v0, process_zone.xi, bulk.material, bulk.n, bulk.k, bulk.l0)
+
+    def process_zone_factor(self, v):
+        """``Gamma_pz(v) / dg``."""
+        return self.process_zone.gamma(v)
+
+    def bulk_factor(self, v):
+        """The bulk's Persson-Brener factor ``Gamma_PB(v / l0)``."""
+        return self.bulk.gamma(np.maximum(np.asarray(v, dtype=float), 0.0))
+
+    def gamma(self, v):
+        return (np.asarray(self.process_zone_factor(v)) * self.bulk_factor(v))[()]
+
+    def speed(self, g):
+        """``V(g)`` and ``dV/dg`` (0 where ``g <= 1``)."""
+        x = np.asarray(g, dtype=float) - 1.0
+        v, dv = np.zeros(x.shape), np.zeros(x.shape)
+        pos = x > 0
+        if pos.any():
+            (x_lo, y_lo, s_lo), (x_hi, y_hi, s_hi) = self._ends
+            lx = np.log(x[pos])
+            y = np.where(lx < x_lo, y_lo + s_lo * (lx - x_lo),
+                         np.where(lx > x_hi, y_hi + s_hi * (lx - x_hi),
+                                  self._spline(np.clip(lx, x_lo, x_hi))))
+            dy = np.where(lx < x_lo, s_lo, np.where(lx > x_hi, s_hi,
+                                                   self._dspline(np.clip(lx, x_lo, x_hi))))
+            v[pos] = np.exp(y)
+            dv[pos] = v[pos] * dy / x[pos]
+        return v[()], dv[()]
+
+    def __repr__(self):
+        return f"ProcessZoneLaw({self.process_zone!r}, {self.bulk!r})"
+
+
+@lru_cache(maxsize=32)
+def _product_table(v0, xi, material, n, k, l0):
+    """PCHIP of ``ln v`` against ``ln(Gamma - 1)`` for :class:`ProcessZoneLaw`, its
+    derivative, and the ends ``(x, y, slope)`` of the table at both sides."""
+    from scipy.interpolate import PchipInterpolator  # lazy: not on a BEM scene's path
+    bulk = PerssonBrenerLaw(n, k, l0, material)
+    v_pb, g_pb, q = bulk.table()
+    lo = math.log10(v0) - min(10.0 / xi, PZ_TABLE_MAX_DECADES)
+    hi = math.log10(v0) + min(8.0 / xi, PZ_TABLE_MAX_DECADES)
+    lo_pb, hi_pb = math.log10(v_pb[0]), math.log10(v_pb[-1])
+    below = np.logspace(lo, lo_pb, max(int((lo_pb - lo) * PZ_TABLE_PER_DECADE), 1) + 1)[:-1] \
+        if lo < lo_pb else np.empty(0)
+    above = np.logspace(hi_pb, hi, max(int((hi - hi_pb) * PZ_TABLE_PER_DECADE), 1) + 1)[1:] \
+        if hi > hi_pb else np.empty(0)
+    v = np.concatenate([below, v_pb, above])
+    gb = np.concatenate([1.0 + q * below, g_pb, np.full(above.shape, g_pb[-1])])
+    g = (1.0 + (v / v0) ** xi) * gb
+    x, y = np.log(g - 1.0), np.log(v)
+    ok = np.concatenate([[True], np.diff(x) > 1e-12])     # strictly increasing abscissa
+    x, y = x[ok], y[ok]
+    spline = PchipInterpolator(x, y)
+    ends = ((x[0], y[0], (y[1] - y[0]) / (x[1] - x[0])),
+            (x[-1], y[-1], (y[-1] - y[-2]) / (x[-1] - x[-2])))
+    return spline, spline.derivative(), ends
+
+
 def pb_law_for_scene(n, k, mu, material="mpl") -> PerssonBrenerLaw:
     """The PB law of a dimensionless scene: speeds in ``a_ref/tau0``, ``l0 = l0_hat(mu)``."""
     return PerssonBrenerLaw(n, k, units.l0_hat(mu), material)
+
+
+def scene_law(n, k, mu, material="mpl", pz_law="none", pz_v0=None, pz_xi=None):
+    """``Gamma(v)`` of the crack-front model for a dimensionless scene (speeds in a_ref/tau0):
+    the bulk's Persson-Brener law (:func:`pb_law_for_scene`, k < 1) without a process zone;
+    with the Gent-Schultz one (``pz_v0`` in a_ref/tau0, ``pz_xi``) the product
+    :class:`ProcessZoneLaw`, or :class:`GentSchultzLaw` alone for an elastic bulk (k = 1).
+    (:func:`simulate_crack` treats a nearly elastic bulk, 1/k - 1 <= :data:`NEARLY_ELASTIC`,
+    with a constant bulk factor instead.)"""
+    pz_law = check_choice("pz_law", pz_law, ("none", "gent-schultz"))
+    if pz_law == "none":
+        return pb_law_for_scene(n, k, mu, material)
+    process_zone = GentSchultzLaw(pz_v0, pz_xi)
+    if k == 1.0:
+        return process_zone
+    return ProcessZoneLaw(process_zone, pb_law_for_scene(n, k, mu, material))
 
 
 # ============================================================================ unloading
@@ -426,7 +565,11 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
 
 
 def simulate_crack(scene, numerics=None):
-    """Run a :class:`sweep.Scene` with the crack-front model and its material's PB law.
+    """Run a :class:`sweep.Scene` with the crack-front model and its law :func:`scene_law`:
+    the material's PB law, times the Gent-Schultz process zone where the scene has one (a
+    nearly elastic bulk, 1/k - 1 <= :data:`NEARLY_ELASTIC`, contributes the constant factor
+    ``c = 1/sqrt(k)``, its ``error_estimate`` ``c - 1``; 0 at k = 1; there a process zone
+    below :data:`NEGLIGIBLE_PROCESS_ZONE` is none).
 
     Returns a :class:`sweep.Result` (the BEM's row format): ``pull_off``, ``a_pulloff``,
     ``delta_pulloff``, ``t_pulloff``, ``crack_speed``, ``vhat``, ``rhat_pb``, ``a0_result``,
@@ -444,10 +587,27 @@ def simulate_crack(scene, numerics=None):
                       f"{FIXED_GRIP_A_MIN:g} a_ref a JKR contact is not stable under fixed grip "
                       f"(the crack-front model, the mu -> infinity limit, starts at or above it)")
         return res
-    if 1.0 / scene.k - 1.0 <= NEARLY_ELASTIC * (1.0 + 1e-12):
-        return _elastic_crack(scene, res, t_start)
+    nearly_elastic = 1.0 / scene.k - 1.0 <= NEARLY_ELASTIC * (1.0 + 1e-12)
+    if nearly_elastic:
+        closed = _elastic_crack(scene, Result(scene=scene, numerics=numerics), t_start)
+        if scene.pz_law == "none":
+            return closed
+        # a process zone too weak to count: its Gent-Schultz term at ten times the crack
+        # speed of the constant-Gamma contact (the indentation speed where that has none)
+        v = closed.crack_speed if math.isfinite(closed.crack_speed) else \
+            scene.rate * units.h0_hat(scene.mu)
+        term = (10.0 * v / scene.pz_v0) ** scene.pz_xi
+        if term <= NEGLIGIBLE_PROCESS_ZONE:
+            closed.error_estimate += term
+            return closed
     try:
-        law = pb_law_for_scene(scene.n, scene.k, scene.mu, scene.material)
+        if nearly_elastic:         # the bulk a constant factor c = 1/sqrt(k), as _elastic_crack
+            c = 1.0 / math.sqrt(scene.k)
+            law = GentSchultzLaw(scene.pz_v0, scene.pz_xi, c=c)
+            res.error_estimate = c - 1.0
+        else:
+            law = scene_law(scene.n, scene.k, scene.mu, scene.material, scene.pz_law,
+                            scene.pz_v0, scene.pz_xi)
         s = unload(law, rate=scene.rate, mu=scene.mu, a0=scene.a0, delta0=scene.delta0,
                    stop=scene.stop, time_budget_s=numerics.time_budget_s)
     except NUMERICAL_ERRORS as exc:   # reported; a bug (TypeError, ...) raises

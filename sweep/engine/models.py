@@ -9,7 +9,10 @@ bem      the boundary-element model (:func:`sweep.engine.bem.simulate`): LJ inte
          around the crack tip that follows it (:mod:`sweep.engine.tip_following`,
          :func:`wants_tip_following`)
 crack    the crack-front model (:func:`sweep.engine.crack_front.simulate_crack`): JKR contact whose
-         edge opens with the Persson-Brener Gamma(v) of the scene's spectrum
+         edge opens with the Persson-Brener Gamma(v) of the scene's spectrum, times the
+         process zone's Gamma_pz(v) where the scene has one (``pz_law``): the one model
+         that runs a rate-dependent process zone (the others refuse it,
+         :data:`PROCESS_ZONE_REFUSALS`)
 pb       the paper's closed-form estimate (:func:`pb_estimate`): the crack speed at pull-off
          from the paper's fit vhat = 2.887 rhat_PB^1.171, Gamma_PB at that speed, and the
          load-control JKR pull-off with it, P = 1.5 Gamma_PB
@@ -17,7 +20,7 @@ elastic  the quasi-static elastic branch (:func:`sweep.engine.quasistatic.simula
          hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100; "bem" and
          "auto" scenes that are elastic and quasi-static run it (:func:`wants_quasistatic`)
 auto     the cheapest model whose error meets ``numerics.pull_off_rtol`` (:func:`model_choice`):
-         the elastic branch for elastic quasi-static scenes; the PB estimate or the
+         the crack-front model for a scene with a process zone; the elastic branch for elastic quasi-static scenes; the PB estimate or the
          crack-front model where their error against the BEM, measured over a random sample
          (:func:`measured_error`, ``make model-errors``), fits; else the BEM (graded or
          tip-following mesh), and the crack-front model where the BEM fails for a reason the
@@ -51,7 +54,7 @@ from .problem import BEM_MU_RANGE, derive
 from .resolution import refined, unresolved
 from .quasistatic import simulate_elastic
 
-__all__ = ["MODELS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
+__all__ = ["MODELS", "PROCESS_ZONE_REFUSALS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
            "simulate_scene", "choose_model", "model_choice", "Choice", "measured_error",
            "bem_nodes_needed", "bem_node_budget", "wants_quasistatic", "wants_tip_following"]
 
@@ -273,13 +276,17 @@ def _accepts(model: str, scene) -> bool:
 
 
 def model_choice(scene, numerics=None) -> Choice:
-    """The model "auto" runs first for ``scene``: the quasi-static elastic branch for an
-    elastic quasi-static scene; beyond the BEM's Tabor range the crack-front model, its
+    """The model "auto" runs first for ``scene``: the crack-front model for a scene with a
+    process zone (``pz_law``; the other models refuse it); the quasi-static elastic branch
+    for an elastic quasi-static scene; beyond the BEM's Tabor range the crack-front model, its
     mu -> infinity limit; else the cheapest model (:data:`BY_COST`) whose
     :func:`measured_error` at the smallest amplification meets ``numerics.pull_off_rtol``,
     else the BEM (graded or tip-following mesh). :func:`simulate_model` checks a cheaper
     model's error again at the amplification it computed and runs the BEM where it misses."""
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if scene.pz_law != "none":
+        return Choice("crack", f"auto: crack-front model, the one model with a rate-dependent "
+                               f"process zone (pz_law {scene.pz_law})")
     bem_ok = _accepts("bem", scene)
     if wants_quasistatic(scene, numerics) and bem_ok:
         return Choice("elastic", "auto: k = 1, quasi-static: the elastic branch")
@@ -329,10 +336,11 @@ MODELS = {"bem": _bem, "crack": simulate_crack, "pb": simulate_pb, "elastic": si
 def wants_quasistatic(scene, numerics) -> bool:
     """Whether a "bem" or "auto" scene is elastic and quasi-static, so that the equilibrium
     branch (:mod:`sweep.engine.quasistatic`) answers it without the hereditary machinery: k = 1,
-    started from a0, stopped at the pull-off, on the engine's own mesh (an explicit
+    no process zone (a rate-dependent interface is not quasi-static), started from a0,
+    stopped at the pull-off, on the engine's own mesh (an explicit
     ``numerics.domain`` or ``exact`` asks for the hereditary BEM on that domain)."""
     return (scene.k == 1.0 and scene.a0 is not None and scene.stop == "pulloff"
-            and numerics.domain is None and not numerics.exact)
+            and numerics.domain is None and not numerics.exact and scene.pz_law == "none")
 
 
 def _model_error(model: str, scene, res) -> float:
@@ -342,8 +350,25 @@ def _model_error(model: str, scene, res) -> float:
     return measured_error(model, scene.mu, amplification(res.pull_off)) + own
 
 
+#: why each model but the crack-front one refuses a scene with a process zone (``pz_law``): a
+#: failed row with this reason (not a physical refusal: the crack-front model answers it)
+PROCESS_ZONE_REFUSALS = {
+    "bem": "the BEM's interface is the rate-independent Lennard-Jones law: a scene with a "
+           "rate-dependent process zone (pz_law {pz_law}) runs with model crack or auto",
+    "elastic": "the elastic branch is quasi-static and its interface rate independent: a "
+               "scene with a rate-dependent process zone (pz_law {pz_law}) runs with model "
+               "crack or auto",
+    "pb": "the pb estimate's v-r fit was measured without a process zone: a scene with "
+          "pz_law {pz_law} runs with model crack or auto",
+}
+
+
 def _run(model: str, scene, numerics) -> Result:
-    """``MODELS[model]``; a numerical failure is a failed result, a bug raises."""
+    """``MODELS[model]``; a numerical failure is a failed result, a bug raises; a scene with
+    a process zone that the model has no law for is refused (:data:`PROCESS_ZONE_REFUSALS`)."""
+    if scene.pz_law != "none" and model in PROCESS_ZONE_REFUSALS:
+        return Result(scene=scene, numerics=numerics, status="failed",
+                      reason=PROCESS_ZONE_REFUSALS[model].format(pz_law=scene.pz_law))
     try:
         budget.check(f"the {NAMES[model]}'s start")
         return MODELS[model](scene, numerics)
@@ -387,7 +412,7 @@ def _simulate_model(scene, model: str, numerics) -> Result:
 
     res = run(choice.model)
     if model == "auto" and choice.model in ("crack", "pb") and scene.mu <= BEM_MU_RANGE[1] \
-            and not res.error_estimate <= numerics.pull_off_rtol:
+            and scene.pz_law == "none" and not res.error_estimate <= numerics.pull_off_rtol:
         miss = (f"auto: BEM: the {NAMES[choice.model]}'s measured error at its amplification "
                 f"{amplification(res.pull_off):.3g}, {res.error_estimate:.2g}, exceeds "
                 f"pull_off_rtol {numerics.pull_off_rtol:g}" if res.ok else

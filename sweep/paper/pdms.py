@@ -15,7 +15,12 @@ Models (all in :mod:`sweep.engine.crack_front` / :mod:`sweep.engine.models`):
 * ``crack_pb`` -- crack-front model, Gamma(v) = Persson-Brener of the MPL spectrum (linear
   viscoelasticity, the analogue of the paper's (P_po)_lin);
 * ``crack_gs`` -- crack-front model, Gamma(v) = dg (1 + (v/v0)^xi) with the paper's fit of the
-  experiments, v0 = 213.5 um/s, xi = 0.4154 (the analogue of the paper's green dashed line);
+  experiments, v0 = 213.5 um/s, xi = 0.4154 (the analogue of the paper's green dashed line):
+  the engine's process zone (``pz_law`` gent-schultz) in an elastic relaxed bulk (k = 1);
+* ``crack_pb_pz`` -- crack-front model with both dissipations (issue 35): the MPL bulk's
+  Persson-Brener factor times the process zone whose ratio the paper fitted,
+  Gamma_pz(v) = dg (1 + (v/v1)^(1/2)), v1 = 1e4 um/s (its Fig. comparison (b), right axis);
+  :func:`bulk_and_process_zone` gives the share of each in dg_eff at the paper's speeds;
 * ``pb_estimate`` -- the paper's closed-form chain: crack speed from its v-r fit
   vhat = 2.887 rhat^1.171 and P = 1.5 Gamma_PB(vhat), with rhat = r tau0/d_ref (docs/design.md section 2);
 * ``pb_estimate_l0`` -- the same with rhat = r tau0/l0, the convention the paper uses in its
@@ -54,7 +59,7 @@ import yaml
 from scipy.optimize import brentq
 
 from .. import units
-from ..engine.crack_front import GentSchultzLaw, pb_law_for_scene, unload
+from ..engine.crack_front import scene_law, unload
 from ..errors import InputError
 from ..campaign.si import SIScene
 from ..theory import A_PULL_OFF_FORCE, gent_schultz, paper_v_vs_r_fit, pb_gamma_eff
@@ -81,7 +86,9 @@ CRACK_RTOL = 1e-11
 #: Where this project's own fits live (written by ``make threshold`` and ``make vr``).
 OWN_FIT_FILES = {"threshold": "results/threshold/fit.json", "v_vs_r": "results/vr/fit.json"}
 
-MODELS = ("crack_pb", "crack_gs", "pb_estimate", "pb_estimate_l0")
+MODELS = ("crack_pb", "crack_gs", "crack_pb_pz", "pb_estimate", "pb_estimate_l0")
+#: the crack-front models and the law of the context (:func:`_context`) each runs
+CRACK_MODELS = {"crack_pb": "law_pb", "crack_gs": "law_gs", "crack_pb_pz": "law_pb_pz"}
 
 
 def _speeds(spec) -> np.ndarray:
@@ -89,10 +96,20 @@ def _speeds(spec) -> np.ndarray:
     return np.logspace(a, b, int(num))
 
 
-def pdms_scene(speed_m_s: float, case=PDMS_CASE) -> SIScene:
+def pdms_scene(speed_m_s: float, case=PDMS_CASE, **process_zone) -> SIScene:
+    """The case as an SI scene at an unloading speed [m/s]; ``process_zone``: the SI keys
+    ``pz_law``, ``pz_v0`` [m/s], ``pz_xi``."""
     return SIScene(R=case["R"], E0=case["E0"], Einf=case["Einf"], nu=case["nu"], n=case["n"],
                    tau0=case["tau0"], dg=case["dg"], h0=case["h0"], preload=case["preload"],
-                   speed=speed_m_s)
+                   speed=speed_m_s, **process_zone)
+
+
+def _scene_law(si: SIScene, elastic_bulk: bool = False):
+    """The crack-front model's Gamma(v) of an SI scene (:func:`sweep.engine.crack_front.
+    scene_law` on its dimensionless form; ``elastic_bulk``: k = 1, the relaxed modulus)."""
+    d = si.dimensionless()
+    return scene_law(d["n"], 1.0 if elastic_bulk else d["k"], d["mu"], d["material"],
+                     d["pz_law"], d["pz_v0"], d["pz_xi"])
 
 
 def own_fits(root=ROOT) -> dict:
@@ -160,11 +177,14 @@ def _context(case) -> dict:
     si0 = pdms_scene(1e-6, case)
     sc = si0.scale
     d0 = si0.dimensionless()
-    gs = case["gent_schultz"]
+    gs, v1 = case["gent_schultz"], case["gs_over_linear"]
+    si_gs = pdms_scene(1e-6, case, pz_law="gent-schultz", pz_v0=gs["v0_um_s"] * 1e-6,
+                       pz_xi=gs["xi"])
+    si_pz = pdms_scene(1e-6, case, pz_law="gent-schultz", pz_v0=v1["v1_um_s"] * 1e-6,
+                       pz_xi=v1["exponent"])
     return {"si0": si0, "sc": sc, "tau0": si0.tau0, "k": si0.k, "n": si0.n, "mu": si0.mu,
-            "a0": d0["a0"], "law_pb": pb_law_for_scene(si0.n, si0.k, si0.mu),
-            "law_gs": GentSchultzLaw(float(sc.crack_speed_hat(gs["v0_um_s"] * 1e-6, si0.tau0)),
-                                     gs["xi"])}
+            "a0": d0["a0"], "law_pb": _scene_law(si0),
+            "law_gs": _scene_law(si_gs, elastic_bulk=True), "law_pb_pz": _scene_law(si_pz)}
 
 
 def model_pull_off(model, speeds_um, case=PDMS_CASE, ctx=None) -> dict:
@@ -172,7 +192,7 @@ def model_pull_off(model, speeds_um, case=PDMS_CASE, ctx=None) -> dict:
 
     Parameters
     ----------
-    model : {"crack_pb", "crack_gs", "pb_estimate", "pb_estimate_l0"}
+    model : {"crack_pb", "crack_gs", "crack_pb_pz", "pb_estimate", "pb_estimate_l0"}
     speeds_um : array_like
         Unloading speeds [um/s].
     """
@@ -180,8 +200,8 @@ def model_pull_off(model, speeds_um, case=PDMS_CASE, ctx=None) -> dict:
     sc, tau0, mu = ctx["sc"], ctx["tau0"], ctx["mu"]
     speeds_um = np.atleast_1d(np.asarray(speeds_um, dtype=float))
     rates = np.array([float(sc.rate_hat(v * 1e-6, tau0)) for v in speeds_um])
-    if model in ("crack_pb", "crack_gs"):
-        law = ctx["law_pb"] if model == "crack_pb" else ctx["law_gs"]
+    if model in CRACK_MODELS:
+        law = ctx[CRACK_MODELS[model]]
         rows = [unload(law, rate=r, mu=mu, a0=ctx["a0"], rtol=CRACK_RTOL) for r in rates]
         return {"pull_off_mN": [float(sc.load_physical(r.pull_off)) * 1e3 for r in rows],
                 "crack_speed_um_s": [float(sc.crack_speed_physical(r.crack_speed, tau0)) * 1e6
@@ -511,6 +531,65 @@ def gs_over_bem(case=PDMS_CASE, bem=None, fits=None, ctx=None, pf=None) -> dict:
     return out
 
 
+#: unloading speeds [um/s] of the bulk + process-zone shares (the paper's range)
+SHARE_SPEEDS_UM_S = (1.0, 10.0, 100.0, 1.0e3, 1.0e4)
+
+
+def bulk_and_process_zone(case=PDMS_CASE, ctx=None, speeds=SHARE_SPEEDS_UM_S) -> dict:
+    r"""Bulk and process zone together (issue 35): the crack-front model with Gamma(v) =
+    Gamma_pz(v) Gamma_PB(v/l0), the MPL bulk of the case times the process zone whose ratio
+    the paper fitted, Gamma_pz = dg (1 + (v/v1)^(1/2)) with v1 = 1e4 um/s (``gs_over_linear``),
+    beside the bulk alone and the Gent-Schultz fit of the experiments (``crack_gs``), at the
+    unloading speeds ``speeds`` [um/s].
+
+    At the pull-off the edge opens with ``dg_eff = Gamma(v_po) = f_bulk f_pz``; the shares of
+    the two dissipations are those of the logarithm, ``ln f_bulk / ln(dg_eff/dg)`` and
+    ``ln f_pz / ln(dg_eff/dg)`` (the product makes them add up to 1). ``product_check``: the
+    largest ``|f_bulk f_pz / g - 1|`` against the ``g`` the integrator opened the edge with
+    (the law's table inverted).
+
+    Returns
+    -------
+    dict
+        ``speeds_um_s``; pull-offs [mN] ``bulk`` (crack_pb), ``bulk_pz`` (crack_pb_pz),
+        ``gs_fit`` (crack_gs); ``bulk_pz_over_gs`` (relative difference from the experiments'
+        fit), ``bulk_pz_over_bulk``; at the bulk + process zone's pull-off: its crack speed
+        [um/s], ``dg_eff`` (/dg, the product of the factors), ``bulk_factor``, ``process_zone_factor``, ``bulk_share``,
+        ``process_zone_share``; ``law`` (text), ``wall_s_per_scene`` (the crack-front runs
+        of the bulk + process-zone curve).
+    """
+    ctx = ctx or _context(case)
+    speeds = np.asarray(speeds, dtype=float)
+    t0 = time.perf_counter()
+    both = model_pull_off("crack_pb_pz", speeds, case, ctx)
+    wall = (time.perf_counter() - t0) / speeds.size
+    bulk = model_pull_off("crack_pb", speeds, case, ctx)
+    gs = model_pull_off("crack_gs", speeds, case, ctx)
+    law, sc, tau0 = ctx["law_pb_pz"], ctx["sc"], ctx["tau0"]
+    v_hat = np.array([float(sc.crack_speed_hat(v * 1e-6, tau0)) for v in both["crack_speed_um_s"]])
+    f_pz = np.asarray(law.process_zone_factor(v_hat), dtype=float)
+    f_bulk = np.asarray(law.bulk_factor(v_hat), dtype=float)
+    g = np.asarray(both["gamma_pulloff"], dtype=float)
+    p_both, p_bulk, p_gs = (np.asarray(x["pull_off_mN"]) for x in (both, bulk, gs))
+    v1 = case["gs_over_linear"]
+    return {
+        "law": (f"Gamma(v) = dg (1 + (v/v1)^{v1['exponent']:g}) Gamma_PB(v/l0), v1 = "
+                f"{v1['v1_um_s']:g} um/s (the paper's fitted ratio), crack-front model"),
+        "speeds_um_s": speeds.tolist(),
+        "pull_off_mN": {"bulk": p_bulk.tolist(), "bulk_pz": p_both.tolist(),
+                        "gs_fit": p_gs.tolist()},
+        "bulk_pz_over_gs": (p_both / p_gs - 1.0).tolist(),
+        "bulk_pz_over_bulk": (p_both / p_bulk).tolist(),
+        "crack_speed_um_s": both["crack_speed_um_s"],
+        "dg_eff": (f_bulk * f_pz).tolist(), "bulk_factor": f_bulk.tolist(),
+        "process_zone_factor": f_pz.tolist(),
+        "product_check": float(np.max(np.abs(f_bulk * f_pz / g - 1.0))),
+        "bulk_share": (np.log(f_bulk) / np.log(f_bulk * f_pz)).tolist(),
+        "process_zone_share": (np.log(f_pz) / np.log(f_bulk * f_pz)).tolist(),
+        "status": both["status"], "wall_s_per_scene": wall,
+    }
+
+
 def compute(case=PDMS_CASE, fits=None, bem=None) -> dict:
     """Every number of the PDMS report (SI unless the key says otherwise).
 
@@ -588,6 +667,7 @@ def compute(case=PDMS_CASE, fits=None, bem=None) -> dict:
                 "(h0 scaled) on the tip-following mesh and carried over to the PDMS's mu by "
                 "the crack-front model's ratio"),
         "gs_over_bem": gs_over_bem(case, bem, fits, ctx, pf),
+        "bulk_and_process_zone": bulk_and_process_zone(case, ctx),
         "discussion_paper_protocol": ours_pp,
         "gs_over_linear": {
             "divides_by": ("Gamma_PB(v): the infinite-size Persson-Brener effective surface "
@@ -620,6 +700,7 @@ def plot(res: dict, out) -> Path:
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
     styles = {"crack_pb": ("k-", "crack front, PB Gamma(v) (linear)"),
               "crack_gs": ("g--", "crack front, Gent-Schultz fit"),
+              "crack_pb_pz": ("m-", "crack front, PB bulk x process zone 1 + (v/v1)^(1/2)"),
               "pb_estimate": ("b:", "PB estimate, rhat = r tau0/d_ref"),
               "pb_estimate_l0": ("c-.", "PB estimate, rhat = r tau0/l0")}
     for name, (st, label) in styles.items():
@@ -663,6 +744,10 @@ def plot(res: dict, out) -> Path:
             vb = dict(zip(gb["speeds_um_s"], gb["crack_speed_um_s"]))
             ax3.semilogx([vb[b["speed_um_s"]] for b in okb], [b["ratio"] for b in okb], "rs",
                          ms=6, label="GS(v(r)) P_JKR / P_lin(r), BEM (paper's definition)")
+    bp = res.get("bulk_and_process_zone")
+    if bp:
+        ax3.semilogx(bp["crack_speed_um_s"], bp["process_zone_factor"], "m*", ms=8,
+                     label="process-zone factor at pull-off, bulk x process zone (engine)")
     ax3.set_ylabel("ratio")
     h1, l1 = ax2.get_legend_handles_labels()
     h2, l2 = ax3.get_legend_handles_labels()
@@ -747,6 +832,54 @@ def _gs_over_bem_lines(res: dict) -> list[str]:
     return L
 
 
+def _bulk_and_process_zone_lines(res: dict) -> list[str]:
+    """Bulk and process zone together, their shares in dg_eff (:func:`bulk_and_process_zone`)."""
+    b = res.get("bulk_and_process_zone")
+    if not b:
+        return []
+    p = b["pull_off_mN"]
+    L = ["## Bulk and process zone together (issue 35)", "",
+         f"The crack-front model with {b['law']}: the engine's scene fields pz_law "
+         "gent-schultz, pz_v0 = v1, pz_xi = 1/2 (sweep/engine/crack_front.py, "
+         "`ProcessZoneLaw`). At the pull-off dg_eff/dg = Gamma(v_po) = f_bulk f_pz; the shares "
+         "are those of ln(dg_eff/dg). The Gent-Schultz fit of the experiments is the crack-front "
+         "model with the paper's fit 1 + (v/v0)^xi in the relaxed (elastic) bulk.", "",
+         "| r [um/s] | bulk only [mN] | bulk x process zone [mN] | GS fit of the experiments "
+         "[mN] | bulk x pz / GS - 1 | crack speed [um/s] | dg_eff/dg | bulk factor | "
+         "process-zone factor | bulk share | process-zone share |",
+         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for i, r in enumerate(b["speeds_um_s"]):
+        L.append(f"| {r:g} | {p['bulk'][i]:.3f} | {p['bulk_pz'][i]:.3f} | {p['gs_fit'][i]:.3f} "
+                 f"| {100 * b['bulk_pz_over_gs'][i]:+.1f} % | {b['crack_speed_um_s'][i]:.4g} | "
+                 f"{b['dg_eff'][i]:.3f} | {b['bulk_factor'][i]:.3f} | "
+                 f"{b['process_zone_factor'][i]:.3f} | {100 * b['bulk_share'][i]:.1f} % | "
+                 f"{100 * b['process_zone_share'][i]:.1f} % |")
+    over = b["bulk_pz_over_gs"]
+    above = [f"{r:g}" for r, x, y in zip(b["speeds_um_s"], p["bulk"], p["gs_fit"]) if x > y]
+    ratio = [v / r for v, r in zip(b["crack_speed_um_s"], b["speeds_um_s"])]
+    meets = "meets" if min(abs(x) for x in over) < 0.05 else "does not meet"
+    L += ["", f"Bulk x process zone {meets} the experiments' fit: it lies "
+          f"{100 * min(over):+.0f} % to {100 * max(over):+.0f} % from it over "
+          f"{b['speeds_um_s'][0]:g}-{b['speeds_um_s'][-1]:g} um/s; the bulk alone lies above "
+          f"it at {', '.join(above) or 'none'} um/s (its crack speed at pull-off is "
+          f"{min(ratio):.0f}-{max(ratio):.0f} times the unloading speed, while the paper took "
+          "its ratio at the v-r fit's crack speed). The process zone's factor at pull-off rises from "
+          f"{b['process_zone_factor'][0]:.3f} to {b['process_zone_factor'][-1]:.3f}; its share of "
+          f"ln dg_eff from {100 * b['process_zone_share'][0]:.0f} % to "
+          f"{100 * b['process_zone_share'][-1]:.0f} %. Product check max |f_bulk f_pz / Gamma - 1| "
+          f"= {b['product_check']:.1g}; {b['wall_s_per_scene'] * 1e3:.0f} ms a scene at the "
+          "script's integrator tolerance 1e-11.",
+          "", f"The preload's contact, a0 = {res['a0_preload_hat']:.3f} a_ref, reaches the "
+          "load-control pull-off 1.5 pi R dg_eff only where a0 >= 1.040 (dg_eff/dg)^(1/3) "
+          "(the threshold radius of the crack-front model): at r = " + (", ".join(
+              f"{r:g}" for r, g in zip(b["speeds_um_s"], b["dg_eff"])
+              if res["a0_preload_hat"] >= A_PULL_OFF_FORCE * g ** (1 / 3)) or "none")
+          + " um/s; above, that radius exceeds the contact's own (which only shrinks), the "
+          "pull-off stays below 1.5 pi R dg_eff, and the process zone's factor appears only in "
+          "part in the force."]
+    return L
+
+
 def report(res: dict, out) -> Path:
     pv = _paper_values()
     pp = res.get("paper") or {}
@@ -808,15 +941,19 @@ def report(res: dict, out) -> Path:
          f"at r = 1e4 um/s (crack speed "
          f"{res['gs_over_linear']['pull_off_ratio_crack_speed_um_s'][-1]:.3g} um/s) | "
          f"{res['gs_over_linear']['pull_off_ratio_crack_front'][-1]:.3f} | -- |",
-         "", *_gs_over_bem_lines(res), "", "## Pull-off force [mN]", "",
-         "| r [um/s] | crack front, PB | crack front, GS | PB estimate (d_ref) | PB estimate (l0) | crack speed, PB [um/s] |",
-         "| --- | --- | --- | --- | --- | --- |"]
+         "", *_gs_over_bem_lines(res), "", *_bulk_and_process_zone_lines(res),
+         "", "## Pull-off force [mN]", "",
+         "| r [um/s] | crack front, PB | crack front, GS | crack front, PB x process zone | "
+         "PB estimate (d_ref) | PB estimate (l0) | crack speed, PB [um/s] |",
+         "| --- | --- | --- | --- | --- | --- | --- |"]
     for i in pick:
         p = res["pull_off_mN"]
         L.append(f"| {speeds[i]:g} | {p['crack_pb'][i]:.4f} | {p['crack_gs'][i]:.4f} | "
+                 f"{p['crack_pb_pz'][i]:.4f} | "
                  f"{p['pb_estimate'][i]:.4f} | {p['pb_estimate_l0'][i]:.4f} | "
                  f"{res['models']['crack_pb']['crack_speed_um_s'][i]:.3g} |")
     names = {"crack_pb": "crack front, PB", "crack_gs": "crack front, GS",
+             "crack_pb_pz": "crack front, PB x process zone",
              "pb_estimate": "PB estimate (d_ref)", "pb_estimate_l0": "PB estimate (l0)"}
     L += ["", "## Slow limit", "",
           f"Speed below which each model's pull-off is within {100 * sl['tolerance']:g} % of the "

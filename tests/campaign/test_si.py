@@ -106,6 +106,19 @@ def test_cli_scene_si_json(capsys):
     assert d["scene"]["rate"] == pytest.approx(0.60909, rel=1e-4)
 
 
+def test_cli_scene_si_process_zone_in_m_s(capsys):
+    """`sweep scene --si --pz-law gent-schultz --pz-v0 V --pz-xi X`: V in m/s, the same
+    pull-off as run_si's, above the scene without a process zone."""
+    pz = ["--pz-law", "gent-schultz", "--pz-v0", "213.5e-6", "--pz-xi", "0.4154"]
+    assert main(SI_ARGS + ["--model", "crack", "--json"] + pz) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["scene"]["pz_law"] == "gent-schultz"
+    assert d["scene"]["pz_v0"] == pytest.approx(213.5e-6 * d["si"]["tau0"] / d["a_ref_m"],
+                                                rel=1e-12)
+    assert main(SI_ARGS + ["--model", "crack", "--json"]) == 0
+    assert d["pull_off"] > json.loads(capsys.readouterr().out)["pull_off"]
+
+
 @pytest.mark.parametrize("extra, message", [
     ([], "mu must be in"),                                   # bem at mu = 103
     (["--model", "crack", "--rate", "1"], "--rate: dimensionless options cannot"),
@@ -251,3 +264,40 @@ def test_angstrom_h0_runs_the_crack_front_model_in_a_sweep_config():
     assert 6000 < scene.mu < 7000
     res = simulate(scene, cfg.numerics)
     assert res.model_used == "crack" and res.ok and "beyond the BEM's range" in res.model_reason
+
+
+def test_si_process_zone_keys_are_converted_and_run(tmp_path, capsys):
+    """`pz_law`, `pz_v0` [m/s], `pz_xi` in an SI grid: pz_v0 becomes a_ref/tau0, the row
+    records the law, `sweep info --si` shows it; the pull-off equals run_si's and exceeds the
+    bulk-only one; pb refuses it."""
+    si = pdms(speed=1e-5, pz_law="gent-schultz", pz_v0=213.5e-6, pz_xi=0.4154)
+    d = si.dimensionless()
+    assert d["pz_v0"] == pytest.approx(213.5e-6 * si.tau0 / si.scale.a_ref, rel=1e-12)
+    assert si.to_scene().pz_law == "gent-schultz" and si.to_scene().pz_xi == 0.4154
+    with pytest.raises(InputError, match="pz_v0/pz_xi: a process-zone parameter needs"):
+        pdms(pz_v0=1e-4, pz_xi=0.5)
+    with pytest.raises(InputError, match="pz_v0 must be > 0"):
+        pdms(pz_law="gent-schultz", pz_v0=-1.0, pz_xi=0.5)
+    assert run_si(si, "pb")["status"] == "failed"
+    grid = ("  R: 5.19e-3\n  E0: 1.458e+6\n  Einf: 3.089e+9\n  nu: 0.5\n  n: 0.2207\n"
+            "  tau0: 0.01876\n  dg: 0.1523\n  h0: 30.8e-9\n  preload: 1.5e-3\n  speed: 1.0e-5\n")
+    p = tmp_path / "pz.yaml"
+    p.write_text("name: pz\nunits: si\ngrid:\n- model: crack\n" + grid + "- model: crack\n  pz_law: gent-schultz\n"
+                 "  pz_v0: 213.5e-6\n  pz_xi: 0.4154\n" + grid
+                 + f"output: {tmp_path / 'pz.h5'}\n")
+    assert main(["run", str(p), "-j", "1", "--progress", "none"]) == 0
+    from sweep.campaign.store import load, si_table
+
+    rows = load(tmp_path / "pz.h5")
+    pz = rows[rows.pz_law == "gent-schultz"].iloc[0]
+    bulk = rows[rows.pz_law == "none"].iloc[0]
+    assert pz.pz_v0 == pytest.approx(d["pz_v0"], rel=1e-12) and pz.pz_xi == 0.4154
+    assert pz.pull_off == pytest.approx(run_si(si, "crack")["pull_off"], rel=1e-9)
+    assert pz.pull_off > bulk.pull_off
+    df = si_table(tmp_path / "pz.h5")
+    assert set(df.si_pz_law) == {"none", "gent-schultz"}
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "pz.h5"), "--si"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert "pz_law" in out[0] and "pz_v0[m/s]" in out[0]
+    assert sum("gent-schultz" in ln for ln in out[1:]) == 1

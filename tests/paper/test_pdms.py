@@ -30,7 +30,8 @@ def test_keys_and_scales(res):
     for key in ("speeds_um_s", "pull_off_mN", "mu", "l0_nm", "a0t_mm",
                 "speed_full_amplification_m_s"):
         assert key in res
-    assert set(res["pull_off_mN"]) == {"crack_pb", "crack_gs", "pb_estimate", "pb_estimate_l0"}
+    assert set(res["pull_off_mN"]) == {"crack_pb", "crack_gs", "crack_pb_pz", "pb_estimate",
+                                       "pb_estimate_l0"}
     assert res["mu"] == pytest.approx(103, abs=0.5)
     assert res["l0_nm"] == pytest.approx(PV["l0_nm"], abs=0.05)
     assert res["speeds_um_s"][0] == pytest.approx(1e-6)
@@ -252,3 +253,33 @@ def test_report_labels_what_each_ratio_divides_by(tmp_path):
     assert "failed: time budget" in text
     # the full-amplification criterion and the paper's vhat reading beside the headline
     assert "criterion: Gamma_PB = 0.9/k" in text and "with the paper's reading vhat" in text
+
+
+def test_bulk_and_process_zone_shares(res):
+    """The bulk x process-zone curve (issue 35): above the bulk alone by the process zone's
+    factor at its crack speed (P ~ 1.5 pi R dg_eff for this large contact), its factors
+    multiply to the dg_eff the crack front opened with, and the shares of ln dg_eff add up
+    to 1, the process zone's growing with speed."""
+    b = res["bulk_and_process_zone"]
+    assert b["speeds_um_s"] == list(pdms.SHARE_SPEEDS_UM_S)
+    assert b["status"] == ["ok"] * 5
+    p = b["pull_off_mN"]
+    assert np.all(np.array(p["bulk_pz"]) > np.array(p["bulk"]))
+    v1 = PDMS_CASE["gs_over_linear"]["v1_um_s"]
+    f_pz = 1 + np.sqrt(np.array(b["crack_speed_um_s"]) / v1)
+    np.testing.assert_allclose(b["process_zone_factor"], f_pz, rtol=1e-9)
+    sc = pdms.pdms_scene(1e-6).scale
+    vhat = np.array(b["crack_speed_um_s"]) * 1e-6 * PDMS_CASE["tau0"] / sc.l0
+    np.testing.assert_allclose(b["bulk_factor"],
+                               pb_gamma_eff(PDMS_CASE["n"], res["k"], vhat), rtol=1e-9)
+    np.testing.assert_allclose(np.array(b["bulk_factor"]) * f_pz, b["dg_eff"], rtol=1e-5)
+    np.testing.assert_allclose(np.array(b["bulk_share"]) + b["process_zone_share"], 1.0,
+                               rtol=1e-12)
+    assert np.all(np.diff(b["process_zone_share"]) > 0)
+    # P(a, g) >= -1.5 g over every radius: the pull-off is at most 1.5 pi dg R dg_eff, and
+    # reaches it only where a0 >= 1.040 dg_eff^(1/3) (a0 = 1.75 a_ref: the two slowest)
+    bound = res["jkr_pull_off_mN"] * np.array(b["dg_eff"])
+    assert np.all(np.array(p["bulk_pz"]) <= bound * (1 + 1e-6))
+    large = res["a0_preload_hat"] >= A_PULL_OFF_FORCE * np.array(b["dg_eff"]) ** (1 / 3)
+    assert large[:2].all() and not large[-1]
+    np.testing.assert_allclose(np.array(p["bulk_pz"])[large], bound[large], rtol=0.05)
