@@ -14,7 +14,10 @@ and the campaign's config, as it resolves today, must still be the config the re
 computed from (its hash covers every scene id, hence the resolved numerics: a preset whose
 values changed changes it). ``tests/paper/test_committed_results.py`` runs it in ``make test``
 on every committed result, so a change of numerics or of the engine's numbers regenerates the
-committed results (``make reproduce``) or is refused, instead of leaving a stale report.
+committed results (``make reproduce``) or is refused, instead of leaving a stale report. The
+PDMS report (``results/pdms/pdms.json``, ``make pdms``) is checked there too: the campaign
+fits it used must be the committed ones, and its crack-front curves are computed again at five
+of its speeds.
 
 The tolerances are far above what the processor's last digits move (the same scene in two
 processes gives the same bits, ``tests/engine/test_reproducible.py``; another processor's

@@ -73,3 +73,23 @@ def test_the_sample_is_cheap_spread_and_keeps_failed_rows():
     median = df.wall_s[df.status == "ok"].median()
     assert all(df.wall_s[i] <= median for i in ok)
     assert len(bad) == 2 and all(df.status[i] == "failed" for i in bad)
+
+
+def test_committed_pdms_is_what_main_computes():
+    """results/pdms/pdms.json (make pdms): the fits it used are the committed campaigns' fits,
+    and main computes its crack-front curves again at five of its speeds, the pull-offs within
+    engine_check.PULL_OFF_RTOL (issue 33 item 4)."""
+    from sweep.paper import pdms
+
+    doc = json.loads((ROOT / "results" / "pdms" / "pdms.json").read_text())
+    fits = pdms.own_fits(ROOT)
+    for key, fit in doc["fits"].items():
+        assert fit["prefactor"] == pytest.approx(fits[key]["prefactor"], rel=1e-12), \
+            f"results/pdms/pdms.json used another {key} fit than results/: run make pdms"
+    speeds = doc["speeds_um_s"][::10]
+    picks = list(range(0, len(doc["speeds_um_s"]), 10))
+    for model in ("crack_pb", "crack_gs", "crack_pb_pz"):
+        now = pdms.model_pull_off(model, speeds)["pull_off_mN"]
+        then = [doc["pull_off_mN"][model][i] for i in picks]
+        assert now == pytest.approx(then, rel=ec.PULL_OFF_RTOL), \
+            f"results/pdms/pdms.json: main computes other {model} pull-offs: run make pdms"
