@@ -34,6 +34,7 @@ help:
 	@echo "make tip-convergence - tip-following BEM: pull-off vs spacing and window, mu = 30, 100 (k = 0.5) and 30 (k = 0.1, rate 10^2.5)"
 	@echo "make elastic-table - elastic pull-off vs mu (0.01 ... 100), quasi-static branch"
 	@echo "make calibrate-demo - fit a synthetic PDMS-like pull-off curve (results/calibrate/)"
+	@echo "make calibrate-pz-demo - fit a process zone to synthetic PDMS data, bulk from DMA (results/calibrate/pdms-pz/, ~1 min)"
 	@echo "make model-errors - crack-front model and PB estimate vs the BEM over mu (the table auto reads)"
 	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem (results/random/)"
 	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
@@ -193,6 +194,12 @@ agreement-high-mu: $(STAMP)
 # written by the command in the header of configs/calibrate/pdms-lens.yaml
 calibrate-demo: $(STAMP)
 	$(BIN)/sweep calibrate configs/calibrate/pdms-lens.yaml --out results/calibrate
+
+# issue 35 item 5: the process zone's pz_v0, pz_xi (and dg) fitted with the PDMS bulk fixed;
+# the CSV was written by the command in the header of configs/calibrate/pdms-pz.yaml
+.PHONY: calibrate-pz-demo
+calibrate-pz-demo: $(STAMP)
+	$(BIN)/sweep calibrate configs/calibrate/pdms-pz.yaml --out results/calibrate/pdms-pz
 
 # issue 21: the crack-front model's and the PB estimate's error against the BEM at each mu,
 # written into the package (sweep/engine/model_errors.json) for the model chooser

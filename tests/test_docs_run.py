@@ -166,11 +166,17 @@ def test_readme_tradeoff_counts_are_results_tradeoff():
     assert f"{len(table) // scenes} numerics x {scenes} scenes" in _page("docs/history.md")
 
 
-def test_calibration_table_is_results_calibrate():
-    """`make calibrate-demo`'s table and cost in docs/calibration.md quote
-    results/calibrate/calibration.json."""
-    cal = json.loads((ROOT / "results" / "calibrate" / "calibration.json").read_text())
+@pytest.mark.parametrize("result, section", [
+    ("results/calibrate/calibration.json", "# Calibrating to measurements"),
+    ("results/calibrate/pdms-pz/calibration.json", "## A process zone"),
+])
+def test_calibration_table_is_results_calibrate(result, section):
+    """`make calibrate-demo`'s and `make calibrate-pz-demo`'s tables and costs in
+    docs/calibration.md (the first table after ``section``) quote their calibration.json."""
+    cal = json.loads((ROOT / result).read_text())
     text = _page("docs/calibration.md")
+    assert section in text
+    text = text[text.index(section):]
     for name, p in cal["parameters"].items():
         row = re.search(rf"\| {name} [^|]*\| [^|]+ \| ([\d.]+) \| \[([\d.]+), ([\d.]+)[^|]*\] "
                         rf"\| ([\w ]+) \|", text)

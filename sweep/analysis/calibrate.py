@@ -16,7 +16,11 @@ Input: a YAML calibration file (:func:`load_calibration`)::
     numerics: {preset: fast}
 
 Every SI field but ``speed`` is either fixed or fitted (exactly one of ``preload``, ``a0``,
-``indentation``). A bound pair spanning a decade or more (and > 0) is searched in log scale,
+``indentation``). A rate-dependent process zone (issue 35) is optional: ``pz_law`` (``none``,
+the default, or ``gent-schultz``) is a ``fixed`` field (a law is chosen, not fitted); with a
+law, ``pz_v0`` [m/s] (the crack speed at which the process zone doubles the work of adhesion)
+and ``pz_xi`` are fixed or fitted like the other fields (``pz_v0: [1.0e-5, 1.0]`` is searched
+in log scale), without one they are not given. A bound pair spanning a decade or more (and > 0) is searched in log scale,
 otherwise linearly; ``[lo, hi, log]`` or ``[lo, hi, linear]`` forces the choice. Optional
 keys: ``material`` (mpl, sls), ``start`` (a starting point for the local fit), ``search``
 (``{points: 64, starts: 3, seed: 0}``, the coarse search), ``profile`` (``{points: 12,
@@ -84,7 +88,7 @@ from ..campaign.si import SI_AXES, SIScene, run_si
 from ..campaign.store import to_jsonable
 from ..engine import bem
 from ..errors import InputError, check_choice, check_int, check_range
-from ..scene import Numerics
+from ..scene import PZ_LAWS, PZ_PARAMETERS, Numerics
 from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
 from .plots import pyplot
 
@@ -93,8 +97,10 @@ __all__ = ["Parameter", "Calibration", "load_calibration", "calibration_from_dic
 
 #: the SI fields that may be fixed or fitted (every SI field of an SIScene but the speed)
 FIT_FIELDS = ("R", "E0", "Einf", "nu", "n", "tau0", "dg", "h0", "preload", "a0",
-              "indentation")
+              "indentation", *PZ_PARAMETERS)
 INITIAL_FIELDS = ("preload", "a0", "indentation")
+#: the process zone's law: a ``fixed`` field only (sweep.scene.PZ_LAWS)
+LAW_FIELD = "pz_law"
 DATA_COLUMNS = ("speed_m_s", "pull_off_N")
 CAL_MODELS = ("bem", "crack", "pb", "auto")
 TOP_KEYS = ("name", "description", "data", "fixed", "fit", "model", "numerics", "material",
@@ -265,6 +271,18 @@ def _read_yaml(p: Path) -> dict:
     return data
 
 
+def _check_process_zone(law: str, given: set) -> None:
+    """The process zone's parameters are given (fixed or fitted) exactly with a law."""
+    pz = [f for f in PZ_PARAMETERS if f in given]
+    if law == "none" and pz:
+        raise InputError(f"{', '.join(pz)}: a process-zone parameter needs fixed.pz_law "
+                         f"({', '.join(PZ_LAWS[1:])}; got none)")
+    missing = [f for f in PZ_PARAMETERS if f not in given]
+    if law != "none" and missing:
+        raise InputError(f"{', '.join(missing)}: missing; pz_law {law} needs pz_v0 [m/s] and "
+                         "pz_xi, each fixed or fitted")
+
+
 def calibration_from_dict(data, base=".", source="<dict>", measurements=None) -> Calibration:
     """Validate a calibration mapping (the YAML file's content).
 
@@ -295,6 +313,9 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
     for key, v in fixed_in.items():
         if key == "speed":
             raise InputError("fixed.speed: the speeds are the data's speed_m_s column")
+        if key == LAW_FIELD:
+            fixed[key] = check_choice(f"fixed.{key}", v, PZ_LAWS)
+            continue
         if key not in FIT_FIELDS:
             raise InputError(f"fixed.{key}: unknown SI field (allowed: {', '.join(FIT_FIELDS)})")
         lo, hi, lo_open = _limits(key)
@@ -303,13 +324,18 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
     for key, spec in fit_in.items():
         if key == "speed":
             raise InputError("fit.speed: the speeds are the data's speed_m_s column")
+        if key == LAW_FIELD:
+            raise InputError(f"fit.{key}: a law is chosen, not fitted; give it in fixed "
+                             f"({', '.join(PZ_LAWS)})")
         if key not in FIT_FIELDS:
             raise InputError(f"fit.{key}: unknown SI field (allowed: {', '.join(FIT_FIELDS)})")
         if key in fixed:
             raise InputError(f"{key}: both fixed and fitted; give it in one of fixed and fit")
         params.append(_bounds(key, spec, _limits(key)))
     given = set(fixed) | {p.name for p in params}
-    missing = [f for f in FIT_FIELDS if f not in INITIAL_FIELDS and f not in given]
+    _check_process_zone(fixed.get(LAW_FIELD, "none"), given)
+    missing = [f for f in FIT_FIELDS if f not in (*INITIAL_FIELDS, *PZ_PARAMETERS)
+               and f not in given]
     if missing:
         raise InputError(f"{', '.join(missing)}: missing; every SI field must be fixed or "
                          "fitted")
@@ -478,7 +504,8 @@ class SceneEvaluator:
         self._num_key = tuple(sorted((k, repr(v)) for k, v in cal.numerics.to_dict().items()))
 
     def key(self, fields: dict) -> tuple:
-        vals = tuple((k, float(f"{v:.{KEY_DIGITS}g}")) for k, v in sorted(fields.items()))
+        vals = tuple((k, v if isinstance(v, str) else float(f"{v:.{KEY_DIGITS}g}"))
+                     for k, v in sorted(fields.items()))
         return (self.cal.model, self.cal.material, self._num_key, vals)
 
     def predict(self, U, speeds=None) -> np.ndarray:

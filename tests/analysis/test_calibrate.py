@@ -2,7 +2,8 @@
 
 The fits use the crack-front model (model crack: one Persson-Brener table per (n, k), then
 about 20 ms a scene) on 4 speeds, with the free parameters chosen among those that leave
-the table unchanged (dg, tau0, h0), so the whole module runs a few thousand scenes.
+the table unchanged (dg, tau0, h0, and the process zone's pz_v0, pz_xi), so the whole
+module runs a few thousand scenes.
 """
 import json
 import math
@@ -34,12 +35,20 @@ def _problem(tmp_path, fit, fixed, data=None, **extra):
     return path
 
 
-def _synthetic(fit, fixed, truth, seed, sigma, repeats=1, noise=0.05):
+def _synthetic(fit, fixed, truth, seed, sigma, repeats=1, noise=0.05, speeds=SPEEDS):
     cal = cb.calibration_from_dict({"name": "s", "fixed": fixed, "fit": fit, "model": "crack"},
                                    measurements=([1.0] * 9, [1.0] * 9, None))
-    d = cb.synthesize(cal, truth, SPEEDS, repeats=repeats, noise=noise, seed=seed,
+    d = cb.synthesize(cal, truth, speeds, repeats=repeats, noise=noise, seed=seed,
                       sigma=sigma)
     return {k: [float(x) for x in v] for k, v in d.items()}
+
+
+def _fitted(tmp, fit, fixed, data, **extra):
+    """Calibrate a written problem (a search of 8 points, 1 start, profiles of 5 points)."""
+    path = _problem(tmp, fit, fixed, data, search={"points": 8, "starts": 1},
+                    profile={"points": 5}, **extra)
+    cal = cb.load_calibration(path)
+    return cal, cb.calibrate(cal, jobs=1, curve_points=5)
 
 
 # ------------------------------------------------------------------ fits with a known answer
@@ -51,10 +60,7 @@ def identifiable(tmp_path_factory):
     fixed = {**FIXED, "h0": TRUTH["h0"]}
     truth = {k: TRUTH[k] for k in fit}
     data = _synthetic(fit, fixed, truth, seed=2, sigma=True, repeats=2)
-    path = _problem(tmp, fit, fixed, data, search={"points": 8, "starts": 1},
-                    profile={"points": 5}, start={"dg": 1.0, "tau0": 1.0e-4}, truth=truth)
-    cal = cb.load_calibration(path)
-    return cal, cb.calibrate(cal, jobs=1, curve_points=5)
+    return _fitted(tmp, fit, fixed, data, start={"dg": 1.0, "tau0": 1.0e-4}, truth=truth)
 
 
 @pytest.fixture(scope="module")
@@ -66,10 +72,18 @@ def degenerate(tmp_path_factory):
     fixed = {**FIXED, "dg": TRUTH["dg"]}
     truth = {k: TRUTH[k] for k in fit}
     data = _synthetic(fit, fixed, truth, seed=3, sigma=False, repeats=2)
-    path = _problem(tmp, fit, fixed, data, search={"points": 8, "starts": 1},
-                    profile={"points": 5}, truth=truth)
-    cal = cb.load_calibration(path)
-    return cal, cb.calibrate(cal, jobs=1, curve_points=5)
+    return _fitted(tmp, fit, fixed, data, truth=truth)
+
+
+def _assert_recovered(res, names):
+    """Each parameter's interval holds its estimate and its truth, closed inside the box."""
+    for name in names:
+        p = res["parameters"][name]
+        lo, hi = p["interval"]
+        assert lo < p["estimate"] < hi
+        assert lo <= p["truth"] <= hi, (name, p)
+        assert p["identifiable"] and p["status"] == "identifiable"
+        assert p["bounds"][0] < lo and hi < p["bounds"][1]          # closed inside the box
 
 
 def test_truth_inside_the_intervals_from_a_bad_start(identifiable):
@@ -79,13 +93,7 @@ def test_truth_inside_the_intervals_from_a_bad_start(identifiable):
     assert first["start"]["dg"] == pytest.approx(1.0)
     assert first["start"]["tau0"] == pytest.approx(1e-4)
     assert first["ssr"] < 1e-3 * first["ssr_start"]
-    for name in ("dg", "tau0"):
-        p = res["parameters"][name]
-        lo, hi = p["interval"]
-        assert lo < p["estimate"] < hi
-        assert lo <= p["truth"] <= hi, (name, p)
-        assert p["identifiable"] and p["status"] == "identifiable"
-        assert p["bounds"][0] < lo and hi < p["bounds"][1]          # closed inside the box
+    _assert_recovered(res, ("dg", "tau0"))
     # with sigmas the statistic is chi-square(1), and the fit is consistent with the noise
     assert res["fit"]["statistic"] == "chi2(1)"
     assert res["fit"]["threshold"] == pytest.approx(3.8415, abs=1e-3)
@@ -121,6 +129,45 @@ def test_fitted_values_are_the_engine_at_the_estimate(identifiable):
     assert np.all(np.array(c["band_lo_N"]) <= np.array(c["pull_off_N"]) * (1 + 1e-12))
     assert np.all(np.array(c["band_hi_N"]) >= np.array(c["pull_off_N"]) * (1 - 1e-12))
     assert res["scenes_run"] > 0 and res["cache_hits"] > 0 and res["failed_scenes"] == 0
+
+
+@pytest.fixture(scope="module")
+def process_zone(tmp_path_factory):
+    """pz_v0 and pz_xi free (issue 35 item 5): the bulk, dg and h0 fixed, pz_law among the
+    fixed fields; 5 speeds, 2 % noise with sigmas. The crack speed at pull-off runs from
+    about 1e-5 to 2e-2 m/s, across the truth's pz_v0 = 1e-4 m/s."""
+    tmp = tmp_path_factory.mktemp("pz")
+    fit = {"pz_v0": [1.0e-6, 1.0e-1], "pz_xi": [0.2, 1.0]}
+    fixed = {**FIXED, "h0": TRUTH["h0"], "tau0": TRUTH["tau0"], "dg": TRUTH["dg"],
+             "pz_law": "gent-schultz"}
+    truth = {"pz_v0": 1.0e-4, "pz_xi": 0.5}
+    data = _synthetic(fit, fixed, truth, seed=4, sigma=True, noise=0.02,
+                      speeds=np.logspace(-6, -2, 5))
+    return _fitted(tmp, fit, fixed, data, truth=truth)
+
+
+def test_process_zone_recovered_inside_its_intervals(process_zone):
+    cal, res = process_zone
+    assert res["fixed"]["pz_law"] == "gent-schultz"
+    assert res["parameters"]["pz_v0"]["scale"] == "log"            # four decades of bounds
+    assert res["parameters"]["pz_xi"]["scale"] == "linear"
+    _assert_recovered(res, ("pz_v0", "pz_xi"))
+    # 2 % noise pins pz_v0 within a factor 1.5 and pz_xi within 0.1 (the bounds: 1e5, 0.8)
+    iv = res["parameters"]["pz_v0"]["interval"]
+    assert iv[1] / iv[0] < 1.5
+    iv = res["parameters"]["pz_xi"]["interval"]
+    assert iv[1] - iv[0] < 0.1
+    assert res["fit"]["chi2"] < 3.0 * res["fit"]["dof"] + 3.0
+    # the fitted pull-offs are the crack-front model with the process zone at the estimate
+    est = {k: v["estimate"] for k, v in res["parameters"].items()}
+    for i in (0, len(cal.speed_m_s) - 1):
+        si = SIScene(**cal.fixed, **est, speed=float(cal.speed_m_s[i]))
+        assert res["data"]["fitted_N"][i] == pytest.approx(run_si(si, "crack")["pull_off_N"],
+                                                           rel=1e-6)
+    # ... and not the model without it: the fastest point is about 4x the pull-off without it
+    bare = {k: v for k, v in cal.fixed.items() if k != "pz_law"}
+    si = SIScene(**bare, speed=float(cal.speed_m_s[-1]))
+    assert res["data"]["fitted_N"][-1] > 2.0 * run_si(si, "crack")["pull_off_N"]
 
 
 def test_unidentifiable_parameter_is_flagged(degenerate):
@@ -203,6 +250,13 @@ GOOD_DATA = {"speed_m_s": [1e-6, 1e-5, 1e-4], "pull_off_N": [0.01, 0.02, 0.03]}
                                                               if k != "Einf"}},
      "fit.Einf: lower bound must be >= E0"),
     ({"model": "fem"}, "model must be one of bem, crack, pb, auto"),
+    ({"fit": {**GOOD_FIT, "pz_law": [0.0, 1.0]}}, "fit.pz_law: a law is chosen, not fitted"),
+    ({"fixed": {**GOOD_FIXED, "pz_law": "viscous"}},
+     "fixed.pz_law must be one of none, gent-schultz"),
+    ({"fit": {**GOOD_FIT, "pz_v0": [1e-5, 1e-1]}},
+     "pz_v0: a process-zone parameter needs fixed.pz_law"),
+    ({"fixed": {**GOOD_FIXED, "pz_law": "gent-schultz", "pz_xi": 0.5}},
+     "pz_v0: missing; pz_law gent-schultz needs pz_v0 [m/s] and pz_xi"),
 ])
 def test_bad_files_one_line_exit_2(tmp_path, capsys, change, words):
     fit = change.get("fit", GOOD_FIT)
