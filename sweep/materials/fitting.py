@@ -12,6 +12,9 @@ from .prony_series import PronySeries
 
 FIT_PPD = 24          # fit grid, points per decade
 CHECK_PPD = 160       # measurement grid, points per decade (plus local refinement)
+#: attempts one term fewer at a time below a passing N while no failing N is known, before
+#: bisecting from 0: the first estimate passes 0-2 terms above the fewest in most fits
+STEP_DOWN = 3
 
 
 def _loggrid(a: float, b: float, ppd: int) -> np.ndarray:
@@ -401,10 +404,16 @@ def fit_prony(chat, t_min, t_max, rtol, k, exact=None, max_terms=120):
                 break
             N = min(n_cap, int(math.ceil(1.3 * N)) + 1)
     if n_pass is not None:
+        descents = 0
         while n_pass - n_fail > 1:
             lo_e = tried[n_fail][0] if n_fail else None
             hi_e = tried[n_pass][0]
-            if lo_e is not None and lo_e > hi_e:
+            if not n_fail and descents < STEP_DOWN:
+                # no failure known: the estimate is mostly within a few terms of the fewest
+                # (a probe at half of it fails far off and costs a whole attempt)
+                N = n_pass - 1
+                descents += 1
+            elif lo_e is not None and lo_e > hi_e:
                 frac = math.log(lo_e / target) / math.log(lo_e / hi_e)
                 N = n_fail + int(round(frac * (n_pass - n_fail)))
             else:
