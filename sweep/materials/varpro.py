@@ -22,6 +22,40 @@ LM_BOUNDED = 1          # an NNLS weight exceeded 1: stopped at the last accepte
 
 
 @njit(cache=True)
+def _cholesky_solve(M, g):
+    """x with M x = g for a symmetric positive definite M (Cholesky); (x, False) where a
+    pivot is not positive (M singular to rounding). Loops, not np.linalg.solve, whose
+    compile with its checks costs about 5 s (docs/performance.md, "The first run")."""
+    n = M.shape[0]
+    L = np.zeros((n, n))
+    for j in range(n):
+        d = M[j, j]
+        for k in range(j):
+            d -= L[j, k] * L[j, k]
+        if not d > 0.0:
+            return np.zeros(n), False
+        L[j, j] = np.sqrt(d)
+        for i in range(j + 1, n):
+            s = M[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            L[i, j] = s / L[j, j]
+    y = np.zeros(n)
+    for i in range(n):
+        s = g[i]
+        for k in range(i):
+            s -= L[i, k] * y[k]
+        y[i] = s / L[i, i]
+    x = np.zeros(n)
+    for i in range(n - 1, -1, -1):
+        s = y[i]
+        for k in range(i + 1, n):
+            s -= L[k, i] * x[k]
+        x[i] = s / L[i, i]
+    return x, True
+
+
+@njit(cache=True)
 def _solve_passive(A, b, passive):
     """Least squares on the columns of A where ``passive``: (z on all columns, zero
     elsewhere; Q of the reduced QR of those columns; their count)."""
@@ -38,7 +72,8 @@ def _solve_passive(A, b, passive):
     k = 0
     for j in range(n):
         if passive[j]:
-            Ap[:, k] = A[:, j]
+            for i in range(m):            # loops, not slices: no shape-mismatch message
+                Ap[i, k] = A[i, j]        # to compile (docs/performance.md, "The first run")
             cols[k] = j
             k += 1
     Qf, R = np.linalg.qr(Ap)
@@ -74,7 +109,8 @@ def nnls(A, b, start, maxiter):
                 passive[j] = False
                 bad = True
         if not bad:
-            x[:] = z
+            for j in range(n):
+                x[j] = z[j]
             break
     scale = 0.0
     for i in range(m):
@@ -98,7 +134,8 @@ def nnls(A, b, start, maxiter):
             skip[j_max] = True
             z, Q, p = _solve_passive(A, b, passive)
             continue
-        skip[:] = False
+        for j in range(n):
+            skip[j] = False
         while True:                       # inner loop: back to feasibility
             it += 1
             if it > maxiter:
@@ -111,7 +148,8 @@ def nnls(A, b, start, maxiter):
                     if a < alpha:
                         alpha = a
             if not neg:
-                x[:] = z
+                for j in range(n):
+                    x[j] = z[j]
                 break
             for j in range(n):
                 if passive[j]:
@@ -175,9 +213,8 @@ def lm_log_times(tg, sw, b, lt, lt_lo, lt_hi, iters):
         for j in range(N):
             if dH[j] <= 0.0:
                 dH[j] = 1e-300
-        try:
-            step = np.linalg.solve(H + mu * np.diag(dH), -g)
-        except Exception:
+        step, regular = _cholesky_solve(H + mu * np.diag(dH), -g)
+        if not regular:                   # singular to rounding: more damping
             mu *= 10.0
             continue
         lt2 = np.minimum(np.maximum(lt + np.minimum(np.maximum(step, -2.0), 2.0), lt_lo), lt_hi)
