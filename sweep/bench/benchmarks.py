@@ -447,8 +447,10 @@ class BenchPlan:
     dataset_ranges: dict = field(default_factory=lambda: dict(DATASET_RANGES))
     dataset_numerics: dict = field(default_factory=lambda: {"pull_off_rtol": 0.01})
     #: where the first run's time goes: every dataset_profile_stride-th scene of the sample
-    #: run again in this process, from an empty disk cache, its phases timed
-    dataset_profile_stride: int = 4
+    #: run again in this process, from an empty disk cache, its phases timed. The whole
+    #: sample: a subset grows the unit influence matrix less far (every 4th scene: 0.5 s of
+    #: influence matrices where the whole sample takes 5 s)
+    dataset_profile_stride: int = 1
 
     @classmethod
     def tiny(cls) -> "BenchPlan":
@@ -1222,10 +1224,9 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
                             "warm; first_s from an empty disk cache, warm_s from the cache "
                             "it filled; share_within_tolerance: rows ok with error_estimate "
                             "<= pull_off_rtol over all rows (first run); first_run_share: "
-                            "the shares of a first run's wall (every "
-                            "dataset_profile_stride-th scene, in this process, empty disk "
-                            "cache) in the Prony fit, influence matrices, relaxed starts, "
-                            "the unloading solve and the rest",
+                            "the shares of a first run's wall (the sample again, in this "
+                            "process at -j1, empty disk cache) in the Prony fit, influence "
+                            "matrices, relaxed starts, the unloading solve and the rest",
         "scale_minutes": "estimated wall minutes of the whole scale_config grid at -j{jobs}, "
                          "from a seeded random sample of scale_sample scenes: their warm "
                          "(set-up cached) cost scaled to the grid, plus one relaxed start "
