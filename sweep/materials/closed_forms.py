@@ -3,6 +3,7 @@ Psi(T) (docs/design.md section 3), and the SLS integrated compliance."""
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -35,32 +36,55 @@ def _mpl_series(T: np.ndarray, n: float, d: int, J: int = 40) -> np.ndarray:
     (eps = N - n):  (-1)^N pi T^q / (Gamma(n) q! m!) * T^(-eps) q!/Gamma(q+1-eps)
     * expm1(eps D)/sin(pi eps),  q = j - d,  D = ln T - dlg(1+m, eps) - dlg(q+1, -eps).
     No cancellation for small T (every term is O(T^2) or O(T^(n+1))).
+    The factors that do not depend on T are computed once per (n, d, J)
+    (:func:`_series_factors`; a Prony fit evaluates the series hundreds of times).
     """
-    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     lnT = np.log(T)
     out = np.zeros_like(T)
+    unpaired, tail = _series_factors(n, d, J)
+    for sign_ratio, power, lg in unpaired:         # unpaired terms of the first sum
+        out += sign_ratio * np.exp(power * lnT - lg)
+    kind, factors = tail
+    if kind == "gamma":
+        for g1n, power, lg1, lg2 in factors:
+            out += g1n * np.exp(power * lnT - lg1 - lg2)
+        return out
+    eps = factors[0]
+    for scale, dl1, dl2, power, lgn, lg1, lg2 in factors[1:]:
+        D = lnT - dl1 - dl2
+        f = D if eps == 0.0 else np.expm1(eps * D) / eps
+        logmag = power * lnT - lgn - lg1 - lg2
+        out += scale * np.exp(logmag) * f
+    return out
+
+
+@lru_cache(maxsize=256)
+def _series_factors(n: float, d: int, J: int):
+    """The T-independent factors of the terms of :func:`_mpl_series`, in its order of
+    summation: (unpaired terms, ("gamma", terms) or ("paired", (eps, *terms)))."""
+    from scipy import special  # lazy: not on a BEM scene's path (docs/performance.md)
     N = int(math.floor(n + 0.5))
     lgn = special.gammaln(n)
     ratio = 1.0                                    # Gamma(n+1-j)/Gamma(n)
     jmax = J if N == 0 else N
-    for j in range(2, jmax + 1):                   # unpaired terms of the first sum
+    unpaired = []
+    for j in range(2, jmax + 1):
         ratio /= n - (j - 1)
-        out += (-1) ** j * ratio * np.exp((j - d) * lnT - special.gammaln(j - d + 1))
+        unpaired.append(((-1) ** j * ratio, j - d, special.gammaln(j - d + 1)))
     if N == 0:
         g1n = special.gamma(1.0 - n)
-        for m in range(J):
-            out += g1n * np.exp((m + n + 1 - d) * lnT - special.gammaln(m + 1)
-                                - special.gammaln(m + n + 2 - d))
-        return out
+        return tuple(unpaired), ("gamma", tuple(
+            (g1n, m + n + 1 - d, special.gammaln(m + 1), special.gammaln(m + n + 2 - d))
+            for m in range(J)))
     eps = N - n
     pref = 1.0 / math.pi if eps == 0.0 else eps / math.sin(math.pi * eps)
+    paired = [eps]
     for m in range(J):
         q = N + 1 + m - d
-        D = lnT - _dlgamma(1.0 + m, eps) - _dlgamma(q + 1.0, -eps)
-        f = D if eps == 0.0 else np.expm1(eps * D) / eps
-        logmag = (q - eps) * lnT - lgn - special.gammaln(q + 1 - eps) - special.gammaln(m + 1)
-        out += (-1) ** N * math.pi * pref * np.exp(logmag) * f
-    return out
+        paired.append(((-1) ** N * math.pi * pref, _dlgamma(1.0 + m, eps),
+                       _dlgamma(q + 1.0, -eps), q - eps, lgn, special.gammaln(q + 1 - eps),
+                       special.gammaln(m + 1)))
+    return tuple(unpaired), ("paired", tuple(paired))
 
 
 _X_MAX = 5000.0        # 2 sqrt(T) beyond which exp(-X) X^(n+1) underflows (n <= 20)

@@ -214,6 +214,77 @@ def test_random_sample_is_seeded_distinct_and_spans_the_grid():
                 == {getattr(s, axis) for _, s in cfg.tasks()})
 
 
+def test_dataset_sample_is_seeded_log_uniform_in_the_ranges_and_asks_for_the_accuracy():
+    from sweep.bench.benchmarks import DATASET_RANGES, dataset_sample
+    a, b = dataset_sample(60, seed=1), dataset_sample(60, seed=1)
+    scenes = [s for _, s in a.tasks()]
+    assert scenes == [s for _, s in b.tasks()] and len(set(scenes)) == 60
+    assert scenes != [s for _, s in dataset_sample(60, seed=2).tasks()]
+    assert a.numerics == Numerics.for_tolerance(0.01)
+    assert {s.model for s in scenes} == {"bem"} and {s.material for s in scenes} == {"mpl"}
+    for axis, (lo, hi) in DATASET_RANGES.items():
+        v = np.log10([getattr(s, axis) for s in scenes])
+        assert np.all((v >= np.log10(lo) - 1e-3) & (v <= np.log10(hi) + 1e-3)), axis
+        # log-uniform: the sample reaches both halves of each range's decades
+        mid = 0.5 * (np.log10(lo) + np.log10(hi))
+        assert (v < mid).any() and (v > mid).any(), axis
+
+
+def test_phase_timer_counts_each_phase_without_the_phases_nested_in_it(monkeypatch):
+    """Exclusive times: a phase called inside another is subtracted from it (a fake clock)."""
+    import types
+
+    from sweep.bench import benchmarks as bm
+    clock = types.SimpleNamespace(t=0.0)
+    monkeypatch.setattr(bm.time, "perf_counter", lambda: clock.t)
+    ns = types.SimpleNamespace()
+
+    def outer():
+        clock.t += 1.0
+        ns.inner()
+        ns.inner()
+        clock.t += 2.0
+        return "outer"
+
+    def inner():
+        clock.t += 5.0
+    ns.outer, ns.inner = outer, inner
+    monkeypatch.setattr(bm._PhaseTimer, "TARGETS", {"a": ((ns, "outer"),), "b": ((ns, "inner"),)})
+    with bm._PhaseTimer() as timer:
+        assert ns.outer() == "outer"
+        ns.inner()
+    assert timer.seconds == {"a": 3.0, "b": 15.0}
+    assert timer.calls == {"a": 1, "b": 3}
+    assert ns.outer is outer and ns.inner is inner          # put back
+
+
+def test_dataset_campaign_counts_and_shares_add_up():
+    from sweep.bench.benchmarks import bench_dataset_campaign
+    plan = BenchPlan.tiny()
+    rep = bench_dataset_campaign(plan)
+    json.dumps(rep)
+    n = plan.dataset_scenes
+    assert rep["scenes"] == n and rep["numerics"]["pull_off_rtol"] == 0.03
+    for label in ("first", "warm"):
+        r = rep["rows"][label]
+        assert r["scenes"] == r["ran"] == n == r["ok"] + r["failed"]
+        assert sum(r["status_counts"].values()) == n
+        assert sum(r["failure_reasons"].values()) == r["failed"]
+        assert r["within_tolerance"] <= r["ok"]
+        assert r["share_within_tolerance"] == pytest.approx(r["within_tolerance"] / n)
+    assert rep["first_over_warm"] == pytest.approx(rep["first_s"] / rep["warm_s"])
+    # every scene has k < 1: a first run fits Prony series, which the warm run reads
+    assert rep["rows"]["first"]["prony_series_fitted"] >= 1
+    assert rep["rows"]["warm"]["prony_series_fitted"] == 0
+    prof = rep["profile"]
+    assert prof["scenes"] == len(range(0, n, plan.dataset_profile_stride))
+    assert prof["prony_series_fitted"] >= 1 and prof["calls"]["prony"] >= prof["scenes"]
+    assert prof["calls"]["unload"] >= prof["scenes"]
+    assert all(v >= 0.0 for v in prof["seconds"].values())
+    assert sum(prof["share"].values()) == pytest.approx(1.0)
+    assert sum(prof["seconds"].values()) <= prof["wall_s"]
+
+
 def test_bench_json_keys_with_a_tiny_plan():
     plan = BenchPlan.tiny()
     rep = bench_all(plan, progress=lambda m: None)
@@ -234,6 +305,9 @@ def test_bench_json_keys_with_a_tiny_plan():
     assert set(sc["sequential_s"]) == {"cold", "warm"}
     assert 1 <= sc["start_groups"]["sample"] <= sc["start_groups"]["grid"]
     assert rep["scale_minutes"] == sc["minutes_estimate"] > 0
+    dc = rep["dataset_campaign_detail"]
+    assert rep["dataset_campaign"]["first_s"] == dc["first_s"] > 0
+    assert rep["dataset_campaign"]["scenes"] == dc["rows"]["warm"]["ran"] == plan.dataset_scenes
     bc = rep["campaign_balanced_detail"]
     assert rep["campaign_balanced_s"] == bc["wall_s"] > 0
     assert bc["scenes"] == bc["ran"] == sum(bc["status_counts"].values()) >= 2
