@@ -6,7 +6,6 @@ forms are required to agree to 1e-10 relative (the brief asks 1e-8; what is meas
 test, with the reason.
 """
 import math
-import time
 
 import numpy as np
 import pytest
@@ -447,13 +446,18 @@ def test_prony_elastic_and_series_integral():
         assert ps.integrated_compliance(T) == pytest.approx(q, rel=1e-11)
 
 
-def test_prony_is_fast_enough_for_a_scene():
-    # the solver calls prony() once per scene; a typical window and the balanced tolerance
+def test_prony_fit_of_a_scene_window_is_small_and_within_its_tolerance():
+    """The fit the solver makes once per scene (a typical window, the balanced tolerance):
+    converged within rtol with about one term per decade, not a dense spectrum. Its speed is
+    measured by make bench (prony_speedup, dataset_campaign), not here: no test times the
+    machine."""
     m = MPLRetardation.from_k(0.8, 0.1)
-    m.prony(1e-2, 1e1, 1e-3)     # the fitter's compiled iteration loaded (or compiled, once)
-    t0 = time.perf_counter()
-    m.prony(1e-5, 1e3, 1e-4)
-    assert time.perf_counter() - t0 < 2.0      # typically ~0.05 s; generous for loaded CI
+    s = m.prony(1e-5, 1e3, 1e-4)
+    assert s.converged and s.max_rel_error <= 1e-4
+    assert s.n_terms <= 16                      # 11 here; 8 decades
+    t = np.logspace(-5, 3, 801)
+    err = np.max(np.abs(s.normalized_creep_compliance(t) / m.normalized_creep_compliance(t) - 1))
+    assert err <= 1e-4 * 1.01                   # an independent evaluation of its error
 
 
 # ===================================================================== input validation

@@ -13,7 +13,10 @@ NOT_ON_A_SCENES_PATH = ("pandas", "h5py", "matplotlib", "joblib", "scipy.special
                         "scipy.optimize", "scipy.integrate", "scipy.interpolate")
 
 
-def test_a_bem_scene_imports_no_plotting_storage_or_other_models_scipy():
+def test_a_bem_scene_imports_no_plotting_storage_or_other_models_scipy(tmp_path):
+    """With its Prony series on disk (a first process fits it into a fresh SWEEP_CACHE_DIR),
+    a BEM scene in a new process imports none of NOT_ON_A_SCENES_PATH: whatever the
+    machine's cache held before."""
     code = ("import sys\n"
             "from sweep.engine import models\n"
             "from sweep import Scene, Numerics\n"
@@ -22,8 +25,11 @@ def test_a_bem_scene_imports_no_plotting_storage_or_other_models_scipy():
             "                               da_max=2.0, pull_off_rtol=0.0))\n"
             "assert res.ok, res.reason\n"
             f"print([m for m in {NOT_ON_A_SCENES_PATH!r} if m in sys.modules])\n")
+    env = dict(os.environ, SWEEP_CACHE_DIR=str(tmp_path / "cache"))
+    subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                   env=env)                                  # fits and keeps the series
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True)
+                         check=True, env=env)
     assert out.stdout.strip().splitlines()[-1] == "[]"
 
 
