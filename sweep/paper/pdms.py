@@ -697,7 +697,7 @@ def plot(res: dict, out) -> Path:
     import matplotlib.ticker  # noqa: F401 - used as matplotlib.ticker
 
     v = np.array(res["speeds_um_s"])
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 7.0))
     styles = {"crack_pb": ("k-", "crack front, PB Gamma(v) (linear)"),
               "crack_gs": ("g--", "crack front, Gent-Schultz fit"),
               "crack_pb_pz": ("m-", "crack front, PB bulk x process zone 1 + (v/v1)^(1/2)"),
@@ -720,7 +720,7 @@ def plot(res: dict, out) -> Path:
     ax1.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax1.set_yticks([3, 4, 5, 7, 10, 15, 20, 30])
     ax1.set_title(f"PDMS, preload 1.5 mN, mu = {res['mu']:.1f}, l0 = {res['l0_nm']:.1f} nm")
-    ax1.legend(fontsize=8)
+    ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13))
     ax1.grid(True, which="both", alpha=0.3)
     g = res["gs_over_linear"]
     vc = np.array(g["crack_speed_um_s"])
@@ -751,9 +751,11 @@ def plot(res: dict, out) -> Path:
     ax3.set_ylabel("ratio")
     h1, l1 = ax2.get_legend_handles_labels()
     h2, l2 = ax3.get_legend_handles_labels()
-    ax2.legend(h1 + h2, l1 + l2, fontsize=8, loc="upper left")
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    # the legends below the panels: inside, they hid the curves they name
+    ax2.legend(h1 + h2, l1 + l2, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13),
+               ncol=2)
+    fig.subplots_adjust(left=0.07, right=0.93, top=0.95, bottom=0.38, wspace=0.3)
+    fig.savefig(out, dpi=110, bbox_inches="tight")     # with the legends below the panels
     plt.close(fig)
     return Path(out)
 
