@@ -68,6 +68,9 @@ N_MAX = 10.0
 VHAT_MAX = 1e100
 _STEP = 0.2  # trapezoid step in s = ln(x / c)
 _TAIL = 36.0  # half-width of the s-window around both 0 and ln(1/c): e^-36 ~ 2e-16
+#: x = tau/tau0 beyond which P(n, x) = 1, Q(n, x) = 0 and x^n e^-x = 0 in double precision for
+#: every n <= N_MAX (Q(10, 1000) ~ 1e-413): those nodes are not evaluated
+_X_DEAD = 1000.0
 
 
 # --------------------------------------------------------------------------------------------
@@ -103,7 +106,14 @@ def _kernel_w(s):
 
 
 def _mpl_integrals(n: float, c: np.ndarray):
-    """I(c), J(c) = 1 - I(c) and c dJ/dc for the Gamma(n) spectrum; c is a 1-D array > 0."""
+    """I(c), J(c) = 1 - I(c) and c dJ/dc for the Gamma(n) spectrum; c is a 1-D array > 0.
+
+    Each node costs one incomplete gamma function: ``Q(n, x)`` above ``max(1, n)``, ``P(n, x)``
+    at or below it, the other as its complement (what scipy's own ``gammainc`` does above
+    that point, so ``J`` there is the same number; below it ``Q = 1 - P >= Q(n, max(1, n))``
+    loses nothing that counts). Beyond ``x =`` :data:`_X_DEAD` the nodes are ``P = 1``,
+    ``Q = 0`` and ``x p(x) = 0`` in double precision and are not evaluated.
+    """
     from scipy.special import gammainc, gammaincc, gammaln  # lazy: not on a BEM scene's path
     lnc = np.log(c)
     s0 = np.minimum(-_TAIL, -lnc - _TAIL)
@@ -112,11 +122,21 @@ def _mpl_integrals(n: float, c: np.ndarray):
     s = s0[:, None] + _STEP * np.arange(m)[None, :]
     w = _STEP * _kernel_w(s)
     x = c[:, None] * np.exp(s)
-    big_i = np.sum(w * gammaincc(n, x), axis=1)
-    big_j = np.sum(w * gammainc(n, x), axis=1)
-    # c dJ/dc = int w(s) x p(x) ds, x p(x) = x^n e^-x / Gamma(n)
+    live = x < _X_DEAD
+    lower = live & (x <= max(1.0, n))
+    upper = live & ~lower
+    p = np.ones_like(x)
+    q = np.zeros_like(x)
+    p[lower] = gammainc(n, x[lower])
+    q[upper] = gammaincc(n, x[upper])
+    q[lower] = 1.0 - p[lower]
+    p[upper] = 1.0 - q[upper]
+    big_i = np.sum(w * q, axis=1)
+    big_j = np.sum(w * p, axis=1)
+    # c dJ/dc = int w(s) x p(x) ds, x p(x) = x^n e^-x / Gamma(n) (only the Newton slope)
+    xp = np.zeros_like(x)
     with np.errstate(under="ignore"):
-        xp = np.exp(n * np.log(x) - x - gammaln(n))
+        np.exp(n * (lnc[:, None] + s) - x - gammaln(n), out=xp, where=live)
     c_dj = np.sum(w * xp, axis=1)
     return big_i, big_j, c_dj
 
@@ -143,19 +163,22 @@ def _solve_gamma(vhat: np.ndarray, k: float, integrals) -> np.ndarray:
     lo = -ln2pv  # G = 1
     hi = -ln2pv - np.log(k)  # G = 1/k
     u = lo.copy()
+    active = np.arange(v.size)  # rows whose Newton step was still above 1e-14
     for _ in range(100):
-        _, big_j, c_dj = integrals(np.exp(u))
+        ua = u[active]
+        _, big_j, c_dj = integrals(np.exp(ua))
         d = k + (1.0 - k) * big_j
-        phi = ln2pv + u + np.log(d)
+        phi = ln2pv[active] + ua + np.log(d)
         slope = 1.0 + (1.0 - k) * c_dj / d
-        lo = np.where(phi <= 0.0, u, lo)
-        hi = np.where(phi >= 0.0, u, hi)
-        u_new = u - phi / slope
-        outside = (u_new < lo) | (u_new > hi)
-        u_new = np.where(outside, 0.5 * (lo + hi), u_new)
-        step = np.abs(u_new - u)
-        u = u_new
-        if np.all(step <= 1e-14 * np.maximum(1.0, np.abs(u))):
+        lo_a = np.where(phi <= 0.0, ua, lo[active])
+        hi_a = np.where(phi >= 0.0, ua, hi[active])
+        u_new = ua - phi / slope
+        outside = (u_new < lo_a) | (u_new > hi_a)
+        u_new = np.where(outside, 0.5 * (lo_a + hi_a), u_new)
+        step = np.abs(u_new - ua)
+        u[active], lo[active], hi[active] = u_new, lo_a, hi_a
+        active = active[step > 1e-14 * np.maximum(1.0, np.abs(u_new))]
+        if not active.size:
             break
     _, big_j, _ = integrals(np.exp(u))
     out[todo] = 1.0 / (k + (1.0 - k) * big_j)
