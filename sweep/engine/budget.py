@@ -22,7 +22,8 @@ import time
 from contextlib import contextmanager
 from contextvars import ContextVar
 
-__all__ = ["OverBudget", "scene_budget", "deadline", "remaining", "check", "CHECK_SLACK_S"]
+__all__ = ["OverBudget", "scene_budget", "deadline", "remaining", "budget_seconds", "check",
+           "CHECK_SLACK_S"]
 
 #: (deadline in time.perf_counter() seconds, the budget in seconds) of the scene being run
 _BUDGET: ContextVar[tuple[float, float] | None] = ContextVar("scene_budget", default=None)
@@ -74,9 +75,10 @@ def deadline(seconds: float) -> float:
     return own if outer is None else min(own, outer[0])
 
 
-def remaining(seconds: float = 0.0) -> float:
+def remaining() -> float:
     """Seconds left of the running scene's budget (``inf`` without one)."""
-    return deadline(seconds) - time.perf_counter()
+    outer = _BUDGET.get()
+    return math.inf if outer is None else outer[0] - time.perf_counter()
 
 
 def budget_seconds(default: float = 0.0) -> float:

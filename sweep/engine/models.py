@@ -20,9 +20,10 @@ elastic  the quasi-static elastic branch (:func:`sweep.engine.quasistatic.simula
          hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100; "bem" and
          "auto" scenes that are elastic and quasi-static run it (:func:`wants_quasistatic`)
 auto     the cheapest model whose error meets ``numerics.pull_off_rtol`` (:func:`model_choice`):
-         the crack-front model for a scene with a process zone; the elastic branch for elastic quasi-static scenes; the PB estimate or the
-         crack-front model where their error against the BEM, measured over a random sample
-         (:func:`measured_error`, ``make model-errors``), fits; else the BEM (graded or
+         the crack-front model for a scene with a process zone; the elastic branch for
+         elastic quasi-static scenes; the PB estimate or the crack-front model where their
+         error against the BEM, measured over a random sample (:func:`measured_error`,
+         ``make model-errors``), fits; else the BEM (graded or
          tip-following mesh), and the crack-front model where the BEM fails for a reason the
          crack-front model lifts (the tip zone unresolvable) or beyond the BEM's Tabor range
          (mu > 100, the crack-front model is its limit). ``model_reason`` says why
@@ -54,7 +55,8 @@ from .problem import BEM_MU_RANGE, derive
 from .resolution import refined, unresolved
 from .quasistatic import simulate_elastic
 
-__all__ = ["MODELS", "PROCESS_ZONE_REFUSALS", "simulate", "pb_estimate", "simulate_pb", "simulate_model",
+__all__ = ["MODELS", "PROCESS_ZONE_REFUSALS", "simulate", "pb_estimate", "simulate_pb",
+           "simulate_model",
            "simulate_scene", "choose_model", "model_choice", "Choice", "measured_error",
            "bem_nodes_needed", "bem_node_budget", "wants_quasistatic", "wants_tip_following"]
 
