@@ -36,6 +36,8 @@ help:
 	@echo "make calibrate-demo - fit a synthetic PDMS-like pull-off curve (results/calibrate/)"
 	@echo "make calibrate-pz-demo - fit a process zone to synthetic PDMS data, bulk from DMA (results/calibrate/pdms-pz/, ~1 min)"
 	@echo "make model-errors - crack-front model and PB estimate vs the BEM over mu (the table auto reads)"
+	@echo "make pz-check - the BEM's process zone vs the crack-front model, and its cost (results/process_zone/)"
+	@echo "make pz-map - the process zone's map from crack speed to opening rate (the table the BEM reads, ~1 min)"
 	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem (results/random/)"
 	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
 	@echo "make crack-speed [QUICK=1] - the crack speed at pull-off per preset against a fine reference, per fit window (results/crack_speed/, ~6 min)"
@@ -197,6 +199,17 @@ calibrate-demo: $(STAMP)
 
 # issue 35 item 5: the process zone's pz_v0, pz_xi (and dg) fitted with the PDMS bulk fixed;
 # the CSV was written by the command in the header of configs/calibrate/pdms-pz.yaml
+# issue 35: the map from the process zone's crack speed to its opening rate, written into the
+# package (sweep/engine/process_zone_map.json) for the BEM's rate-dependent interface law
+.PHONY: pz-map
+pz-map: $(STAMP)
+	$(BIN)/python -m sweep.bench.process_zone_map
+
+# issue 35: the BEM's process zone against the crack-front model, and its cost
+.PHONY: pz-check
+pz-check: $(STAMP)
+	$(BIN)/python -m sweep.bench.process_zone_check
+
 .PHONY: calibrate-pz-demo
 calibrate-pz-demo: $(STAMP)
 	$(BIN)/sweep calibrate configs/calibrate/pdms-pz.yaml --out results/calibrate/pdms-pz

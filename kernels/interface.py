@@ -8,6 +8,9 @@ The most tensile traction -sigma_0 is reached at h_m = 3^(1/6) h0.
 """
 from __future__ import annotations
 
+from collections import namedtuple
+
+import numpy as np
 from numba import njit
 
 #: the gap at the crack tip over h0: the traction is most tensile at h_m = 3^(1/6) h0, and the
@@ -51,3 +54,99 @@ def crossing_radius(h, r, level):
             frac = (level - h[i]) / (h[i + 1] - h[i])
             return r[i] + frac * (r[i + 1] - r[i])
     return 0.0
+
+
+# ------------------------------------------------------------------ the process zone
+
+#: the interface law the solver kernels take whole: the LJ law's h0 and c, and the process
+#: zone's state over the step, ``zone`` (ZONE_SIZE) with the last accepted gap ``h_old`` its
+#: opening rate is measured from (:func:`traction`; ``zone[ZONE_RATE] = 0``: the LJ law)
+Interface = namedtuple("Interface", ["h0", "c", "h_old", "zone"])
+
+
+#: the process zone's state over a step, one float64 array of ZONE_SIZE:
+#: zone[ZONE_RATE] = 1/(hdot_c dt), the opening rate's scale (0: no process zone, the LJ law
+#: exactly), zone[ZONE_XI] = xi and zone[ZONE_SMOOTH] = q_s (:func:`zone_factor`)
+ZONE_RATE = 0
+ZONE_XI = 1
+ZONE_SMOOTH = 2
+ZONE_SIZE = 3
+#: the process zone's term m - 1 below which its law is smoothed: q_s = ZONE_SMOOTH_TERM^(1/xi)
+#: (:func:`zone_factor`); above it the law is the power law exactly
+ZONE_SMOOTH_TERM = 1e-2
+
+
+@njit(cache=True)
+def zone_factor(q, xi, qs):
+    """m(q) and dm/dq of the process zone at the normalized opening rate q = hdot/hdot_c:
+
+        m = 1 + q^xi                                  q >= q_s
+        m = 1 + q_s^xi x^2 (3 - xi + (xi - 2) x),     x = q/q_s in (0, 1)
+        m = 1                                         q <= 0 (a closing node, or at rest)
+
+    The cubic joins 1 and the power law with value and slope (m is C1 and increasing), so
+    that Newton meets no infinite slope at q = 0 (the power law's for xi < 1; with it the
+    solves stalled, docs/design.md "The process zone in the BEM"); below q_s it differs from
+    the power law by less than q_s^xi = ZONE_SMOOTH_TERM."""
+    if q <= 0.0:
+        return 1.0, 0.0
+    if q >= qs:
+        p = q ** xi
+        return 1.0 + p, xi * p / q
+    x = q / qs
+    a = qs ** xi
+    return (1.0 + a * x * x * (3.0 - xi + (xi - 2.0) * x),
+            a * x * (6.0 - 2.0 * xi + 3.0 * (xi - 2.0) * x) / qs)
+
+
+@njit(cache=True)
+def traction(h, h_old, zone, h0, c, out):
+    """sigma at every node into ``out``: the Lennard-Jones law, its tension multiplied by the
+    process zone (docs/design.md, "The process zone in the BEM"):
+
+        sigma(h) = m(q) sigma_LJ(h)  for h > h0 (tension),   sigma_LJ(h) for h <= h0,
+
+    with q = (h - h_old) zone[ZONE_RATE] the opening rate over the step (backward Euler, in
+    units of hdot_c) and m from :func:`zone_factor` (1 at q <= 0: a closing gap follows the
+    LJ law); at a constant opening rate the work of separation is m dg exactly. ``zone[ZONE_RATE] == 0`` is the LJ law (``h_old`` unread).
+    """
+    s = zone[ZONE_RATE]
+    if s == 0.0:
+        lj_traction(h, h0, c, out)
+        return
+    xi, qs = zone[ZONE_XI], zone[ZONE_SMOOTH]
+    for i in range(h.size):
+        x3 = (h0 / h[i]) ** 3
+        sig = -c * (x3 - x3 * x3 * x3)
+        if h[i] > h0:
+            m, _ = zone_factor((h[i] - h_old[i]) * s, xi, qs)
+            sig *= m
+        out[i] = sig
+
+
+@njit(cache=True)
+def traction_and_stiffness(h, h_old, zone, h0, c, sig, dsig):
+    """sigma (:func:`traction`) and d sigma / dh at every node, the rate term included."""
+    s = zone[ZONE_RATE]
+    if s == 0.0:
+        lj_traction_and_stiffness(h, h0, c, sig, dsig)
+        return
+    xi, qs = zone[ZONE_XI], zone[ZONE_SMOOTH]
+    for i in range(h.size):
+        x3 = (h0 / h[i]) ** 3
+        x9 = x3 * x3 * x3
+        lj = -c * (x3 - x9)
+        dlj = c * (3.0 * x3 - 9.0 * x9) / h[i]
+        if h[i] > h0:
+            m, dm = zone_factor((h[i] - h_old[i]) * s, xi, qs)
+            sig[i] = m * lj
+            dsig[i] = m * dlj + lj * dm * s
+        else:
+            sig[i] = lj
+            dsig[i] = dlj
+
+
+def lennard_jones(h0, c, N):
+    """The :data:`Interface` of the Lennard-Jones law alone, on N nodes (for the kernels'
+    callers)."""
+    return Interface(h0, c, np.zeros(N), np.zeros(ZONE_SIZE))

@@ -48,7 +48,7 @@ import numpy as np
 from numba import njit
 
 from .blas import gemv_cols, gemv_rows, lu_factor, lu_solve
-from .interface import lj_traction_and_stiffness
+from .interface import traction_and_stiffness
 
 #: a node belongs to the factorized set S when A_ii |E_i| exceeds this (the columns left
 #: out differ from the identity by less; their effect on Newton is of this order)
@@ -137,15 +137,16 @@ def crack_tip_index(d):
 
 
 @njit(cache=True)
-def factorize(h, A, ceff, h0, c, cache):
+def factorize(h, A, ceff, h0, c, h_old, zone, cache):
     """Factorize the Jacobian at ``h`` into ``cache``: choose S, Z and B, factorize K, form
-    X and C. Returns m = |S|."""
+    X and C. Returns m = |S|. ``h_old`` and ``zone`` are the process zone's
+    (:func:`kernels.interface.traction`)."""
     base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state = cache[:9]
     N = h.size
     zmax = zone_cols.size // N
     sig = np.empty(N)
     d = np.empty(N)
-    lj_traction_and_stiffness(h, h0, c, sig, d)
+    traction_and_stiffness(h, h_old, zone, h0, c, sig, d)
     m = 0
     for i in range(N):
         if A[i, i] * abs(ceff * d[i]) > SUBSET_EPS:

@@ -47,7 +47,9 @@ from numba import njit
 
 from .blas import lu_factor, lu_solve
 from .history import history_vector, step_coefficients, update_modes
-from .interface import TIP_GAP, crossing_radius, lj_traction, lj_traction_and_stiffness
+from .interface import (TIP_GAP, ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_SMOOTH_TERM, ZONE_XI,
+                        Interface, crossing_radius, lj_traction, traction,
+                        traction_and_stiffness)
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
 from .jacobian import (CACHE_CONTRACTION, CACHE_STATE, STATE_EXACT,  # noqa: F401
                        STATE_VALID, factorize, invalidate, new_jacobian_cache,
@@ -85,8 +87,10 @@ MeshArrays = namedtuple("MeshArrays", ["A", "r", "wP"])
 
 #: the scene's laws and loading (dimensionless, docs/design.md section 2): h0 and c of the
 #: Lennard-Jones law, the Prony modes (weights, times) of Chat (times may be inf: a lumped
-#: glassy constant), rate = r-hat (d delta/dt = -rate h0)
-Physics = namedtuple("Physics", ["h0", "c", "weights", "times", "rate"])
+#: glassy constant), rate = r-hat (d delta/dt = -rate h0); the process zone's opening-rate
+#: scale hdot_c (d_ref / tau0; inf: none, the LJ law) and exponent xi
+#: (:func:`kernels.interface.zone_factor`)
+Physics = namedtuple("Physics", ["h0", "c", "weights", "times", "rate", "hdot_c", "xi"])
 
 #: the step control settings:
 #: step_max, step_min: indentation steps (units of h0);
@@ -116,8 +120,12 @@ StepControl = namedtuple("StepControl", ["step_max", "step_min", "da_max", "step
 #: start; on return the modes of the last accepted step); n the records already written
 #: (0: a new run, record 0 is the initial state; n >= 1: continue after record n - 1, the
 #: stop rule sees all records); step (1,) the indentation step (units of h0), in/out (<= 0
-#: starts at step_max; on return the step the run would take next)
-RunState = namedtuple("RunState", ["h", "delta0", "q", "n", "step"])
+#: starts at step_max; on return the step the run would take next; step[1], where given, the
+#: time step that made h); sigma (N,) the traction of h and h_prev (N,) the state before it,
+#: in/out: read when resuming with a process zone (its traction depends on the step that made
+#: h, not on h alone, and Newton starts from the extrapolation through both), on return
+#: those of the last accepted state
+RunState = namedtuple("RunState", ["h", "delta0", "q", "n", "step", "sigma", "h_prev"])
 
 #: the outputs: records t, delta, P, a, a_inner (length >= max_steps + 1: time, indentation,
 #: load, contact radius at h_m and at h0) and h (N,), the gap of the last accepted step
@@ -129,10 +137,12 @@ Records = namedtuple("Records", ["t", "delta", "P", "a", "a_inner", "h"])
 #: equation, r^2/2 at the nodes, the modes q (M, N) (those of RunState), the ring of the
 #: last LATTICE_HISTORY accepted states of the tip predictor (:func:`predict_lattice`): their
 #: gaps past (LATTICE_HISTORY, N) and times and contact radii past_ta (2, LATTICE_HISTORY),
-#: and the step's two starts, cubic and tip predictor's, starts (2, N)
+#: and the step's two starts, cubic and tip predictor's, starts (2, N); the process zone's
+#: state over the step, zone (ZONE_SIZE; :func:`kernels.interface.traction`), and the gap
+#: its opening is measured from, ref (N; :func:`zone_step`)
 Work = namedtuple("Work", ["h", "h_prev", "h_prev2", "h_prev3", "hp", "h_pred", "sigma",
                            "sig_new", "sigma_pred", "e", "b", "H", "g", "r2half", "q",
-                           "past", "past_ta", "starts"])
+                           "past", "past_ta", "starts", "zone", "ref"])
 
 # the loop's scalars: one float64 array (N_RUN), positions named RUN_*
 RUN_T = 0          # time of the last accepted state
@@ -290,9 +300,10 @@ def stop_reached(P, a, n, i_min, stop_mode, min_travel):
 
 
 @njit(cache=True, inline='always')
-def residual(h, g, A, ceff, H, h0, c, sig, w, F):
-    """F = h - g - A (ceff sigma(h) - H); returns max |F|. sig, w are work arrays."""
-    lj_traction(h, h0, c, sig)
+def residual(h, g, A, ceff, H, law, sig, w, F):
+    """F = h - g - A (ceff sigma(h) - H); returns max |F|. sig, w are work arrays; ``law``
+    the interface law (:data:`kernels.interface.Interface`)."""
+    traction(h, law.h_old, law.zone, law.h0, law.c, sig)
     for j in range(h.size):
         w[j] = ceff * sig[j] - H[j]
     u = A @ w
@@ -326,8 +337,8 @@ def _norm2(F):
 
 
 @njit(cache=True, inline='always')
-def _refactorize(h, A, ceff, h0, c, cache, stats, reason):
-    m = factorize(h, A, ceff, h0, c, cache)
+def _refactorize(h, A, ceff, law, cache, stats, reason):
+    m = factorize(h, A, ceff, law.h0, law.c, law.h_old, law.zone, cache)
     stats[STAT_FACTOR] += 1
     stats[STAT_SUBSET] += m
     if reason >= 0:
@@ -335,15 +346,15 @@ def _refactorize(h, A, ceff, h0, c, cache, stats, reason):
 
 
 @njit(cache=True, inline='always')
-def _direction(h, F, A, ceff, h0, c, sig, d, cache, stats):
+def _direction(h, F, A, ceff, law, sig, d, cache, stats):
     """Newton's direction at ``h`` (residual ``F``) with the cached factorization, made again
     once when it no longer fits (the crack tip left the zone). Returns (dh, ok,
     refactorized); ok is False when even the fresh factorization gives none."""
-    lj_traction_and_stiffness(h, h0, c, sig, d)
+    traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d)
     dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
     if ok:
         return dh, True, False
-    _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_ZONE)
+    _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_ZONE)
     dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
     return dh, ok, True
 
@@ -359,8 +370,10 @@ def _end_predicted(h, dh, theta, stats):
 
 
 @njit(cache=True)
-def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
+def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
     """Solve F(h) = 0 in place, starting from ``h``. Returns True on convergence.
+
+    ``law`` is the interface law (:data:`kernels.interface.Interface`).
 
     The Jacobian factorization in the cache (:func:`kernels.jacobian.new_jacobian_cache`)
     is reused, its crack-tip zone kept exact (:func:`kernels.jacobian.newton_direction`); it
@@ -383,20 +396,20 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
     F = np.empty(N)
     Ft = np.empty(N)
     ht = np.empty(N)
-    norm = residual(h, g, A, ceff, H, h0, c, sig, w, F)
+    norm = residual(h, g, A, ceff, H, law, sig, w, F)
     stats[STAT_RESIDUALS] += 1
     if norm <= tol:
         return True
     fresh = False
     if state[STATE_VALID] == 0:
-        _refactorize(h, A, ceff, h0, c, cache, stats, -1)
+        _refactorize(h, A, ceff, law, cache, stats, -1)
         fresh = True
     for it in range(max_iter):
         stats[STAT_ITER] += 1
         if state[STATE_EXACT] == 1 and not fresh:
-            _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_RETRY)
+            _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_RETRY)
             fresh = True
-        dh, ok, refactorized = _direction(h, F, A, ceff, h0, c, sig, d, cache, stats)
+        dh, ok, refactorized = _direction(h, F, A, ceff, law, sig, d, cache, stats)
         fresh = fresh or refactorized
         if not ok:       # singular even on a fresh factorization: give up
             return False
@@ -413,7 +426,7 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
         for _ls in range(LINE_SEARCH_STEPS):
             for i in range(N):
                 ht[i] = h[i] + lam * dh[i]
-            nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
+            nt = residual(ht, g, A, ceff, H, law, sig, w, Ft)
             stats[STAT_RESIDUALS] += 1
             nt2 = _norm2(Ft)
             if nt2 < (1.0 - ARMIJO * lam) * n2:
@@ -423,7 +436,7 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
         if not accepted:
             if fresh:        # a line search failed on an exact Jacobian: give up
                 return False
-            _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_LINESEARCH)
+            _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_LINESEARCH)
             fresh = True
             continue
         theta[0] = nt / norm if lam == 1.0 else 1.0
@@ -435,12 +448,12 @@ def newton(h, g, A, ceff, H, h0, c, tol, max_iter, cache, stats):
             return True
         fresh = not fresh and nt2 > SLOW_CONTRACTION * n2
         if fresh:
-            _refactorize(h, A, ceff, h0, c, cache, stats, STAT_REFACTOR_SLOW)
+            _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_SLOW)
     return False
 
 
 @njit(cache=True, inline='always')
-def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
+def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
     """Pseudo-transient continuation to a *stable* equilibrium, in place; True on success.
 
     Integrates the relaxation dh/dtau = -F(h) with linearly implicit Euler steps,
@@ -458,7 +471,7 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
     F = np.empty(N)
     Ft = np.empty(N)
     ht = np.empty(N)
-    norm = residual(h, g, A, ceff, H, h0, c, sig, w, F)
+    norm = residual(h, g, A, ceff, H, law, sig, w, F)
     n2 = _norm2(F)
     dtau = RELAX_DTAU_START
     J = np.empty((N, N))
@@ -470,7 +483,7 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
             return True
         stats[STAT_ITER] += 1
         stats[STAT_FACTOR] += 1
-        lj_traction_and_stiffness(h, h0, c, sig, d)
+        traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d)
         for i in range(N):
             for j in range(N):
                 J[i, j] = -ceff * A[i, j] * d[j]
@@ -484,7 +497,7 @@ def relax(h, g, A, ceff, H, h0, c, tol, max_iter, stats):
         lam = positive_step(h, dh)
         for i in range(N):
             ht[i] = h[i] + lam * dh[i]
-        nt = residual(ht, g, A, ceff, H, h0, c, sig, w, Ft)
+        nt = residual(ht, g, A, ceff, H, law, sig, w, Ft)
         nt2 = _norm2(Ft)
         if not np.isfinite(nt2) or nt2 > RELAX_DIVERGENCE * n2:
             dtau *= RELAX_DTAU_CUT
@@ -522,8 +535,8 @@ def snap(mesh, physics, work, ceff, tol, max_iter, hm, cache, stats):
                 hp[i] = h[i + shift]
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
-        if newton(hp, work.g, mesh.A, ceff, work.H, physics.h0, physics.c, tol, max_iter,
-                  cache, stats):
+        if newton(hp, work.g, mesh.A, ceff, work.H, Interface(physics.h0, physics.c, work.ref, work.zone),
+                  tol, max_iter, cache, stats):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -710,16 +723,23 @@ def new_work(r, h_init, q):
                 np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(M),
                 np.empty(M), np.empty(N), np.empty(N), r2half, q,
                 np.empty((LATTICE_HISTORY, N)), np.empty((2, LATTICE_HISTORY)),
-                np.empty((2, N)))
+                np.empty((2, N)), np.zeros(ZONE_SIZE), h_init.copy())
 
 
 @njit(cache=True, inline='always')
 def start_run(mesh, physics, start, records, work, run, hm):
-    """The state the loop starts from: the tractions of ``work.h`` and the run's time,
+    """The state the loop starts from: the tractions of ``work.h`` (the LJ law's at the
+    relaxed start, at rest; a resumed run's own, ``start.sigma``) and the run's time,
     indentation and contact radius (record 0, the initial state, written for a new run).
     Returns (records written, index of the load minimum among them)."""
     h0, r = physics.h0, mesh.r
-    lj_traction(work.h, h0, physics.c, work.sigma)
+    if start.n == 0:
+        lj_traction(work.h, h0, physics.c, work.sigma)
+    else:
+        _copy(start.sigma, work.sigma)
+        if not np.isinf(physics.hdot_c) and start.step.size > 1 and start.step[1] > 0.0:
+            _copy(start.h_prev, work.h_prev)
+            run[RUN_DT_PREV] = start.step[1]
     run[RUN_A] = crossing_radius(work.h, r, hm)
     if start.n == 0:
         records.t[0] = 0.0
@@ -740,6 +760,29 @@ def start_run(mesh, physics, start, records, work, run, hm):
 
 
 @njit(cache=True, inline='always')
+def zone_step(physics, work, dt, dt_prev):
+    """The process zone's state over the step ``dt``: its opening rate by the variable-step
+    BDF2 formula, hdot = [a0 h - a1 h_n + a2 h_(n-1)] / dt with w = dt/dt_prev, a0 = (1 +
+    2w)/(1 + w), a1 = 1 + w, a2 = w^2/(1 + w) (second order; backward Euler, a0 = 1, on a
+    first step), written as hdot = a0 (h - ref)/dt: ``work.ref`` and zone[ZONE_RATE] =
+    a0/(hdot_c dt) (:func:`kernels.interface.traction`). Backward Euler's first-order lag
+    moved the pull-off by 1 % at the balanced preset's step (docs/design.md)."""
+    a0 = 1.0
+    if dt_prev > 0.0:
+        w = dt / dt_prev
+        a0 = (1.0 + 2.0 * w) / (1.0 + w)
+        a1 = 1.0 + w
+        a2 = w * w / (1.0 + w)
+        for i in range(work.h.size):
+            work.ref[i] = (a1 * work.h[i] - a2 * work.h_prev[i]) / a0
+    else:
+        _copy(work.h, work.ref)
+    work.zone[ZONE_RATE] = a0 / (physics.hdot_c * dt)
+    work.zone[ZONE_XI] = physics.xi
+    work.zone[ZONE_SMOOTH] = ZONE_SMOOTH_TERM ** (1.0 / physics.xi)
+
+
+@njit(cache=True, inline='always')
 def predict_step(mesh, physics, work, run):
     """-- predict: the step's time step, C_eff, H and g for the step ``run[RUN_DD]``, and
     Newton's starting gaps: the quadratic extrapolation in ``work.h_pred`` (and ``hp``),
@@ -751,6 +794,8 @@ def predict_step(mesh, physics, work, run):
     dt = dd / (physics.rate * h0)
     run[RUN_DT] = dt
     run[RUN_CEFF] = step_coefficients(physics.weights, physics.times, dt, work.e, work.b)
+    if not np.isinf(physics.hdot_c):
+        zone_step(physics, work, dt, run[RUN_DT_PREV])
     history_vector(physics.weights, work.e, work.b, work.q, work.sigma, work.H)
     delta = run[RUN_DELTA]
     for i in range(work.g.size):
@@ -782,15 +827,16 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     failed; after a failure the step is halved, down to SNAP_STEP_FRACTION step_max, and
     the next solves are exact Newton; below it the path folds and the snapped state is
     looked for. Returns SOLVED, HALVED, SNAPPED or FAILED (the state, if any, in hp)."""
-    A, h0, c, hp = mesh.A, physics.h0, physics.c, work.hp
+    A, h0, hp = mesh.A, physics.h0, work.hp
+    law = Interface(h0, physics.c, work.ref, work.zone)
     ceff, tol = run[RUN_CEFF], control.tol * h0
-    ok = newton(hp, work.g, A, ceff, work.H, h0, c, tol, control.max_iter, cache, stats)
+    ok = newton(hp, work.g, A, ceff, work.H, law, tol, control.max_iter, cache, stats)
     if not ok and cubic:
         # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
         # cubic start can overshoot: again from the quadratic one before the step halves
         stats[STAT_FAILED_SOLVES] += 1
         _copy(work.h_pred, hp)
-        ok = newton(hp, work.g, A, ceff, work.H, h0, c, tol, control.max_iter, cache, stats)
+        ok = newton(hp, work.g, A, ceff, work.H, law, tol, control.max_iter, cache, stats)
     if ok:
         return SOLVED
     stats[STAT_FAILED_SOLVES] += 1
@@ -808,7 +854,7 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     if snap(mesh, physics, work, ceff, tol, control.max_iter, hm, cache, stats):
         return SNAPPED
     _copy(work.h, hp)
-    if relax(hp, work.g, A, ceff, work.H, h0, c, tol, RELAX_MAX_ITER, stats):
+    if relax(hp, work.g, A, ceff, work.H, law, tol, RELAX_MAX_ITER, stats):
         return SNAPPED
     return FAILED
 
@@ -864,11 +910,11 @@ def step_load(mesh, physics, work, quadratic):
     step-error estimate: the relative load error of the quadratic extrapolation, inf
     without one. Returns (P, err)."""
     h0, c, wP = physics.h0, physics.c, mesh.wP
-    lj_traction(work.hp, h0, c, work.sig_new)
+    traction(work.hp, work.ref, work.zone, h0, c, work.sig_new)
     P = load(work.sig_new, wP)
     if not quadratic:
         return P, np.inf
-    lj_traction(work.h_pred, h0, c, work.sigma_pred)
+    traction(work.h_pred, work.ref, work.zone, h0, c, work.sigma_pred)
     return P, abs(load(work.sigma_pred, wP) - P) / max(abs(P), LOAD_ERROR_FLOOR)
 
 
@@ -879,12 +925,12 @@ def accept_step(mesh, physics, work, run, records, n, P, a_new):
     starts compared on it), and record ``n`` (load ``P``, contact radius ``a_new``) is
     written."""
     update_modes(work.e, work.b, work.q, work.sig_new, work.sigma)
+    dt = run[RUN_DT]
     _copy(work.h_prev2, work.h_prev3)
     _copy(work.h_prev, work.h_prev2)
     _copy(work.h, work.h_prev)
     _copy(work.hp, work.h)
     _copy(work.sig_new, work.sigma)
-    dt = run[RUN_DT]
     run[RUN_DT_PREV3] = run[RUN_DT_PREV2]
     run[RUN_DT_PREV2] = run[RUN_DT_PREV]
     run[RUN_DT_PREV] = dt
@@ -932,10 +978,11 @@ def unload(mesh, physics, control, start, records, cache, stats):
     h0, converted to d_ref where used)
     ----------
     mesh : MeshArrays (A, r, wP).
-    physics : Physics (h0, c, weights, times, rate).
+    physics : Physics (h0, c, weights, times, rate, hdot_c, xi).
     control : StepControl (step_max, step_min, da_max, step_tol, tol, max_iter, max_steps,
         stop_mode, min_travel, tip_lo, tip_hi, da_max_pulloff, pulloff_zone).
-    start : RunState (h, delta0, q, n, step); q and step are in/out.
+    start : RunState (h, delta0, q, n, step, sigma, h_prev); q, step, sigma and h_prev are
+        in/out.
     records : Records (t, delta, P, a, a_inner, h), written.
     cache : tuple
         The Jacobian cache (:func:`new_jacobian_cache`); may carry the factorization of
@@ -985,5 +1032,9 @@ def unload(mesh, physics, control, start, records, cache, stats):
         run[RUN_DD], easy = next_step(run[RUN_DD], easy, da, da_max, err,
                                       control.step_max * h0, control.step_tol * h0)
     _copy(work.h, records.h)
+    _copy(work.sigma, start.sigma)
+    _copy(work.h_prev, start.h_prev)
+    if start.step.size > 1:
+        start.step[1] = run[RUN_DT_PREV]
     start.step[0] = run[RUN_DD] / h0
     return status, n

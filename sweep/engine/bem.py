@@ -32,6 +32,7 @@ from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_ST
                              MeshArrays, Physics, Records, RunState, StepControl, invalidate,
                              unload)
 from ..errors import NUMERICAL_ERRORS, is_internal_error
+from ..kernels.interface import lj_traction
 from ..scene import Numerics, Result, Scene
 from . import budget
 from .budget import OverBudget
@@ -130,7 +131,9 @@ class UnloadingState:
     """Everything an unloading run carries between kernel calls (all arrays on one mesh):
     the gap ``h``, the Prony modal state ``q`` (M, N), the records (t, delta, P, a,
     a_inner) of which the first ``n`` are filled, the next step (units of h0) ``step``,
-    the Jacobian cache and the solver counters ``stats``."""
+    the Jacobian cache, the solver counters ``stats``, the traction ``sigma`` of ``h`` and
+    the state ``h_prev`` before it (written by the kernel, read on resuming with a process
+    zone: its traction depends on the step that made ``h``)."""
 
     h: np.ndarray
     delta0: float
@@ -140,6 +143,8 @@ class UnloadingState:
     step: np.ndarray
     cache: tuple
     stats: np.ndarray
+    sigma: np.ndarray = None
+    h_prev: np.ndarray = None
 
     @classmethod
     def start(cls, pb: Problem, h_init, delta0: float, cache, stats) -> "UnloadingState":
@@ -148,7 +153,8 @@ class UnloadingState:
         return cls(h=np.asarray(h_init, float).copy(), delta0=float(delta0),
                    q=np.zeros((pb.prony_weights.size, N)),
                    records=[np.empty(pb.numerics.max_steps + 1) for _ in range(5)], n=0,
-                   step=np.zeros(1), cache=cache, stats=stats)
+                   step=np.zeros(2), cache=cache, stats=stats, sigma=np.zeros(N),
+                   h_prev=np.zeros(N))
 
 
 def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int:
@@ -160,6 +166,10 @@ def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int
     """
     numerics = pb.numerics
     h_out = np.empty(pb.mesh.nodes)
+    if run.sigma is None:       # a state carried to another mesh (tip-following: no process
+        run.sigma = np.empty(pb.mesh.nodes)            # zone there): the LJ law's traction
+        lj_traction(run.h, pb.h0, pb.c, run.sigma)
+        run.h_prev, run.step[1:] = run.h.copy(), 0.0
     limit = min(run.n + steps, numerics.max_steps)
     da_max_pulloff = (numerics.da_max if numerics.da_max_pulloff is None
                       else numerics.da_max_pulloff)
@@ -169,8 +179,10 @@ def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int
                           da_max_pulloff * pb.mesh.spacing,
                           PULLOFF_ZONE_SPACINGS * pb.mesh.spacing)
     status, run.n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
-                           Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, pb.scene.rate),
-                           control, RunState(run.h, run.delta0, run.q, run.n, run.step),
+                           Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, pb.scene.rate,
+                                   pb.hdot_c, pb.pz_xi),
+                           control, RunState(run.h, run.delta0, run.q, run.n, run.step,
+                                             run.sigma, run.h_prev),
                            Records(*run.records, h_out), run.cache, run.stats)
     run.h = h_out
     return int(status)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.interface import crossing_radius, lj_traction
+from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
 from ..kernels.solve import (STATUS_DOMAIN, STATUS_DONE, STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT,
                            invalidate, load, new_jacobian_cache, newton, stop_reached)
 
@@ -35,6 +35,7 @@ def unload_exact(pb, h_init, delta0, material, min_travel, out, stats):
     h0, c, hm, stop_mode = pb.h0, pb.c, pb.hm, pb.stop_mode
     t_out, d_out, P_out, a_out, ai_out = out
     N = h_init.size
+    law = lennard_jones(h0, c, N)
     psi = (lambda T: np.asarray(T, dtype=float)) if scene.k == 1.0 else material.integrated_compliance
     sigma0 = np.empty(N)
     lj_traction(h_init, h0, c, sigma0)
@@ -67,7 +68,7 @@ def unload_exact(pb, h_init, delta0, material, min_travel, out, stats):
         H = -(hist - ceff * sigma)
         g = -(delta - dd) + h0 + 0.5 * r**2
         hp = h.copy()
-        ok = newton(hp, g, A, ceff, H, h0, c, numerics.tol * h0, MAX_NEWTON_ITER, cache, stats)
+        ok = newton(hp, g, A, ceff, H, law, numerics.tol * h0, MAX_NEWTON_ITER, cache, stats)
         if not ok:
             invalidate(cache)
             if dd <= numerics.min_step * h0 * 1.0001:

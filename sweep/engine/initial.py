@@ -13,7 +13,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..kernels.interface import TIP_GAP, crossing_radius
+from ..kernels.interface import TIP_GAP, crossing_radius, lennard_jones
 from ..kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton
 
 from . import budget
@@ -63,6 +63,7 @@ class ElasticSolver:
         self.A, self.r, self.h0, self.c, self.tol = A, r, h0, c, tol
         N = A.shape[0]
         self.zero = np.zeros(N)
+        self.law = lennard_jones(h0, c, N)
         self.cache = new_jacobian_cache(N)
         self.stats = np.zeros(N_STATS, dtype=np.int64)
 
@@ -70,7 +71,7 @@ class ElasticSolver:
         budget.check("the relaxed start (elastic solves)")
         h = np.array(guess, dtype=float)
         g = -delta + self.h0 + 0.5 * self.r**2
-        ok = newton(h, g, self.A, 1.0, self.zero, self.h0, self.c, self.tol * self.h0,
+        ok = newton(h, g, self.A, 1.0, self.zero, self.law, self.tol * self.h0,
                     MAX_NEWTON_ITER_INITIAL, self.cache, self.stats)
         if not ok:
             invalidate(self.cache)   # refactorize next time

@@ -153,8 +153,10 @@ def _bem(scene, numerics=None):
 
 
 def _bem_once(scene, numerics):
-    """One BEM solve with its error estimate, on the mesh that fits ``numerics``."""
-    if wants_tip_following(scene, numerics):
+    """One BEM solve with its error estimate, on the mesh that fits ``numerics`` (a scene
+    with a process zone on the graded or uniform mesh: the tip-following mesh's re-meshing
+    carries no opening rates)."""
+    if scene.pz_law == "none" and wants_tip_following(scene, numerics):
         from .tip_following import simulate_tip_following  # lazy: scipy.interpolate, optimize
 
         return simulate_tip_following(scene, numerics)
@@ -287,8 +289,8 @@ def model_choice(scene, numerics=None) -> Choice:
     model's error again at the amplification it computed and runs the BEM where it misses."""
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     if scene.pz_law != "none":
-        return Choice("crack", f"auto: crack-front model, the one model with a rate-dependent "
-                               f"process zone (pz_law {scene.pz_law})")
+        return Choice("crack", f"auto: crack-front model with the process zone (pz_law "
+                               f"{scene.pz_law}; model bem runs its local law)")
     bem_ok = _accepts("bem", scene)
     if wants_quasistatic(scene, numerics) and bem_ok:
         return Choice("elastic", "auto: k = 1, quasi-static: the elastic branch")
@@ -355,13 +357,11 @@ def _model_error(model: str, scene, res) -> float:
 #: why each model but the crack-front one refuses a scene with a process zone (``pz_law``): a
 #: failed row with this reason (not a physical refusal: the crack-front model answers it)
 PROCESS_ZONE_REFUSALS = {
-    "bem": "the BEM's interface is the rate-independent Lennard-Jones law: a scene with a "
-           "rate-dependent process zone (pz_law {pz_law}) runs with model crack or auto",
     "elastic": "the elastic branch is quasi-static and its interface rate independent: a "
                "scene with a rate-dependent process zone (pz_law {pz_law}) runs with model "
-               "crack or auto",
+               "bem, crack or auto",
     "pb": "the pb estimate's v-r fit was measured without a process zone: a scene with "
-          "pz_law {pz_law} runs with model crack or auto",
+          "pz_law {pz_law} runs with model bem, crack or auto",
 }
 
 

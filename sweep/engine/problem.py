@@ -22,7 +22,7 @@ from ..materials import SLS, MPLRetardation
 from ..materials.prony_series import PronySeries
 from ..scene import Numerics, Scene
 from ..theory import jkr_contact_radius
-from . import diskcache
+from . import diskcache, process_zone
 from .mesh import Mesh, scene_mesh
 
 #: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
@@ -194,6 +194,17 @@ class Problem:
         return self.scales.c
 
     @property
+    def hdot_c(self) -> float:
+        """The process zone's opening-rate scale (d_ref / tau0; inf: none, the LJ law),
+        :func:`sweep.engine.process_zone.hdot_c`."""
+        return process_zone.hdot_c(self.scene)
+
+    @property
+    def pz_xi(self) -> float:
+        """The process zone's exponent (0 without one)."""
+        return 0.0 if self.scene.pz_law == "none" else float(self.scene.pz_xi)
+
+    @property
     def hm(self) -> float:
         """The gap at the crack tip, 3^(1/6) h0 (d_ref)."""
         return self.scales.tip_gap
@@ -289,6 +300,10 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
                       f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
                       f"elastic or auto, large contacts the crack-front model (model crack)")
+    if numerics.exact and scene.pz_law != "none":
+        raise Refused(f"numerics.exact: the exact hereditary reference has the Lennard-Jones "
+                      f"interface only, not the process zone (pz_law {scene.pz_law}); leave "
+                      f"exact unset")
     s = derive(scene, numerics)
     zone_length, domain = s.tip_zone, s.domain
     mesh = scene_mesh(numerics, zone_length, s.a0_estimate, domain,
@@ -303,10 +318,12 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused(f"mesh too coarse: the tip zone {zone_length:.3g} a_ref spans {zone:.2g} "
                       f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
     if mesh.nodes > numerics.max_nodes:
+        other = ("the tip-following mesh carries no process zone: use model crack" if
+                 scene.pz_law != "none" else "or run it on the tip-following mesh "
+                 "(sweep.engine.tip_following; model bem does so)")
         raise Refused(f"mesh too large: the crack band needs {mesh.nodes} nodes at "
                       f"band_resolution {numerics.band_resolution:g} (> max_nodes = "
-                      f"{numerics.max_nodes}); raise max_nodes or lower band_resolution, or run it "
-                      f"on the tip-following mesh (sweep.engine.tip_following; model bem does so)")
+                      f"{numerics.max_nodes}); raise max_nodes or lower band_resolution; {other}")
     weights = times = np.zeros(0)
     error = 0.0
     if scene.k < 1.0 and not numerics.exact:

@@ -41,7 +41,7 @@ from scipy.optimize import brentq
 from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
                            STATUS_LEFT_BAND, STATUS_STEP_LIMIT, invalidate, new_jacobian_cache,
                            newton)
-from ..kernels.interface import lj_traction
+from ..kernels.interface import lennard_jones, lj_traction
 
 from ..scene import Numerics, Result, Scene
 from . import budget
@@ -210,6 +210,7 @@ def transfer(run, old, new, form: str = "auto") -> None:
     the caller's load continuity check judges the result.
     """
     old_r, new_r = old.mesh.r, new.mesh.r
+    run.sigma = None        # the LJ law's traction on the new mesh (bem.unload_chunk)
     h = CubicSpline(old_r, run.h)(new_r)
     # the spline passes through its knots only to rounding (which depends on the BLAS
     # kernels of the CPU): the common nodes take their old gap exactly
@@ -261,8 +262,8 @@ def _reequilibrate(run, new, h, ceff, H):
     g = -float(run.records[1][run.n - 1]) + new.h0 + 0.5 * new.mesh.r**2
     h_eq = h.copy()
     stats = run.stats if run.stats is not None else np.zeros(N_STATS, dtype=np.int64)
-    ok = newton(h_eq, g, new.A, ceff, H, new.h0, new.c, new.numerics.tol * new.h0,
-                REEQUILIBRATE_ITER, new_jacobian_cache(h.size), stats)
+    ok = newton(h_eq, g, new.A, ceff, H, lennard_jones(new.h0, new.c, h.size),
+                new.numerics.tol * new.h0, REEQUILIBRATE_ITER, new_jacobian_cache(h.size), stats)
     return h_eq if ok else None
 
 
@@ -650,6 +651,7 @@ def interpolate_as_traction(run, old, new) -> None:
     run.h = np.maximum(CubicSpline(old.mesh.r, run.h)(new.mesh.r), 0.5 * float(np.min(run.h)))
     run.q = np.ascontiguousarray(CubicSpline(old.mesh.r, run.q, axis=1)(new.mesh.r))
     run.cache = new_jacobian_cache(new.mesh.nodes)
+    run.sigma = None
 
 
 def remesh_jumps(scene: Scene, numerics: Numerics | None = None, form: str = "auto",

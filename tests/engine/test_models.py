@@ -197,14 +197,14 @@ def test_an_elastic_branch_failure_is_not_the_answer_of_auto():
     assert res.model_reason.startswith("auto: crack-front model: the elastic branch failed")
 
 
-# -- a rate-dependent process zone (issue 35): only the crack-front model has its law --------
+# -- a rate-dependent process zone (issue 35): the crack-front model and the BEM have its law --
 PZ = dict(pz_law="gent-schultz", pz_v0=0.1, pz_xi=0.4154)
 
 
 @pytest.mark.parametrize("k", [1.0, 0.1])
 def test_a_process_zone_runs_the_crack_front_model_and_the_others_refuse_it(k):
     sc = dict(n=0.8, k=k, mu=3.24, a0=3.0, rate=10.0, **PZ)
-    # auto: the crack-front model, never the elastic branch (k = 1) nor the BEM
+    # auto: the crack-front model, never the elastic branch (k = 1)
     choice = models.model_choice(Scene(**sc, model="auto"))
     assert choice.model == "crack" and "process zone" in choice.reason
     assert not models.wants_quasistatic(Scene(**sc), Numerics.preset("balanced"))
@@ -215,11 +215,10 @@ def test_a_process_zone_runs_the_crack_front_model_and_the_others_refuse_it(k):
     # the process zone raises the pull-off above the same scene without one
     plain = models.simulate(Scene(n=0.8, k=k, mu=3.24, a0=3.0, rate=10.0, model="crack"))
     assert res.pull_off > plain.pull_off
-    for model, words in (("bem", "the BEM's interface is the rate-independent"),
-                         ("elastic", "the elastic branch is quasi-static"),
+    for model, words in (("elastic", "the elastic branch is quasi-static"),
                          ("pb", "the pb estimate's v-r fit was measured without")):
         r = models.simulate(Scene(**sc, model=model))
         assert r.status == "failed" and r.reason.startswith(words), (model, r.reason)
-        assert "pz_law gent-schultz" in r.reason and "model crack or auto" in r.reason
+        assert "pz_law gent-schultz" in r.reason and "model bem, crack or auto" in r.reason
         assert not is_physical_refusal(r.reason)      # another model answers it
         assert r.model_used == model

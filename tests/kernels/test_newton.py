@@ -6,7 +6,7 @@ import pytest
 
 from sweep.kernels import jacobian as jac
 from sweep.kernels import solve as ks
-from sweep.kernels.interface import lj_traction_and_stiffness
+from sweep.kernels.interface import ZONE_SIZE, lennard_jones, lj_traction_and_stiffness
 from sweep.engine.mesh import uniform_mesh
 from sweep.engine.problem import lj_constants
 
@@ -30,7 +30,7 @@ def _stiffness(h, h0, c, ceff):
 
 
 def _factorize(h, A, ceff, h0, c, cache):
-    return jac.factorize(h, A, ceff, h0, c, cache)
+    return jac.factorize(h, A, ceff, h0, c, np.zeros(h.size), np.zeros(ZONE_SIZE), cache)
 
 
 def _direction(F, d, A, ceff, cache, stats):
@@ -141,7 +141,7 @@ def test_newton_solves_the_discrete_equilibrium():
     cache = ks.new_jacobian_cache(120)
     stats = np.zeros(ks.N_STATS, np.int64)
     hs = h_start.copy()
-    assert ks.newton(hs, g, A, ceff, H, h0, c, 1e-10 * h0, 40, cache, stats)
+    assert ks.newton(hs, g, A, ceff, H, lennard_jones(h0, c, A.shape[0]), 1e-10 * h0, 40, cache, stats)
     sig, d = np.empty(120), np.empty(120)
     lj_traction_and_stiffness(hs, h0, c, sig, d)
     assert np.max(np.abs(hs - g - A @ (ceff * sig - H))) < 1e-10 * h0
@@ -169,7 +169,7 @@ def test_solves_ended_on_the_predicted_residual_meet_the_tolerance():
         g = -delta + h0 + 0.5 * r**2
         guess = 2.0 * h - prev if n > 0 else h.copy()
         before = stats[ks.STAT_PREDICTED]
-        assert ks.newton(guess, g, A, ceff, H, h0, c, tol, 40, cache, stats)
+        assert ks.newton(guess, g, A, ceff, H, lennard_jones(h0, c, A.shape[0]), tol, 40, cache, stats)
         lj_traction_and_stiffness(guess, h0, c, sig, d)
         residual = np.max(np.abs(guess - g - A @ (ceff * sig - H)))
         ended[bool(stats[ks.STAT_PREDICTED] > before)].append(residual / tol)
@@ -218,9 +218,11 @@ def test_relax_reaches_the_equilibrium_newton_finds():
     ceff, H = 0.8, -0.05 * np.exp(-r)
     stats = np.zeros(ks.N_STATS, np.int64)
     hn = h_start.copy()
-    assert ks.newton(hn, g, A, ceff, H, h0, c, 1e-10 * h0, 40, ks.new_jacobian_cache(N), stats)
+    assert ks.newton(hn, g, A, ceff, H, lennard_jones(h0, c, A.shape[0]), 1e-10 * h0, 40,
+                     ks.new_jacobian_cache(N), stats)
     hr = h_start.copy()
-    assert ks.relax(hr, g, A, ceff, H, h0, c, 1e-10 * h0, ks.RELAX_MAX_ITER, stats)
+    assert ks.relax(hr, g, A, ceff, H, lennard_jones(h0, c, N), 1e-10 * h0, ks.RELAX_MAX_ITER,
+                    stats)
     sig, d = np.empty(N), np.empty(N)
     lj_traction_and_stiffness(hr, h0, c, sig, d)
     assert np.max(np.abs(hr - g - A @ (ceff * sig - H))) < 1e-10 * h0

@@ -24,7 +24,7 @@ def _run(chunk):
     el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, NUMERICS.tol)
     h, delta0 = relaxed_state(el, a0=SCENE.a0)
     N, M = pb.mesh.nodes, pb.prony_weights.size
-    q, step = np.zeros((M, N)), np.zeros(1)
+    q, step, sigma = np.zeros((M, N)), np.zeros(1), np.zeros(N)
     out = [np.empty(NUMERICS.max_steps + 1) for _ in range(5)]
     stats = np.zeros(N_STATS, np.int64)
     cache = new_jacobian_cache(N)
@@ -37,8 +37,9 @@ def _run(chunk):
                               STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range,
                               NUMERICS.da_max * pb.mesh.spacing, 0.0)
         status, n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
-                           Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, SCENE.rate),
-                           control, RunState(h, delta0, q, n, step), Records(*out, h_out),
+                           Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, SCENE.rate,
+                                   pb.hdot_c, pb.pz_xi),
+                           control, RunState(h, delta0, q, n, step, sigma, np.zeros(N)), Records(*out, h_out),
                            cache, stats)
         calls += 1
         h = h_out

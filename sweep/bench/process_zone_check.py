@@ -1,0 +1,89 @@
+"""The BEM's process zone against the crack-front model, and what it costs (``make pz-check``).
+
+For each case of :data:`CASES` (an elastic bulk and two viscoelastic materials at mu = 5,
+the Gent-Schultz process zone pz_v0 = 1 a_ref/tau0, xi = 0.5) and each rate, the pull-off
+with and without the process zone from the BEM (balanced preset, graded mesh) and from the
+crack-front model, their amplifications P(pz)/P(none), and the BEM's wall time with the
+process zone over the same scene's without it (one process, the kernels compiled first, the
+scenes run in alternation). Written to ``results/process_zone/check.json`` with a table on
+stdout.
+
+``python -m sweep.bench.process_zone_check [--out PATH]``
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..campaign.store import provenance, to_jsonable
+from ..engine.models import simulate
+from ..engine.process_zone import opening_rate_scale
+from ..scene import Numerics, Scene
+
+MU, A0 = 5.0, 1.5
+PZ = dict(pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5)
+#: (name, material fields, rates)
+CASES = (("elastic", dict(n=0.5, k=1.0), (0.1, 1.0, 10.0, 100.0)),
+         ("MPL n 0.5 k 0.1", dict(n=0.5, k=0.1), (1.0, 10.0, 100.0)),
+         ("SLS k 0.2", dict(material="sls", n=0.5, k=0.2), (1.0, 10.0)))
+OUT = Path("results") / "process_zone" / "check.json"
+
+
+def _run(model: str, fields: dict, rate: float, pz: bool):
+    extra = PZ if pz else {}
+    t0 = time.perf_counter()
+    res = simulate(Scene(model=model, mu=MU, a0=A0, rate=rate, **fields, **extra),
+                   Numerics.preset("balanced"))
+    return res, time.perf_counter() - t0
+
+
+def measure() -> dict:
+    _run("bem", CASES[0][1], 1.0, True)           # compile (or load) the kernels first
+    rows = []
+    for name, fields, rates in CASES:
+        for rate in rates:
+            (bem_pz, w_pz), (bem, w) = _run("bem", fields, rate, True), _run("bem", fields, rate, False)
+            (cr_pz, _), (cr, _) = _run("crack", fields, rate, True), _run("crack", fields, rate, False)
+            row = {"case": name, "rate": rate, "bem_pull_off": bem.pull_off,
+                   "bem_pz_pull_off": bem_pz.pull_off, "bem_pz_status": bem_pz.status,
+                   "bem_pz_reason": bem_pz.reason, "bem_pz_error_estimate": bem_pz.error_estimate,
+                   "crack_pull_off": cr.pull_off, "crack_pz_pull_off": cr_pz.pull_off,
+                   "bem_amplification": bem_pz.pull_off / bem.pull_off,
+                   "crack_amplification": cr_pz.pull_off / cr.pull_off,
+                   "crack_speed": bem_pz.crack_speed, "bem_wall_s": w, "bem_pz_wall_s": w_pz,
+                   "bem_steps": bem.steps, "bem_pz_steps": bem_pz.steps}
+            row["difference"] = row["bem_amplification"] / row["crack_amplification"] - 1.0
+            rows.append(row)
+            print(f"{name:16s} rate {rate:7g}: amplification BEM {row['bem_amplification']:.4f}"
+                  f" crack-front {row['crack_amplification']:.4f} ({row['difference']:+.2%}); "
+                  f"BEM wall {w_pz:.2f} s with, {w:.2f} s without ({bem_pz.status})", flush=True)
+    walls = np.array([[r["bem_pz_wall_s"], r["bem_wall_s"]] for r in rows])
+    ratio = float(walls[:, 0].sum() / walls[:, 1].sum())
+    print(f"cost: the BEM with the process zone over without it, summed over the scenes: "
+          f"{ratio:.2f}")
+    return {"what": "BEM vs crack-front model with a Gent-Schultz process zone; the BEM's cost",
+            "command": "make pz-check", "mu": MU, "a0": A0, "process_zone": PZ,
+            "beta": opening_rate_scale(MU, PZ["pz_xi"]), "rows": rows,
+            "cost_ratio": ratio, "provenance": provenance()}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m sweep.bench.process_zone_check",
+                                 description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default=str(OUT), help="where to write the results (JSON)")
+    args = ap.parse_args(argv)
+    data = measure()
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(to_jsonable(data), indent=1) + "\n", encoding="utf-8")
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
