@@ -125,11 +125,16 @@ def traction(h, h_old, zone, h0, c, out):
 
 
 @njit(cache=True)
-def traction_and_stiffness(h, h_old, zone, h0, c, sig, dsig):
-    """sigma (:func:`traction`) and d sigma / dh at every node, the rate term included."""
+def traction_and_stiffness(h, h_old, zone, h0, c, sig, dsig, drate):
+    """sigma (:func:`traction`) and d sigma / dh at every node, the rate term included, and
+    that rate term alone, sigma_LJ dm/dh, in ``drate`` (zero without a process zone; the
+    Jacobian's kept factorization leaves it out beyond the crack-tip zone:
+    :mod:`kernels.jacobian`)."""
     s = zone[ZONE_RATE]
     if s == 0.0:
         lj_traction_and_stiffness(h, h0, c, sig, dsig)
+        for i in range(h.size):
+            drate[i] = 0.0
         return
     xi, qs = zone[ZONE_XI], zone[ZONE_SMOOTH]
     for i in range(h.size):
@@ -140,10 +145,12 @@ def traction_and_stiffness(h, h_old, zone, h0, c, sig, dsig):
         if h[i] > h0:
             m, dm = zone_factor((h[i] - h_old[i]) * s, xi, qs)
             sig[i] = m * lj
-            dsig[i] = m * dlj + lj * dm * s
+            drate[i] = lj * dm * s
+            dsig[i] = m * dlj + drate[i]
         else:
             sig[i] = lj
             dsig[i] = dlj
+            drate[i] = 0.0
 
 
 def lennard_jones(h0, c, N):

@@ -346,16 +346,16 @@ def _refactorize(h, A, ceff, law, cache, stats, reason):
 
 
 @njit(cache=True, inline='always')
-def _direction(h, F, A, ceff, law, sig, d, cache, stats):
+def _direction(h, F, A, ceff, law, sig, d, dr, cache, stats):
     """Newton's direction at ``h`` (residual ``F``) with the cached factorization, made again
     once when it no longer fits (the crack tip left the zone). Returns (dh, ok,
     refactorized); ok is False when even the fresh factorization gives none."""
-    traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d)
-    dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
+    traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d, dr)
+    dh, ok = newton_direction(F, d, dr, A, ceff, cache, stats, STAT_ZONE)
     if ok:
         return dh, True, False
     _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_ZONE)
-    dh, ok = newton_direction(F, d, A, ceff, cache, stats, STAT_ZONE)
+    dh, ok = newton_direction(F, d, dr, A, ceff, cache, stats, STAT_ZONE)
     return dh, ok, True
 
 
@@ -371,9 +371,8 @@ def _end_predicted(h, dh, theta, stats):
 
 @njit(cache=True)
 def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
-    """Solve F(h) = 0 in place, starting from ``h``. Returns True on convergence.
-
-    ``law`` is the interface law (:data:`kernels.interface.Interface`).
+    """Solve F(h) = 0 in place, starting from ``h``, with the interface law ``law``
+    (:data:`kernels.interface.Interface`). Returns True on convergence.
 
     The Jacobian factorization in the cache (:func:`kernels.jacobian.new_jacobian_cache`)
     is reused, its crack-tip zone kept exact (:func:`kernels.jacobian.newton_direction`); it
@@ -392,6 +391,7 @@ def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
     N = h.size
     sig = np.empty(N)
     d = np.empty(N)
+    dr = np.empty(N)
     w = np.empty(N)
     F = np.empty(N)
     Ft = np.empty(N)
@@ -409,7 +409,7 @@ def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
         if state[STATE_EXACT] == 1 and not fresh:
             _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_RETRY)
             fresh = True
-        dh, ok, refactorized = _direction(h, F, A, ceff, law, sig, d, cache, stats)
+        dh, ok, refactorized = _direction(h, F, A, ceff, law, sig, d, dr, cache, stats)
         fresh = fresh or refactorized
         if not ok:       # singular even on a fresh factorization: give up
             return False
@@ -483,7 +483,7 @@ def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
             return True
         stats[STAT_ITER] += 1
         stats[STAT_FACTOR] += 1
-        traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d)
+        traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d, w)
         for i in range(N):
             for j in range(N):
                 J[i, j] = -ceff * A[i, j] * d[j]
@@ -810,6 +810,15 @@ def predict_step(mesh, physics, work, run):
     cubic = predict_cubic(work.h, work.h_prev, work.h_prev2, work.h_prev3, dt,
                           run[RUN_DT_PREV], run[RUN_DT_PREV2], run[RUN_DT_PREV3], work.hp)
     run[RUN_TIP_MADE] = 0.0
+    if not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0:
+        # a process zone's first step: Newton starts from the rigid opening of the gaps in
+        # tension (at rest the law's rate term vanishes, and a Jacobian made there misses the
+        # far field's stiffness: the solve failed on n 0.5, k 0.1, mu 5, rate 10 with 414
+        # factorizations); from rest again where that fails (the retry of a cubic start)
+        for i in range(work.h.size):
+            if work.h[i] > h0:
+                work.hp[i] = work.h[i] + dd
+        return quadratic, True
     if cubic:
         _copy(work.hp, work.starts[0])
         if predict_lattice(mesh.r, work.h, work.past, work.past_ta, int(run[RUN_PAST]), dt,

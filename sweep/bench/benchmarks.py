@@ -596,7 +596,7 @@ def newton_diagnosis(scene, numerics, at_step: int = 300, ahead: int = 10) -> di
         lj_traction_and_stiffness(h, h0, c, sig, d)
         return d
     d0 = stiffness(gaps[at_step])
-    tip = crack_tip_index(d0)
+    tip = crack_tip_index(d0, np.zeros(d0.size))
     lo, hi = max(tip - ZONE_IN, 0), min(tip + ZONE_OUT, N)
     chord = {}
     for k in (at_step + 1, at_step + ahead):

@@ -347,10 +347,21 @@ def wants_quasistatic(scene, numerics) -> bool:
             and numerics.domain is None and not numerics.exact and scene.pz_law == "none")
 
 
+#: a crack row with a process zone: its difference from the BEM's local law, measured by
+#: ``make pz-check`` (results/process_zone/check.json, 9 scenes at mu 5), grows with the
+#: process zone's term (v/pz_v0)^pz_xi at the pull-off's crack speed: at most 0.095 of the
+#: term (elastic, rates 10 and 100; 0.055 on the SLS, 0.022 on the MPL); this fraction, with
+#: a quarter's margin, is added to the row's error
+PROCESS_ZONE_ERROR = 0.12
+
+
 def _model_error(model: str, scene, res) -> float:
     """A crack or pb row's error: :func:`measured_error` at its amplification, plus the error
-    the model states itself (the nearly elastic crack-front closed form's bound), if any."""
+    the model states itself (the nearly elastic crack-front closed form's bound), if any, and
+    with a process zone :data:`PROCESS_ZONE_ERROR` times its term at the pull-off."""
     own = res.error_estimate if math.isfinite(res.error_estimate) else 0.0
+    if scene.pz_law != "none" and math.isfinite(res.crack_speed) and res.crack_speed > 0:
+        own += PROCESS_ZONE_ERROR * (res.crack_speed / scene.pz_v0) ** scene.pz_xi
     return measured_error(model, scene.mu, amplification(res.pull_off)) + own
 
 

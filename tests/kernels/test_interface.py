@@ -84,10 +84,10 @@ def test_a_closing_or_compressed_gap_follows_the_lj_law_exactly():
 
 def test_without_a_process_zone_the_law_is_lj_bitwise():
     h = np.linspace(0.7 * H0, 6 * H0, 50)
-    a, b, da, db = (np.empty(h.size) for _ in range(4))
+    a, b, da, db, rate = (np.empty(h.size) for _ in range(5))
     lj_traction_and_stiffness(h, H0, C, a, da)
-    traction_and_stiffness(h, h - H0, np.zeros(ZONE_SIZE), H0, C, b, db)
-    assert np.array_equal(a, b) and np.array_equal(da, db)
+    traction_and_stiffness(h, h - H0, np.zeros(ZONE_SIZE), H0, C, b, db, rate)
+    assert np.array_equal(a, b) and np.array_equal(da, db) and not rate.any()
 
 
 @pytest.mark.parametrize("xi", [0.4154, 1.0])
@@ -95,8 +95,8 @@ def test_the_stiffness_is_the_laws_derivative(xi):
     h = np.linspace(0.9 * H0, 5 * H0, 40)
     h_old = h - np.linspace(-0.05, 0.3, 40) * H0      # closing, slow and fast opening
     z = zone(50.0, xi)
-    sig, d = np.empty(h.size), np.empty(h.size)
-    traction_and_stiffness(h, h_old, z, H0, C, sig, d)
+    sig, d, rate = np.empty(h.size), np.empty(h.size), np.empty(h.size)
+    traction_and_stiffness(h, h_old, z, H0, C, sig, d, rate)
     eps = 1e-7 * H0
     up, down = np.empty(h.size), np.empty(h.size)
     traction(h + eps, h_old, z, H0, C, up)
@@ -104,3 +104,9 @@ def test_the_stiffness_is_the_laws_derivative(xi):
     fd = (up - down) / (2 * eps)
     smooth = np.abs(h - H0) > 2 * eps                     # the LJ side switch at h0
     assert np.allclose(d[smooth], fd[smooth], rtol=1e-5, atol=1e-6 * np.max(np.abs(fd)))
+    # the rate term alone: the derivative at a fixed factor m is d - rate
+    m = np.where(h > H0, sig, 1.0) / np.where(h > H0, -C * ((H0 / h) ** 3 - (H0 / h) ** 9), 1.0)
+    lj, dlj = np.empty(h.size), np.empty(h.size)
+    lj_traction_and_stiffness(h, H0, C, lj, dlj)
+    assert np.allclose(d - rate, np.where(h > H0, m, 1.0) * dlj, rtol=1e-10, atol=0)
+    assert np.any(rate != 0) and not rate[h - h_old <= 0].any()
