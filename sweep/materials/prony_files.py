@@ -3,7 +3,8 @@ r"""Prony tables from what a lab has: :func:`read_prony` and the :class:`PronyTa
 A lab characterizes a material by DMA and keeps a Prony (generalized Maxwell) table, written by
 a fitting tool. :func:`read_prony` reads one from a file or an inline mapping, checks it, and
 returns a :class:`PronyTable`: the :class:`~sweep.materials.Prony` material, its relaxed and
-instantaneous moduli, where it came from, and a hash of its numbers (:meth:`PronyTable.content_hash`).
+instantaneous moduli, where it came from, and a hash of its numbers
+(:meth:`PronyTable.content_hash`).
 
 Conventions (those of :mod:`sweep.materials`)
 ---------------------------------------------
@@ -25,8 +26,8 @@ Accepted formats (recognized by their content; the extension is not needed)
 ``visco-sweep`` -- this project's CSV. Comment lines start with ``#``; the first is
 ``# visco-sweep prony``; ``# key = value`` lines give ``form`` (``wiechert`` or ``kelvin``;
 default from the column names), exactly one of ``E0`` (relaxed) or ``Einf`` (instantaneous),
-and optionally ``modulus_unit`` and ``time_unit``. Then a header ``tau,E`` (Wiechert arm
-moduli, in the modulus unit) or ``tau,c`` (Kelvin weights) and one row per arm::
+and optionally ``modulus_unit`` and ``time_unit`` (both or neither). Then a header ``tau,E``
+(Wiechert arm moduli, in the modulus unit) or ``tau,c`` (Kelvin weights) and one row per arm::
 
     # visco-sweep prony
     # form = wiechert
@@ -118,7 +119,7 @@ import io
 import json
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -281,7 +282,8 @@ def read_prony(spec, *, base_dir=None, nu=None, Einf=None) -> PronyTable:
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError:
-        raise InputError(f"{path}: not a Prony table (a binary file); accepted: {_ACCEPTED}") from None
+        raise InputError(f"{path}: not a Prony table (a binary file); "
+                         f"accepted: {_ACCEPTED}") from None
     except OSError as exc:
         raise InputError(f"{path}: cannot read the Prony table ({exc.strerror})") from None
     nu = None if nu is None else check_range("nu", nu, -1.0, 0.5, lo_open=True)
@@ -290,9 +292,7 @@ def read_prony(spec, *, base_dir=None, nu=None, Einf=None) -> PronyTable:
     reader = {"visco-sweep": _read_project_csv, "pyvisco": _read_pyvisco,
               "ansys": _read_ansys, "fit-dma": _read_json}[fmt]
     table = reader(path, text, nu=nu, Einf=Einf)
-    if name is not None:
-        object.__setattr__(table, "name", str(name))
-    return table
+    return table if name is None else replace(table, name=str(name))
 
 
 def _detect(path: Path, text: str) -> str:
@@ -336,7 +336,8 @@ def _make(form, tau, w, *, E0=None, Einf=None, where, fmt, name, source, units_k
     for label, arr in (("tau", tau), (col, w)):
         bad = np.flatnonzero(~np.isfinite(arr))
         if bad.size:
-            raise InputError(f"{where}: {label}[{bad[0]}] must be a finite number (got {arr[bad[0]]})")
+            raise InputError(f"{where}: {label}[{bad[0]}] must be a finite number "
+                             f"(got {arr[bad[0]]})")
     bad = np.flatnonzero(tau <= 0.0)
     if bad.size:
         raise InputError(f"{where}: times tau must be > 0 (got tau[{bad[0]}] = {tau[bad[0]]:g})")
@@ -385,8 +386,8 @@ def _relative(arms, tau, Einf, *, where, label, **kw):
     if arms.size and np.all(np.isfinite(arms)):
         bad = np.flatnonzero(arms < 0.0)
         if bad.size:
-            raise InputError(f"{where}: relative moduli {label} must be >= 0 (got {label}[{bad[0]}] "
-                             f"= {arms[bad[0]] / Einf:g})")
+            raise InputError(f"{where}: relative moduli {label} must be >= 0 "
+                             f"(got {label}[{bad[0]}] = {arms[bad[0]] / Einf:g})")
         s = float(arms.sum()) / Einf
         if not s < 1.0:
             raise InputError(f"{where}: the relative moduli {label} must sum to < 1 (the "
@@ -424,8 +425,9 @@ def _form(where, value, col):
     if form is None:
         raise InputError(f"{where}: form must be wiechert or kelvin (got {value!r})")
     if (col == "E") != (form == "wiechert"):
-        raise InputError(f"{where}: form {form} needs the column {'E' if form == 'wiechert' else 'c'} "
-                         f"(got {col}: E for Wiechert arm moduli, c for Kelvin weights)")
+        need = "E" if form == "wiechert" else "c"
+        raise InputError(f"{where}: form {form} needs the column {need} (got {col}: E for "
+                         f"Wiechert arm moduli, c for Kelvin weights)")
     return form
 
 
@@ -617,8 +619,9 @@ def _read_ansys(path, text, *, Einf=None, **_):
                     raise InputError(f"{path} line {no}: TB,PRONY needs TBOPT SHEAR or BULK "
                                      f"(got {opt!r})")
                 npts = f[4] if len(f) > 4 and f[4] else None
-                current = {"opt": "SHEAR" if "SHEAR".startswith(opt) else "BULK",
-                           "npts": None if npts is None else _number(f"{path} line {no}, NPTS", npts),
+                if npts is not None:
+                    npts = _number(f"{path} line {no}, NPTS", npts)
+                current = {"opt": "SHEAR" if "SHEAR".startswith(opt) else "BULK", "npts": npts,
                            "slots": {}, "next": 1, "line": no, "temps": 0}
                 tables.append(current)
         elif cmd in ("TBTEMP", "TBFIELD") and current is not None:
@@ -628,7 +631,9 @@ def _read_ansys(path, text, *, Einf=None, **_):
                                  f"temperature; give a card with one (a master curve at the "
                                  f"reference temperature)")
         elif cmd == "TBDATA" and current is not None:
-            start = int(_number(f"{path} line {no}, STLOC", f[1])) if len(f) > 1 and f[1] else current["next"]
+            start = current["next"]
+            if len(f) > 1 and f[1]:
+                start = int(_number(f"{path} line {no}, STLOC", f[1]))
             values = f[2:]
             while values and not values[-1]:
                 values.pop()

@@ -27,6 +27,7 @@ needs (E_i = E_0 alpha_i, the MPa scale).
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -90,8 +91,6 @@ def project_csv(E0: float, moduli, times) -> str:
 def main() -> None:
     master = HERE / "pdms_mpl_master.csv"
     master.write_text(master_curve())
-    import os
-
     cwd = os.getcwd()
     os.chdir(HERE)
     try:
@@ -100,7 +99,8 @@ def main() -> None:
         os.chdir(cwd)
     (HERE / "pdms_fit_dma.json").write_text(json.dumps(doc, indent=1) + "\n")
     mx = doc["maxwell"]
-    E0, moduli, times = float(mx["E0"]), [float(x) for x in mx["moduli"]], [float(x) for x in mx["times"]]
+    E0 = float(mx["E0"])
+    moduli, times = [float(x) for x in mx["moduli"]], [float(x) for x in mx["times"]]
     (HERE / "pdms_prony.csv").write_text(pyvisco_csv(E0, moduli, times))
     (HERE / "pdms_prony_ansys.mpl").write_text(ansys_card(E0, moduli, times))
     (HERE / "pdms_prony_visco_sweep.csv").write_text(project_csv(E0, moduli, times))
