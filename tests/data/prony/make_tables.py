@@ -8,9 +8,9 @@ E0 = 1.458e6 Pa, Einf = 3.089e9 Pa, n = 0.2207, tau0 = 0.01876 s (``sweep/paper/
 
 * ``pdms_mpl_master.csv`` -- the MPL's complex modulus at 5 angular frequencies a decade from
   1e-2 to 1e14 rad/s (81 rows, as configs/dma/make_sample.py, without noise), full precision;
-* ``pdms_fit_dma.json`` -- ``sweep fit-dma pdms_mpl_master.csv --maxwell 18 --json`` (its
-  ``maxwell`` object is the table: E0 [Pa], 18 moduli [Pa] of which NNLS sets some to 0,
-  times [s]);
+* ``pdms_fit_dma.json`` -- ``sweep fit-dma pdms_mpl_master.csv --maxwell 18 --out
+  pdms_fit_dma.json`` (the ``--json`` object; its ``maxwell`` object is the table: E0 [Pa],
+  18 moduli [Pa] of which NNLS sets some to 0, times [s]);
 * ``pdms_prony.csv`` -- the same table as pyvisco writes its ``df_prony.csv`` (names row
   ``i,tau_i,alpha_i,E_0,E_i``, units row ``-,s,-,MPa,MPa``; E_0 the INSTANTANEOUS modulus
   Einf = E0 + sum E_i, alpha_i = E_i/E_0, E_i = E_0 alpha_i as pyvisco computes it), rows in
@@ -48,12 +48,18 @@ def master_curve() -> str:
     return "\n".join(["omega_rad_s,E_storage_Pa,E_loss_Pa", *rows]) + "\n"
 
 
-def fit_dma_json(master: Path) -> dict:
-    res = CliRunner().invoke(cli, ["fit-dma", master.name, "--maxwell", str(ARMS), "--json"],
-                             catch_exceptions=False)
+def fit_dma_json(master: Path, out: Path) -> dict:
+    """``sweep fit-dma MASTER --maxwell 18 --out OUT`` run in MASTER's folder; OUT's object."""
+    cwd = os.getcwd()
+    os.chdir(master.parent)
+    try:
+        res = CliRunner().invoke(cli, ["fit-dma", master.name, "--maxwell", str(ARMS),
+                                       "--out", out.name], catch_exceptions=False)
+    finally:
+        os.chdir(cwd)
     if res.exit_code != 0:
         raise SystemExit(f"sweep fit-dma failed: {res.output}")
-    return json.loads(res.output)
+    return json.loads(out.read_text())
 
 
 def pyvisco_csv(E0: float, moduli, times) -> str:
@@ -91,13 +97,7 @@ def project_csv(E0: float, moduli, times) -> str:
 def main() -> None:
     master = HERE / "pdms_mpl_master.csv"
     master.write_text(master_curve())
-    cwd = os.getcwd()
-    os.chdir(HERE)
-    try:
-        doc = fit_dma_json(master)
-    finally:
-        os.chdir(cwd)
-    (HERE / "pdms_fit_dma.json").write_text(json.dumps(doc, indent=1) + "\n")
+    doc = fit_dma_json(master, HERE / "pdms_fit_dma.json")
     mx = doc["maxwell"]
     E0 = float(mx["E0"])
     moduli, times = [float(x) for x in mx["moduli"]], [float(x) for x in mx["times"]]
