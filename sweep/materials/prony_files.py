@@ -73,7 +73,8 @@ shear relative moduli are those of E. A ``BULK`` table alone is refused; beside 
 table it must be the same series (else nu would change in time). One temperature only. With
 ``/UNITS,SI`` the numbers are Pa and s, with ``/UNITS,MPA`` MPa and s; otherwise as given.
 
-``fit-dma`` -- the JSON printed by ``sweep fit-dma FILE.csv --maxwell N --json``: its
+``fit-dma`` -- the JSON that ``sweep fit-dma FILE.csv --maxwell N --out FIT.json`` writes (and
+``--json`` prints): its
 ``maxwell`` object (``E0`` relaxed [Pa], ``moduli`` [Pa], ``times`` [s]) is the table. A JSON
 from ``--maxwell 0`` holds only the MPL fit and is REFUSED, naming its four constants: an MPL
 is not a finite table (its Prony series depends on the time window a scene needs, which is
