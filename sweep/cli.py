@@ -560,7 +560,10 @@ def _si_unit(name: str) -> str:
               help="Relative rms noise of E' and E'' (0.03 = 3 %); the Kramers-Kronig "
                    "tolerance grows with it.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (SI units).")
-def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json):
+@click.option("--out", "json_out", default=None, metavar="FIT.json",
+              help="Also write that JSON object to FIT.json: a Prony table a scene can read "
+                   "(its maxwell arms; sweep.materials.read_prony).")
+def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_out):
     """Fit the MPL constants (and a generalized Maxwell model) to DMA data.
 
     FILE.csv holds a master curve (omega_rad_s,E_storage_Pa,E_loss_Pa) or a temperature
@@ -583,14 +586,20 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json):
                                                       0.0, 0.5))
     if plot_out is not None:
         plot_dma(data, mpl, mx, plot_out)
+    out = {"source": csv_file, "kind": data.kind, "points": int(data.omega.size),
+           "omega_min_rad_s": float(data.omega.min()),
+           "omega_max_rad_s": float(data.omega.max()),
+           "T_ref_C": data.T_ref, "wlf": data.wlf,
+           "E0": mpl.E0, "Einf": mpl.Einf, "n": mpl.n, "tau0": mpl.tau0, "k": mpl.k,
+           "mpl": mpl.to_dict(), "maxwell": None if mx is None else mx.to_dict(),
+           "kramers_kronig": kk.to_dict(), "plot": plot_out}
+    if json_out is not None:
+        try:
+            with open(json_out, "w") as fh:   # numpy scalars as Python numbers
+                fh.write(json.dumps(out, indent=1, default=lambda x: x.item()) + "\n")
+        except OSError as exc:
+            raise InputError(f"out: cannot write {json_out} ({exc.strerror})") from None
     if as_json:
-        out = {"source": csv_file, "kind": data.kind, "points": int(data.omega.size),
-               "omega_min_rad_s": float(data.omega.min()),
-               "omega_max_rad_s": float(data.omega.max()),
-               "T_ref_C": data.T_ref, "wlf": data.wlf,
-               "E0": mpl.E0, "Einf": mpl.Einf, "n": mpl.n, "tau0": mpl.tau0, "k": mpl.k,
-               "mpl": mpl.to_dict(), "maxwell": None if mx is None else mx.to_dict(),
-               "kramers_kronig": kk.to_dict(), "plot": plot_out}
         echo_json(out)
         return
     click.echo(f"# {csv_file}: {data.kind}, {data.omega.size} points, omega "
@@ -625,6 +634,8 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json):
                f"{'consistent' if kk.consistent else 'NOT consistent'}")
     if plot_out is not None:
         click.echo(f"plot: {plot_out}")
+    if json_out is not None:
+        click.echo(f"fit: {json_out}")
 
 
 

@@ -60,6 +60,8 @@ Modules (one concept each; import the public names from ``sweep.materials``)
 ``mpl``           ``MPLRetardation``, ``MPLRelaxation``
 ``sls``           ``SLS``
 ``prony_table``   ``Prony`` (a Kelvin or Wiechert table as a material)
+``prony_files``   ``read_prony``, ``PronyTable`` (a Prony table from a lab's file: this project's
+                  CSV, pyvisco's df_prony.csv, an ANSYS TB,PRONY card, sweep fit-dma JSON)
 ``prony_series``  ``PronySeries`` (the fitted series the solver uses)
 ``fitting``       the Prony fitter ``fit_prony``
 ``varpro``        its compiled Levenberg-Marquardt on the log times (Numba; NNLS inside)
@@ -75,6 +77,7 @@ from .closed_forms import (mpl_integrated_compliance, mpl_normalized_creep_compl
 from .fitting import CHECK_PPD, FIT_PPD, fit_prony
 from .mpl import MPLRelaxation, MPLRetardation
 from .prony_series import PronySeries
+from .prony_files import PronyTable, read_prony
 from .prony_table import Prony
 from .sls import SLS
 from .special import expint, expint_scaled
@@ -85,6 +88,8 @@ __all__ = [
     "MPLRelaxation",
     "SLS",
     "Prony",
+    "PronyTable",
+    "read_prony",
     "PronySeries",
     "expint",
     "expint_scaled",

@@ -151,6 +151,32 @@ def test_cli_fit_dma_json(tmp_path, capsys):
     assert d["kramers_kronig"]["consistent"] is True
 
 
+def test_cli_fit_dma_out_is_a_prony_table(tmp_path, capsys):
+    """--out writes the --json object to a file, which read_prony takes as the Maxwell table
+    (issue 36 item 1); with --maxwell 0 the file holds only the MPL and read_prony refuses it."""
+    from sweep.materials import read_prony
+
+    w = np.logspace(-2, 14, 33)
+    E = MPLRetardation(**TRUE).complex_modulus(w)
+    p = tmp_path / "master.csv"
+    write_master(p, w, E)
+    fit = tmp_path / "fit.json"
+    assert main(["fit-dma", str(p), "--maxwell", "12", "--out", str(fit)]) == 0
+    out = capsys.readouterr().out
+    assert f"fit: {fit}" in out
+    d = json.loads(fit.read_text())
+    mx = d["maxwell"]
+    table = read_prony(fit)
+    keep = np.array(mx["moduli"]) > 0
+    assert table.source_format == "fit-dma" and table.n_arms == int(keep.sum())
+    assert table.E0 == mx["E0"] and table.Einf == pytest.approx(mx["Einf"], rel=1e-14)
+    assert np.array_equal(table.weights, np.array(mx["moduli"])[keep])
+    assert main(["fit-dma", str(p), "--maxwell", "0", "--out", str(fit)]) == 0
+    with pytest.raises(InputError, match="holds only an MPL fit"):
+        read_prony(fit)
+    assert main(["fit-dma", str(p), "--out", str(tmp_path / "no" / "f.json")]) == 2
+
+
 def test_cli_fit_dma_text_and_plot(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     w = np.logspace(0, 12, 25)
