@@ -60,8 +60,7 @@ Modules (one concept each; import the public names from ``sweep.materials``)
 ``mpl``           ``MPLRetardation``, ``MPLRelaxation``
 ``sls``           ``SLS``
 ``prony_table``   ``Prony`` (a Kelvin or Wiechert table as a material)
-``prony_files``   ``read_prony``, ``PronyTable`` (a Prony table from a lab's file: this project's
-                  CSV, pyvisco's df_prony.csv, an ANSYS TB,PRONY card, sweep fit-dma JSON)
+``prony_files``   ``read_prony``, ``PronyTable`` (a lab's Prony table file, several formats)
 ``prony_series``  ``PronySeries`` (the fitted series the solver uses)
 ``fitting``       the Prony fitter ``fit_prony``
 ``varpro``        its compiled Levenberg-Marquardt on the log times (Numba; NNLS inside)
