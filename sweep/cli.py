@@ -223,8 +223,7 @@ def scene_from_options(values: dict):
                     for name, v in values.items()})
 
 
-_SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", "indentation",
-               "speed")
+_SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "a0_si", "indentation", "speed")
 
 
 @cli.command("scene")
@@ -240,8 +239,6 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "preload", "a0_si", 
 @click.option("--tau0", "tau0", type=str, default=None, help="[--si] MPL time tau0 [s].")
 @click.option("--dg", "dg", type=str, default=None, help="[--si] work of adhesion [J/m^2].")
 @click.option("--h0", "h0", type=str, default=None, help="[--si] LJ equilibrium distance [m].")
-@click.option("--preload", "preload", type=str, default=None,
-              help="[--si] preload force [N] (relaxed JKR contact at that load).")
 @click.option("--a0-si", "a0_si", type=str, default=None, help="[--si] initial contact radius [m].")
 @click.option("--indentation", "indentation", type=str, default=None,
               help="[--si] initial indentation [m].")
@@ -292,8 +289,12 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, exact, as_json, tr
     if as_json:
         echo_json(res.to_dict(trajectory=trajectory))
     else:
-        click.echo(f"scene      n={sc.n:g} k={sc.k:g} mu={sc.mu:g} rate={sc.rate:g} "
-                   f"{'a0=' + format(sc.a0, 'g') if sc.a0 is not None else 'delta0=' + format(sc.delta0, 'g')}"
+        if sc.protocol() is not None:
+            start = (f"approach_rate={sc.approach_rate:g} preload={sc.preload:g} "
+                     f"dwell={sc.dwell:g} ({sc.dwell_hold})")
+        else:
+            start = f"a0={sc.a0:g}" if sc.a0 is not None else f"delta0={sc.delta0:g}"
+        click.echo(f"scene      n={sc.n:g} k={sc.k:g} mu={sc.mu:g} rate={sc.rate:g} {start}"
                    f" material={sc.material} model={sc.model}")
         for line in scene_text(res, preset):
             click.echo(line)
@@ -409,6 +410,8 @@ def _scene_si(axes, as_json, values):
     if missing:
         raise InputError(f"{', '.join(missing)} must be given with --si")
     kw = {name: as_float(name, v) for name, v in values.items() if v is not None}
+    if axes["preload"] is not None:         # the one --preload: newtons with --si
+        kw["preload"] = as_float("preload", axes["preload"])
     if "a0_si" in kw:
         kw["a0"] = kw.pop("a0_si")
     pz = {"pz_law": axes["pz_law"], **{name: as_float(name, axes[name])

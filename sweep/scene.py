@@ -38,6 +38,8 @@ MODEL_NAMES = ("bem", "crack", "pb", "elastic", "auto")
 PZ_LAWS = ("none", "gent-schultz")
 #: the Scene fields of a process zone's parameters (given exactly when ``pz_law`` is not none)
 PZ_PARAMETERS = ("pz_v0", "pz_xi")
+#: what the dwell of a test protocol holds (``dwell_hold``)
+DWELL_HOLDS = ("force", "depth")
 
 
 def axis(default=dataclasses.MISSING, *, help: str, unit: str = "", limits=None,
@@ -70,6 +72,22 @@ def axis(default=dataclasses.MISSING, *, help: str, unit: str = "", limits=None,
             "choices": choices, "label": label, "order": order, "plot_group": plot_group,
             "cli_default": cli_default}
     return field(default=default, metadata={"axis": meta})
+
+
+def check_protocol(approach_rate, preload, dwell, dwell_hold) -> bool:
+    """Whether the fields give a test protocol (approach, dwell, retract); InputError unless
+    ``approach_rate``, ``preload`` and ``dwell`` are given together, or none of them (and
+    ``dwell_hold`` then at its default)."""
+    values = {"approach_rate": approach_rate, "preload": preload, "dwell": dwell}
+    given = [k for k, v in values.items() if v is not None]
+    if given and len(given) < len(values):
+        missing = [k for k in values if k not in given]
+        raise InputError(f"{'/'.join(missing)}: a protocol needs approach_rate, preload and "
+                         f"dwell together (missing {', '.join(missing)})")
+    if not given and dwell_hold != "force":
+        raise InputError(f"dwell_hold: {dwell_hold!r} needs a protocol (approach_rate, preload, "
+                         f"dwell); without one the scene starts relaxed")
+    return bool(given)
 
 
 def check_process_zone(pz_law, pz_v0, pz_xi, speed_unit: str) -> None:
@@ -129,8 +147,9 @@ class Scene:
         dg is rate independent, the BEM's Lennard-Jones law) or "gent-schultz",
         Gamma_pz(v) = dg (1 + (v/pz_v0)^pz_xi) at an opening crack speed v > 0 and dg at
         v <= 0. The crack-front model multiplies it with the bulk's Persson-Brener factor
-        (:mod:`sweep.engine.crack_front`); the BEM and the pb estimate refuse it, "auto"
-        sends it to the crack-front model.
+        (:mod:`sweep.engine.crack_front`); the BEM runs it as a local law on the opening
+        rate (:mod:`sweep.engine.process_zone`); the pb estimate refuses it, "auto" sends it
+        to the crack-front model.
     pz_v0 : float, optional
         Crack speed at which the process zone doubles the work of adhesion, in a_ref/tau0
         (the crack-speed unit of docs/design.md section 2), > 0; given exactly when
@@ -138,6 +157,13 @@ class Scene:
     pz_xi : float, optional
         Exponent of the Gent-Schultz law, in (0, 10]; given exactly when ``pz_law`` is not
         "none".
+    approach_rate, preload, dwell : float, optional
+        A test protocol, given together (:mod:`sweep.engine.protocol`): the scene starts at
+        first contact (neither ``a0`` nor ``delta0``), approaches at d delta/dt =
+        approach_rate h0 until the load is ``preload`` (pi dg R), dwells for ``dwell``
+        (tau0), then retracts at ``rate``. Only the BEM runs it.
+    dwell_hold : {"force", "depth"}
+        What the dwell holds: the load at ``preload`` (default) or the indentation.
     """
 
     n: float = axis(help="MPL exponent (spectrum broadness); unused by sls", limits=(0.0, 5.0),
@@ -172,7 +198,7 @@ class Scene:
                       choices=MODEL_NAMES, order=-1)
     pz_law: str = axis("none", help="rate-dependent process zone: none (rate-independent dg, "
                        "the LJ law) or gent-schultz, Gamma_pz(v) = dg (1 + (v/pz_v0)^pz_xi) "
-                       "(models crack and auto; bem and pb refuse it)", choices=PZ_LAWS,
+                       "(models bem, crack and auto; pb and elastic refuse it)", choices=PZ_LAWS,
                        order=-4)
     pz_v0: float | None = axis(None, help="process zone: crack speed at which it doubles the "
                                "work of adhesion (with pz_law gent-schultz)",
@@ -181,15 +207,41 @@ class Scene:
     pz_xi: float | None = axis(None, help="process zone: exponent of Gamma_pz(v) (with pz_law "
                                "gent-schultz)", limits=(0.0, 10.0), lo_open=True,
                                label=r"$\xi$", order=-2)
+    approach_rate: float | None = axis(None, help="protocol: approach rate r-hat, d delta/dt "
+                                       "= approach_rate h0 (with preload and dwell; the "
+                                       "scene then starts at first contact, neither a0 nor "
+                                       "delta0)", limits=(0.0, 1e12), lo_open=True,
+                                       label=r"approach rate $\hat r_a$", order=-9)
+    preload: float | None = axis(None, help="protocol: the load at the end of the approach "
+                                 "(sweep scene --si: newtons, and without --dwell the "
+                                 "relaxed contact at that load)", unit="pi dg R", limits=(0.0, 1e6), lo_open=True,
+                                 label=r"$\hat P_0$", order=-8)
+    dwell: float | None = axis(None, help="protocol: the dwell after the approach",
+                               unit="tau0", limits=(0.0, 1e15), label=r"dwell $\hat t_d$",
+                               order=-7)
+    dwell_hold: str = axis("force", help="protocol: what the dwell holds, the load (force) or "
+                           "the indentation (depth)", choices=DWELL_HOLDS, order=-6)
 
     def __post_init__(self):
         info = _axes_of(type(self))
+        protocol = check_protocol(self.approach_rate, self.preload, self.dwell, self.dwell_hold)
         for f in dataclasses.fields(self):
-            if f.name == "a0" and (self.a0 is None) == (self.delta0 is None):
+            if f.name == "a0" and not protocol and (self.a0 is None) == (self.delta0 is None):
                 raise InputError("a0/delta0: give exactly one of a0 (initial contact radius) "
                                  "and delta0 (initial indentation)")
+            if f.name == "a0" and protocol and (self.a0, self.delta0) != (None, None):
+                raise InputError("a0/delta0: a scene with a protocol (approach_rate, preload, "
+                                 "dwell) starts at first contact: give neither a0 nor delta0")
             object.__setattr__(self, f.name, info[f.name].check(getattr(self, f.name)))
         check_process_zone(self.pz_law, self.pz_v0, self.pz_xi, "a_ref/tau0")
+
+    def protocol(self):
+        """The test protocol (:class:`sweep.engine.protocol.Protocol`), or None for the
+        relaxed start."""
+        if self.dwell is None:
+            return None
+        from .engine.protocol import Protocol   # lazy: the engine imports this module
+        return Protocol(self.approach_rate, self.preload, self.dwell, self.dwell_hold)
 
     def to_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -617,8 +669,13 @@ class Result:
         The BEM's resolution behind the row: spacings per process zone (the graded mesh's
         band resolution; NaN on a mesh given by its node count, whose ``nodes_used`` says it)
         and the largest indentation step (h0). NaN for the other models.
+    hysteresis_energy : float
+        A scene with a test protocol: the work the machine did on the sphere over the whole
+        path, int P d delta (pi dg R d_ref; :func:`sweep.engine.protocol.cycle_work`); NaN
+        without a protocol.
     trajectory : dict of arrays
-        ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0).
+        ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0); with
+        a protocol also ``phase`` (0 approach, 1 dwell, 2 retraction).
     """
 
     scene: Scene
@@ -651,6 +708,7 @@ class Result:
     refinements: int = 0
     band_resolution_used: float = math.nan
     step_used: float = math.nan
+    hysteresis_energy: float = math.nan
     trajectory: dict = field(default_factory=dict)
 
     @property
@@ -669,7 +727,11 @@ class Result:
         points = len(next(iter(self.trajectory.values()), ()))
         reason = self.reason if len(self.reason) <= 80 else self.reason[:77] + "..."
         sc = self.scene
-        start = f"a0={sc.a0:g}" if sc.a0 is not None else f"delta0={sc.delta0:g}"
+        if sc.protocol() is not None:
+            start = (f"approach_rate={sc.approach_rate:g} preload={sc.preload:g} "
+                     f"dwell={sc.dwell:g} ({sc.dwell_hold})")
+        else:
+            start = f"a0={sc.a0:g}" if sc.a0 is not None else f"delta0={sc.delta0:g}"
         pz = (f" pz_law={sc.pz_law} pz_v0={sc.pz_v0:g} pz_xi={sc.pz_xi:g}"
               if sc.pz_law != "none" else "")
         return (f"Result({self.status}{' (' + reason + ')' if reason else ''}: "

@@ -40,6 +40,7 @@ from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Problem, Refused, derive, material_of, prepare
+from .protocol import PHASES, cycle_work, run_phases
 from .resolution import estimate_error, refine_advice
 
 #: Newton iterations per solve: a good step converges in 2-5 (quadratic predictor); a solve
@@ -198,6 +199,8 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
     res.prony_terms, res.prony_error = int(pb.prony_weights.size), pb.prony_error
 
     el = ElasticSolver(pb.A, r, pb.h0, pb.c, numerics.tol)
+    if scene.protocol() is not None:
+        return _simulate_protocol(pb, res, el, deadline)
     try:
         h_init, delta0 = relaxed_state(el, delta0=scene.delta0, a0=scene.a0,
                                        mesh_key=(mesh.key, mesh.spacing))
@@ -229,16 +232,29 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
                                  stats)
     else:
         run = UnloadingState.start(pb, h_init, delta0, el.cache, stats)
-        while True:
-            status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
-            if status != STATUS_STEP_LIMIT or run.n > numerics.max_steps:
-                break
-            if time.perf_counter() > deadline:
-                status = STATUS_TIME_BUDGET
-                break
+        status = _unload(pb, run, deadline)
         n, out = run.n, run.records
     t, delta, P, a, a_inner = (x[:n].copy() for x in out)
     res.trajectory = {"t": t, "delta": delta, "P": P, "a": a, "a_inner": a_inner}
+    return _finish(pb, res, status, stats)
+
+
+def _unload(pb: Problem, run: UnloadingState, deadline: float) -> int:
+    """The unloading kernel in chunks of CHUNK_STEPS until it ends, or the deadline does."""
+    while True:
+        status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
+        if status != STATUS_STEP_LIMIT or run.n > pb.numerics.max_steps:
+            return status
+        if time.perf_counter() > deadline:
+            return STATUS_TIME_BUDGET
+
+
+def _finish(pb: Problem, res: Result, status: int, stats) -> str | None:
+    """The counters and the outcome of a run whose trajectory ``res`` holds: "inner"/"outer"
+    where the crack tip left the fine band, else None (:func:`finish`)."""
+    a = res.trajectory["a"]
+    dr, n = pb.mesh.spacing, len(a)
+    min_travel = STOP_TRAVEL_SPACINGS * dr
     res.steps = n - 1
     res.newton_iterations = int(stats[STAT_ITER])
     res.factorizations = int(stats[STAT_FACTOR])
@@ -247,8 +263,47 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
                       f" of the graded mesh (a = {a[-1]:.4g})")
         return "inner" if a[-1] < pb.tip_range[0] else "outer"
     finish(res, status, res.trajectory, dr, min_travel, pb.scales,
-           advice=refine_advice(numerics))
+           advice=refine_advice(pb.numerics))
     return None
+
+
+def _simulate_protocol(pb: Problem, res: Result, el: ElasticSolver, deadline: float):
+    """A scene with a test protocol (:mod:`sweep.engine.protocol`): approach and dwell, then
+    the unloading kernel from the dwell's last state, its modes and its records. The row's
+    initial state (``a0_result``, ``delta0_result``, ``a0_inner``) is the dwell's last, the
+    retraction's start; ``hysteresis_energy`` the work of the whole path; the trajectory's
+    ``phase`` says which phase made each record."""
+    try:
+        march = run_phases(pb, pb.scene.protocol(), el)
+    except OverBudget:
+        raise
+    except RuntimeError as exc:
+        res.reason = f"protocol: {exc}"
+        return None
+    rec = march.records
+    n0 = len(rec["t"])
+    res.delta0_result, res.a0_result, res.a0_inner = march.delta, rec["a"][-1], rec["a_inner"][-1]
+    if res.a0_result >= pb.mesh.r[-2]:
+        res.reason = (f"the contact at the preload, radius {res.a0_result:.4g}, reaches the "
+                      f"mesh edge (domain {pb.mesh.domain:.4g})")
+        return None
+    # the retraction's records follow the march's: room for both
+    pb = dataclasses.replace(pb, numerics=dataclasses.replace(
+        pb.numerics, max_steps=pb.numerics.max_steps + n0))
+    stats = el.stats.copy()
+    invalidate(march.cache)
+    run = UnloadingState.start(pb, march.h, march.delta, march.cache, stats)
+    for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):
+        run.records[i][:n0] = rec[key]
+    run.n, run.q, run.sigma, run.h_prev = n0, march.q, march.sigma, march.h_prev
+    status = _unload(pb, run, deadline)
+    n = run.n
+    res.trajectory = {key: x[:n].copy() for key, x in
+                      zip(("t", "delta", "P", "a", "a_inner"), run.records)}
+    res.trajectory["phase"] = np.concatenate(
+        [np.asarray(rec["phase"], float), np.full(n - n0, float(PHASES["retract"]))])
+    res.hysteresis_energy = cycle_work(res.trajectory)
+    return _finish(pb, res, status, stats)
 
 
 def kernels_cached() -> bool:

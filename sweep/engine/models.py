@@ -55,7 +55,7 @@ from .problem import BEM_MU_RANGE, derive
 from .resolution import refined, unresolved
 from .quasistatic import simulate_elastic
 
-__all__ = ["MODELS", "PROCESS_ZONE_REFUSALS", "simulate", "pb_estimate", "simulate_pb",
+__all__ = ["MODELS", "PROCESS_ZONE_REFUSALS", "PROTOCOL_REFUSALS", "simulate", "pb_estimate", "simulate_pb",
            "simulate_model",
            "simulate_scene", "choose_model", "model_choice", "Choice", "measured_error",
            "bem_nodes_needed", "bem_node_budget", "wants_quasistatic", "wants_tip_following"]
@@ -154,9 +154,9 @@ def _bem(scene, numerics=None):
 
 def _bem_once(scene, numerics):
     """One BEM solve with its error estimate, on the mesh that fits ``numerics`` (a scene
-    with a process zone on the graded or uniform mesh: the tip-following mesh's re-meshing
-    carries no opening rates)."""
-    if scene.pz_law == "none" and wants_tip_following(scene, numerics):
+    with a process zone or a test protocol on the graded or uniform mesh: the tip-following
+    mesh's re-meshing carries no opening rates, and its window starts at a0)."""
+    if wants_tip_following(scene, numerics):
         from .tip_following import simulate_tip_following  # lazy: scipy.interpolate, optimize
 
         return simulate_tip_following(scene, numerics)
@@ -179,8 +179,11 @@ def wants_tip_following(scene, numerics) -> bool:
     a graded mesh sized from the band resolution (``nodes`` unset, not ``exact``) whose
     fixed crack band would need more than ``numerics.max_nodes`` nodes (large mu or a0), or
     :data:`TIP_FOLLOWING_NODE_RATIO` times the nodes of the window that follows the tip (the
-    cheaper mesh at equal resolution)."""
+    cheaper mesh at equal resolution). Never a scene with a process zone (the re-meshing
+    carries no opening rates) or a test protocol (the window starts at a0)."""
     if not (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact):
+        return False
+    if scene.pz_law != "none" or scene.protocol() is not None:
         return False
     graded = bem_nodes_needed(scene, numerics)
     if graded > numerics.max_nodes:
@@ -288,6 +291,9 @@ def model_choice(scene, numerics=None) -> Choice:
     else the BEM (graded or tip-following mesh). :func:`simulate_model` checks a cheaper
     model's error again at the amplification it computed and runs the BEM where it misses."""
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if scene.protocol() is not None:
+        return Choice("bem", "auto: BEM, the one model with a test protocol (approach, dwell, "
+                             "retract)")
     if scene.pz_law != "none":
         return Choice("crack", f"auto: crack-front model with the process zone (pz_law "
                                f"{scene.pz_law}; model bem runs its local law)")
@@ -327,7 +333,8 @@ def _fallback(scene, failed: Result, model: str) -> Choice | None:
     the BEM cannot resolve the tip zone, with its measured error (a contact below its
     fixed-grip limit it refuses, for that physical reason); None where it cannot answer
     either (mu below its measurement)."""
-    if is_physical_refusal(failed.reason) or math.isnan(measured_error("crack", scene.mu)):
+    if (is_physical_refusal(failed.reason) or math.isnan(measured_error("crack", scene.mu))
+            or scene.protocol() is not None):
         return None
     return Choice("crack", f"auto: crack-front model: the {NAMES[model]} failed "
                            f"({failed.reason[:160]})")
@@ -376,12 +383,28 @@ PROCESS_ZONE_REFUSALS = {
 }
 
 
+#: why each model but the BEM refuses a scene with a test protocol: a failed row with this
+#: reason (not a physical refusal: the BEM answers it; auto sends it there)
+PROTOCOL_REFUSALS = {
+    "crack": "the crack-front model starts from a relaxed contact and its bulk is relaxed: a "
+             "test protocol (approach, dwell, retract) runs with model bem or auto",
+    "elastic": "the elastic branch starts from a relaxed contact: a test protocol (approach, "
+               "dwell, retract) runs with model bem or auto",
+    "pb": "the pb estimate has no loading history: a test protocol (approach, dwell, retract) "
+          "runs with model bem or auto",
+}
+
+
 def _run(model: str, scene, numerics) -> Result:
     """``MODELS[model]``; a numerical failure is a failed result, a bug raises; a scene with
-    a process zone that the model has no law for is refused (:data:`PROCESS_ZONE_REFUSALS`)."""
+    a process zone or a protocol that the model has no law for is refused
+    (:data:`PROCESS_ZONE_REFUSALS`, :data:`PROTOCOL_REFUSALS`)."""
     if scene.pz_law != "none" and model in PROCESS_ZONE_REFUSALS:
         return Result(scene=scene, numerics=numerics, status="failed",
                       reason=PROCESS_ZONE_REFUSALS[model].format(pz_law=scene.pz_law))
+    if scene.protocol() is not None and model in PROTOCOL_REFUSALS:
+        return Result(scene=scene, numerics=numerics, status="failed",
+                      reason=PROTOCOL_REFUSALS[model])
     try:
         budget.check(f"the {NAMES[model]}'s start")
         return MODELS[model](scene, numerics)

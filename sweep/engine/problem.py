@@ -23,7 +23,8 @@ from ..materials.prony_series import PronySeries
 from ..scene import Numerics, Scene
 from ..theory import jkr_contact_radius
 from . import diskcache, process_zone
-from .mesh import Mesh, scene_mesh
+from .mesh import Mesh, crack_band, scene_mesh
+from .protocol import mesh_radius as protocol_mesh_radius
 
 #: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
 WINDOW_SAFETY = 10.0
@@ -269,11 +270,13 @@ def derive(scene: Scene, numerics: Numerics) -> Scales:
     """The :class:`Scales` of a scene under its numerics (cached per process: the model
     dispatch, the mesh and the solver of one scene read the same object)."""
     h0, c = lj_constants(scene.mu)
+    protocol = scene.protocol()
+    a_given = protocol_mesh_radius(protocol) if protocol else scene.a0
     if scene.delta0 is not None:
         d_est = scene.delta0
     else:
-        d_est = scene.a0**2 - math.sqrt(2 * scene.a0)
-    a_est = scene.a0 if scene.a0 is not None else max(jkr_radius(d_est), 0.0)
+        d_est = a_given**2 - math.sqrt(2 * a_given)
+    a_est = a_given if a_given is not None else max(jkr_radius(d_est), 0.0)
     domain = (numerics.domain if numerics.domain is not None
               else auto_domain(h0, numerics.tail_gap, d_est, a_est))
     return Scales(h0=h0, c=c, tip_gap=TIP_GAP * h0, process_zone=units.l0_hat(scene.mu),
@@ -300,6 +303,14 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
                       f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
                       f"elastic or auto, large contacts the crack-front model (model crack)")
+    protocol = scene.protocol()
+    if protocol and (numerics.exact or scene.pz_law != "none"):
+        raise Refused("a protocol's approach and dwell run the hereditary BEM with the "
+                      "Lennard-Jones interface: not with numerics.exact nor a process zone "
+                      f"(pz_law {scene.pz_law})")
+    if protocol and band is None:           # the approach starts apart: from r = 0 out
+        band = crack_band(derive(scene, numerics).a0_estimate, tip_zone(scene.mu),
+                          pull_off_only=False)
     if numerics.exact and scene.pz_law != "none":
         raise Refused(f"numerics.exact: the exact hereditary reference has the Lennard-Jones "
                       f"interface only, not the process zone (pz_law {scene.pz_law}); leave "
@@ -328,6 +339,11 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
     error = 0.0
     if scene.k < 1.0 and not numerics.exact:
         t_min, t_max = time_window(scene.rate, s, numerics.min_step)
+        if protocol:        # the approach's steps and the dwell, before the retraction
+            t_approach = time_window(protocol.approach_rate, s, numerics.min_step)
+            t_min = min(t_min, t_approach[0])
+            t_max = max(t_max, 10.0 ** math.ceil(math.log10(t_approach[1] + protocol.dwell +
+                                                            t_max)))
         n = scene.n if scene.material == "mpl" else 0.0
         prony = prony_series(scene.material, n, scene.k, t_min, t_max, numerics.prony_rtol)
         weights = np.ascontiguousarray(prony.weights, dtype=float)

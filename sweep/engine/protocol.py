@@ -1,0 +1,311 @@
+"""The test as run in the lab, on the BEM: approach to a preload, dwell, retract (issue 36).
+
+A scene with a protocol (:class:`Protocol`) does not start relaxed at a0 or delta0. It starts
+at first contact, just after the surfaces jumped into it: a jump-in is fast, so the bulk
+answers it glassy. The start is the LJ equilibrium of the glassy compliance k = Chat(0) at
+the indentation of the glassy JKR contact at zero load, with every Prony mode holding that
+traction as a step applied at t = 0 (q_i = sigma: the hereditary integral of a step,
+docs/design.md section 4), so that the material then relaxes from it (:func:`first_contact`).
+Then
+
+1. *approach*: the indentation grows at d delta/dt = approach_rate h0 (the unloading rate's
+   units, docs/design.md section 2) until the load reaches the preload; the last step is cut
+   so that it ends at the preload (a secant on its length, to PRELOAD_RTOL);
+2. *dwell* for the time ``dwell`` (tau0), holding either the load at the preload (``hold``
+   "force", the indentation solved at each step by a secant on it) or the indentation
+   (``hold`` "depth"), with time steps growing by DWELL_GROWTH from the approach's last one;
+3. *retract*: the unloading kernel (:func:`sweep.kernels.solve.unload`) continues from the
+   dwell's last state, its Prony modes and records, at the scene's rate, to the pull-off (or
+   separation), as every scene's unloading.
+
+Phases 1 and 2 march the same hereditary integral as the kernel (the Prony recursion of
+:mod:`sweep.kernels.history`, the Newton solve of :func:`sweep.kernels.solve.newton` on the
+Lennard-Jones law), step by step from Python: a few hundred solves, each a kernel call. The
+trajectory keeps every phase (``phase``: 0 approach, 1 dwell, 2 retraction); the row adds
+the work the machine did on the sphere over the whole path, ``hysteresis_energy`` (pi dg R
+d_ref, :func:`cycle_work`).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..errors import check_choice, check_positive, check_range
+from ..kernels.history import history_vector, step_coefficients, update_modes
+from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
+from ..kernels.solve import invalidate, load, new_jacobian_cache, newton, relax
+from ..theory import jkr_contact_radius
+from . import budget
+
+__all__ = ["Protocol", "PHASES", "mesh_radius", "run_phases", "cycle_work"]
+
+#: the phases' codes in the trajectory's ``phase`` array
+PHASES = {"approach": 0, "dwell": 1, "retract": 2}
+#: the approach ends when the load is within this fraction of the preload
+PRELOAD_RTOL = 1e-6
+#: the dwell's time steps grow by this factor from the approach's last one ...
+DWELL_GROWTH = 1.3
+#: ... starting no smaller than this fraction of the dwell, and halved no further than this one
+DWELL_FIRST = 1e-4
+DWELL_MIN_STEP = 1e-9
+#: a dwell at force solves its indentation to this fraction of the preload (the load of a
+#: solve is known to about 1e-8 of it: Newton's tolerance is 1e-10 h0) ...
+HOLD_RTOL = 1e-7
+#: ... and accepts the nearest of its iterations within this fraction where the secant stalls
+HOLD_ACCEPT = 1e-5
+#: most Newton iterations of one solve, and secant iterations of a held step
+MAX_ITER = 40
+HOLD_ITER = 30
+#: the approach's smallest step, as a fraction of the largest (then the fold is relaxed) ...
+MIN_STEP_FRACTION = 1.0 / 64.0
+#: ... by at most this many pseudo-transient iterations before Newton takes over, where
+#: Newton from the JKR contact failed (:meth:`_March._jump`)
+RELAX_ITER = 300
+
+
+@dataclasses.dataclass(frozen=True)
+class Protocol:
+    """Approach, dwell, retract (dimensionless, docs/design.md section 2).
+
+    Parameters
+    ----------
+    approach_rate : float
+        The approach's r-hat, d delta/dt = approach_rate h0 (the unloading rate's units).
+    preload : float
+        The load (pi dg R, compressive positive) at the end of the approach; > 0.
+    dwell : float
+        The dwell's duration (tau0), >= 0.
+    hold : {"force", "depth"}
+        What the instrument holds during the dwell.
+    """
+
+    approach_rate: float
+    preload: float
+    dwell: float
+    hold: str = "force"
+
+    def __post_init__(self):
+        check_positive("approach_rate", self.approach_rate)
+        check_positive("preload", self.preload)
+        check_range("dwell", self.dwell, lo=0.0)
+        check_choice("dwell_hold", self.hold, ("force", "depth"))
+
+
+def mesh_radius(protocol: Protocol) -> float:
+    """The largest contact radius the protocol reaches (a_ref): the relaxed JKR radius at the
+    preload (a dwell at force creeps toward it; the approach, stiffer, stays inside it)."""
+    return float(jkr_contact_radius(load=protocol.preload))
+
+
+class _March:
+    """The hereditary march of the approach and the dwell on one prepared problem: the state
+    (gap, Prony modes, traction), the records, and one step's solve."""
+
+    def __init__(self, pb, h, delta, stats):
+        self.pb, self.h, self.delta, self.t = pb, h, float(delta), 0.0
+        N, M = h.size, pb.prony_weights.size
+        self.sigma = np.empty(N)
+        lj_traction(h, pb.h0, pb.c, self.sigma)
+        self.q = np.repeat(self.sigma[None, :], M, axis=0)   # a step applied at t = 0
+        self.h_prev, self.dt_prev = h.copy(), 0.0
+        self.law = lennard_jones(pb.h0, pb.c, N)
+        self.cache, self.stats = new_jacobian_cache(N), stats
+        self.records = {k: [] for k in ("t", "delta", "P", "a", "a_inner", "phase")}
+        self._record(0)
+
+    def _record(self, phase):
+        pb, r = self.pb, self.pb.mesh.r
+        for key, value in (("t", self.t), ("delta", self.delta),
+                           ("P", load(self.sigma, pb.wP)),
+                           ("a", crossing_radius(self.h, r, pb.hm)),
+                           ("a_inner", crossing_radius(self.h, r, pb.h0)), ("phase", phase)):
+            self.records[key].append(value)
+
+    @property
+    def load(self) -> float:
+        return self.records["P"][-1]
+
+    def solve(self, delta, dt, fold=False):
+        """The state after a step to ``delta`` over ``dt`` (not accepted): (ok, h, sigma,
+        P, e, b), Newton from the linear extrapolation of the last two states; where that
+        fails and ``fold``, the stable state the pseudo-transient relaxation reaches from the
+        last one (a dense factorization an iteration: for folds only)."""
+        pb = self.pb
+        M, N = pb.prony_weights.size, self.h.size
+        e, b, H = np.empty(M), np.empty(M), np.zeros(N)
+        ceff = step_coefficients(pb.prony_weights, pb.prony_times, dt, e, b)
+        history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
+        g = -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
+        s = dt / self.dt_prev if self.dt_prev > 0 else 0.0
+        h = np.maximum(self.h + s * (self.h - self.h_prev), 0.3 * self.h)
+        ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, MAX_ITER,
+                    self.cache, self.stats)
+        if not ok:
+            invalidate(self.cache)
+        if not ok and fold:
+            h, ok = self._jump(delta, g, ceff, H)
+        sig = np.empty(N)
+        lj_traction(h, pb.h0, pb.c, sig)
+        return ok, h, sig, load(sig, pb.wP), e, b
+
+    def _jump(self, delta, g, ceff, H):
+        """The state across a fold of the path (the crack tip snapping along the contact):
+        the pseudo-transient relaxation from the last state for RELAX_ITER iterations, and
+        Newton from where they led where they did not converge (it crawls near the end of a
+        jump)."""
+        pb, tol = self.pb, self.pb.numerics.tol * self.pb.h0
+        invalidate(self.cache)
+        h = self.h.copy()
+        if relax(h, g, pb.A, ceff, H, self.law, tol, RELAX_ITER, self.stats):
+            return h, True
+        return h, newton(h, g, pb.A, ceff, H, self.law, tol, MAX_ITER, self.cache, self.stats)
+
+    def accept(self, delta, dt, solved, phase):
+        _, h, sig, _, e, b = solved
+        update_modes(e, b, self.q, sig, self.sigma)
+        self.h_prev, self.h, self.sigma = self.h, h, sig
+        self.delta, self.t, self.dt_prev = float(delta), self.t + dt, dt
+        self._record(phase)
+
+
+def _approach(m: _March, protocol: Protocol) -> None:
+    """Indentation steps of ``numerics.step`` h0 (halved where Newton fails or the contact
+    radius moves by more than ``da_max`` spacings) until the load reaches the preload; the
+    step that passes it is cut to end there."""
+    pb = m.pb
+    speed = protocol.approach_rate * pb.h0
+    dd_max = pb.numerics.step * pb.h0
+    da_max = pb.numerics.da_max * pb.mesh.spacing
+    dd = dd_max
+    while m.load < protocol.preload * (1.0 - PRELOAD_RTOL):
+        budget.check("the approach")
+        smallest = dd <= MIN_STEP_FRACTION * dd_max
+        solved = m.solve(m.delta + dd, dd / speed, fold=smallest)
+        ok, h = solved[0], solved[1]
+        moved = abs(crossing_radius(h, pb.mesh.r, pb.hm) - m.records["a"][-1])
+        if (not ok or moved > da_max) and not smallest:
+            dd = max(0.5 * dd, MIN_STEP_FRACTION * dd_max)
+            continue
+        if not ok:
+            raise RuntimeError(f"approach: no equilibrium at delta = {m.delta + dd:.6g}")
+        if solved[3] > protocol.preload:
+            dd, solved = _cut_to_preload(m, protocol, dd, speed, solved)
+        m.accept(m.delta + dd, dd / speed, solved, PHASES["approach"])
+        dd = min(2.0 * dd, dd_max) if moved < 0.5 * da_max else dd
+
+
+def _cut_to_preload(m: _March, protocol: Protocol, dd, speed, solved):
+    """The step from the last state whose load is the preload: a secant on its length
+    between 0 (the last state's load) and ``dd`` (``solved``, past the preload)."""
+    lo, p_lo, hi, p_hi = 0.0, m.load, dd, solved[3]
+    for _ in range(HOLD_ITER):
+        if not p_hi > p_lo:
+            break
+        x = lo + (protocol.preload - p_lo) * (hi - lo) / (p_hi - p_lo)
+        trial = m.solve(m.delta + x, x / speed)
+        if not trial[0]:
+            break
+        if abs(trial[3] / protocol.preload - 1.0) <= PRELOAD_RTOL:
+            return x, trial
+        if trial[3] > protocol.preload:
+            hi, p_hi, solved, dd = x, trial[3], trial, x
+        else:
+            lo, p_lo = x, trial[3]
+    return dd, solved
+
+
+def _dwell(m: _March, protocol: Protocol) -> None:
+    """Time steps from max(the approach's last, DWELL_FIRST dwell), growing by DWELL_GROWTH,
+    the last cut to end at ``dwell``; at each the indentation held, or solved (secant) so
+    that the load stays at the preload. A step whose solve fails, or whose contact radius
+    moves by more than ``da_max`` spacings (a contact creeping outward), is halved, down to
+    DWELL_MIN_STEP of the dwell, where a fold of the path is relaxed."""
+    if protocol.dwell <= 0.0:
+        return
+    da_max = m.pb.numerics.da_max * m.pb.mesh.spacing
+    dt_min = DWELL_MIN_STEP * protocol.dwell
+    dt = max(m.dt_prev, DWELL_FIRST * protocol.dwell)
+    end = m.t + protocol.dwell
+    while m.t < end * (1.0 - 1e-12):
+        budget.check("the dwell")
+        dt = min(dt, end - m.t)
+        smallest = dt <= dt_min
+        if protocol.hold == "depth":
+            solved, delta = m.solve(m.delta, dt, fold=smallest), m.delta
+        else:
+            delta, solved = _held_step(m, protocol.preload, dt, fold=smallest)
+        moved = abs(crossing_radius(solved[1], m.pb.mesh.r, m.pb.hm) - m.records["a"][-1])
+        if (not solved[0] or moved > da_max) and not smallest:
+            dt = max(0.5 * dt, dt_min)
+            continue
+        if not solved[0]:
+            raise RuntimeError(f"dwell: no equilibrium at t = {m.t + dt:.6g}")
+        m.accept(delta, dt, solved, PHASES["dwell"])
+        dt = dt * DWELL_GROWTH if moved < 0.5 * da_max else dt
+
+
+def _held_step(m: _March, force: float, dt, fold=False):
+    """The indentation at which the step ``dt`` ends at the load ``force``: secant from the
+    last indentation, the slope first from a step of 1e-3 h0 (``fold``: :meth:`_March.solve`)."""
+    d0 = m.delta
+    s0 = m.solve(d0, dt, fold)
+    d1 = d0 + 1e-3 * m.pb.h0
+    s1 = m.solve(d1, dt, fold)
+    best = (abs(s0[3] - force), d0, s0)
+    for _ in range(HOLD_ITER):
+        if not (s0[0] and s1[0]):
+            return d1, s1
+        best = min(best, (abs(s1[3] - force), d1, s1), key=lambda x: x[0])
+        if best[0] <= HOLD_RTOL * force:
+            break
+        slope = (s1[3] - s0[3]) / (d1 - d0)
+        step = (force - s1[3]) / slope if slope != 0.0 else 0.0
+        if d1 + step == d1:              # as close as the indentation's rounding allows
+            break
+        d0, s0 = d1, s1
+        d1 = d1 + step
+        s1 = m.solve(d1, dt, fold)
+    if best[0] <= HOLD_ACCEPT * force:
+        return best[1], best[2]
+    raise RuntimeError(f"dwell at force: the load stayed at {best[2][3]:.8g}, not {force:.8g}")
+
+
+def first_contact(pb, stats):
+    """(gap, indentation) at first contact: the LJ equilibrium of the glassy compliance k =
+    Chat(0) at the indentation of the glassy JKR contact at zero load (the JKR solution of
+    modulus 1/k: radii k^(1/3), indentations k^(2/3) times the relaxed ones), by Newton from
+    that JKR gap."""
+    from .initial import jkr_gap_guess     # lazy: sweep.engine.initial imports problem
+
+    k = 1.0 - float(np.sum(pb.prony_weights))
+    a_s, d_s = k ** (1.0 / 3.0), k ** (2.0 / 3.0)
+    a = float(jkr_contact_radius(load=0.0))
+    delta = d_s * (a * a - np.sqrt(2.0 * a))
+    h = d_s * jkr_gap_guess(pb.mesh.r / a_s, delta / d_s, pb.h0 / d_s)
+    N = h.size
+    ok = newton(h, -delta + pb.h0 + 0.5 * pb.mesh.r ** 2, pb.A, k, np.zeros(N),
+                lennard_jones(pb.h0, pb.c, N), pb.numerics.tol * pb.h0, MAX_ITER,
+                new_jacobian_cache(N), stats)
+    if not ok:
+        raise RuntimeError(f"no glassy contact at first touch (delta = {delta:.4g})")
+    return h, float(delta)
+
+
+def run_phases(pb, protocol: Protocol, el):
+    """Approach and dwell on the prepared problem ``pb`` (``el`` its elastic solver, for the
+    start): the march (:class:`_March`) whose state and records the retraction continues."""
+    h, delta = first_contact(pb, el.stats)
+    m = _March(pb, h, delta, el.stats)
+    _approach(m, protocol)
+    _dwell(m, protocol)
+    return m
+
+
+def cycle_work(trajectory: dict) -> float:
+    """The work the machine did on the sphere over the recorded path, int P d delta
+    (trapezoid; pi dg R d_ref): the energy the approach put in less what the retraction took
+    back, i.e. what the cycle dissipated (with the surface energy of the contact left at
+    the end, none after separation)."""
+    P, d = np.asarray(trajectory["P"], float), np.asarray(trajectory["delta"], float)
+    return float(np.sum(0.5 * (P[1:] + P[:-1]) * np.diff(d)))

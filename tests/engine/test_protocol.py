@@ -1,0 +1,130 @@
+"""The test as run in the lab (issue 36 item 2): approach to a preload, dwell, retract.
+
+Independent values: (a) an elastic bulk (k = 1) has no memory: every protocol gives the
+relaxed start's pull-off (the JKR pull-off of a contact larger than its load-controlled
+pull-off radius does not depend on how large it is); (b) a dwell much longer than the
+material's retardation time ends in the relaxed state: held at force, the relaxed start at
+the preload (the same contact radius, load and pull-off); held at depth, the relaxed start at
+the approach's final indentation; (c) the scene's fields are checked and routed.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from sweep import Numerics, Scene, simulate
+from sweep.engine.protocol import HOLD_ACCEPT
+from sweep.errors import InputError
+
+MU = 5.0
+BASE = dict(n=0.5, mu=MU, rate=1.0)
+PROTOCOL = dict(approach_rate=1.0, preload=2.0, dwell=5.0)
+
+
+#: one uniform mesh for every scene, so that a protocol and a relaxed start are solved on the
+#: same nodes: 13.5 spacings per tip zone at mu 5, no error estimate. On it two ways to one
+#: state still differ by the lattice: the crack tip pins between nodes, so the state reached
+#: by a march and the one Newton finds from the JKR guess at the same indentation are
+#: neighbouring discrete equilibria (measured: radius 4e-6, pull-off 1e-5 to 3e-5; at a
+#: given radius the load moves by dP/da ~ 4 a^2 times the radius's 3e-5: 2e-4). The
+#: tolerances below are these, with a margin.
+SAME_MESH = Numerics(mesh="uniform", nodes=800, domain=4.0, pull_off_rtol=0.0)
+LATTICE = dict(pull_off=1e-4, radius=2e-5, load_at_radius=1e-3, load_at_depth=1e-4)
+
+
+def run(numerics=None, **fields):
+    res = simulate(Scene(model="bem", **fields), numerics or Numerics.preset("balanced"))
+    assert res.ok, res.reason
+    return res
+
+
+def test_the_phases_are_recorded_in_order_and_the_preload_is_held():
+    res = run(**BASE, k=0.2, **PROTOCOL)
+    traj = res.trajectory
+    phase = traj["phase"]
+    assert phase[0] == 0 and np.all(np.diff(phase) >= 0) and phase[-1] == 2
+    dwell = phase == 1
+    assert np.allclose(traj["P"][dwell], PROTOCOL["preload"], rtol=HOLD_ACCEPT)
+    assert traj["t"][dwell][-1] - traj["t"][phase == 0][-1] == pytest.approx(PROTOCOL["dwell"])
+    assert np.all(np.diff(traj["a"][dwell]) > 0)           # held at force: the contact creeps
+    approach = phase == 0
+    assert np.all(np.diff(traj["delta"][approach]) > 0)
+    assert traj["P"][approach][-1] == pytest.approx(PROTOCOL["preload"], rel=1e-5)
+    assert math.isfinite(res.hysteresis_energy) and res.hysteresis_energy > 0
+
+
+def test_held_at_depth_the_load_relaxes():
+    res = run(**BASE, k=0.2, **PROTOCOL, dwell_hold="depth")
+    traj = res.trajectory
+    dwell = traj["phase"] == 1
+    assert np.ptp(traj["delta"][dwell]) == 0.0
+    assert np.all(np.diff(traj["P"][dwell]) < 0)
+
+
+@pytest.mark.parametrize("protocol", [
+    dict(approach_rate=1.0, preload=2.0, dwell=5.0),
+    dict(approach_rate=100.0, preload=6.0, dwell=0.5, dwell_hold="depth"),
+    dict(approach_rate=0.01, preload=1.0, dwell=0.0)])
+def test_an_elastic_bulk_gives_the_same_pull_off_for_every_protocol(protocol):
+    relaxed = run(SAME_MESH, **BASE, k=1.0, a0=2.0)
+    res = run(SAME_MESH, **BASE, k=1.0, **protocol)
+    assert res.pull_off == pytest.approx(relaxed.pull_off, rel=LATTICE["pull_off"])
+
+
+@pytest.mark.parametrize("hold", ["force", "depth"])
+def test_a_long_dwell_ends_in_the_relaxed_state(hold):
+    """SLS k = 0.2 (retardation time tau0, relaxation time k tau0): after a dwell of 200
+    tau0 every mode has decayed by exp(-200)."""
+    sls = dict(BASE, material="sls", k=0.2)
+    res = run(SAME_MESH, **sls, **dict(PROTOCOL, dwell=200.0), dwell_hold=hold)
+    start = dict(a0=res.a0_result) if hold == "force" else dict(delta0=res.delta0_result)
+    relaxed = run(SAME_MESH, **sls, **start)
+    if hold == "force":        # the relaxed start at that radius carries the preload
+        assert relaxed.trajectory["P"][0] == pytest.approx(PROTOCOL["preload"],
+                                                           rel=LATTICE["load_at_radius"])
+    else:                      # at that indentation it has the dwell's final radius and load
+        assert relaxed.a0_result == pytest.approx(res.a0_result, rel=LATTICE["radius"])
+        assert relaxed.trajectory["P"][0] == pytest.approx(
+            res.trajectory["P"][res.trajectory["phase"] == 1][-1], rel=LATTICE["load_at_depth"])
+    assert res.pull_off == pytest.approx(relaxed.pull_off, rel=LATTICE["pull_off"])
+
+
+def test_the_protocol_fields_are_checked():
+    with pytest.raises(InputError, match="preload/dwell: a protocol needs"):
+        Scene(**BASE, k=0.2, approach_rate=1.0)
+    with pytest.raises(InputError, match="a0/delta0: a scene with a protocol"):
+        Scene(**BASE, k=0.2, a0=2.0, **PROTOCOL)
+    with pytest.raises(InputError, match="dwell_hold: 'depth' needs a protocol"):
+        Scene(**BASE, k=0.2, a0=2.0, dwell_hold="depth")
+    with pytest.raises(InputError, match="dwell_hold"):
+        Scene(**BASE, k=0.2, **PROTOCOL, dwell_hold="time")
+
+
+def test_only_the_bem_runs_a_protocol_and_auto_sends_it_there():
+    sc = dict(BASE, k=0.2, **PROTOCOL)
+    res = simulate(Scene(**sc, model="auto"))
+    assert res.ok and res.model_used == "bem" and "test protocol" in res.model_reason
+    for model in ("crack", "pb", "elastic"):
+        r = simulate(Scene(**sc, model=model))
+        assert r.status == "failed" and "runs with model bem or auto" in r.reason
+    pz = simulate(Scene(**sc, pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5))
+    assert pz.status == "failed" and "Lennard-Jones interface" in pz.reason
+
+
+def test_the_effective_adhesion_is_bell_shaped_without_a_dwell_and_monotone_after_one():
+    """Afferrante & Violano (JMPS 2022, LJ + SLS): loading and unloading at one speed, the
+    pull-off against speed rises and falls again (at high speed the whole contact is glassy,
+    loaded and unloaded elastically); after full relaxation it rises monotonically to the
+    flat-punch-like plateau (Mandriota, Menga & Carbone 2024). SLS k = 0.1, mu 5, preload 1;
+    measured 1.570, 3.228, 1.665 without a dwell and 1.570, 3.310, 11.35 after 1e4 tau0."""
+    def pull_off(rate, dwell):
+        res = simulate(Scene(material="sls", n=0.5, k=0.1, mu=MU, rate=rate, approach_rate=rate,
+                             preload=1.0, dwell=dwell, model="bem"),
+                       Numerics.preset("fast", pull_off_rtol=0.0))
+        assert res.ok, res.reason
+        return res.pull_off
+
+    slow, mid, fast = (pull_off(r, 0.0) for r in (0.01, 1.0, 1e4))
+    assert mid > 1.5 * slow and mid > 1.5 * fast            # the bell
+    slow, mid, fast = (pull_off(r, 1e4) for r in (0.01, 1.0, 1e4))
+    assert slow < mid < fast and fast > 3 * mid             # monotone after relaxation
