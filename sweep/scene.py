@@ -74,6 +74,35 @@ def axis(default=dataclasses.MISSING, *, help: str, unit: str = "", limits=None,
     return field(default=default, metadata={"axis": meta})
 
 
+@dataclass(frozen=True)
+class Protocol:
+    """A test as the lab runs it: approach, dwell, retract (dimensionless, docs/design.md
+    section 2; run by :mod:`sweep.engine.protocol`).
+
+    Parameters
+    ----------
+    approach_rate : float
+        The approach's r-hat, d delta/dt = approach_rate h0 (the unloading rate's units).
+    preload : float
+        The load (pi dg R, compressive positive) at the end of the approach; > 0.
+    dwell : float
+        The dwell's duration (tau0), >= 0.
+    hold : {"force", "depth"}
+        What the instrument holds during the dwell.
+    """
+
+    approach_rate: float
+    preload: float
+    dwell: float
+    hold: str = "force"
+
+    def __post_init__(self):
+        check_range("approach_rate", self.approach_rate, lo=0.0, lo_open=True)
+        check_range("preload", self.preload, lo=0.0, lo_open=True)
+        check_range("dwell", self.dwell, lo=0.0)
+        check_choice("dwell_hold", self.hold, DWELL_HOLDS)
+
+
 def check_protocol(approach_rate, preload, dwell, dwell_hold) -> bool:
     """Whether the fields give a test protocol (approach, dwell, retract); InputError unless
     ``approach_rate``, ``preload`` and ``dwell`` are given together, or none of them (and
@@ -235,12 +264,10 @@ class Scene:
             object.__setattr__(self, f.name, info[f.name].check(getattr(self, f.name)))
         check_process_zone(self.pz_law, self.pz_v0, self.pz_xi, "a_ref/tau0")
 
-    def protocol(self):
-        """The test protocol (:class:`sweep.engine.protocol.Protocol`), or None for the
-        relaxed start."""
+    def protocol(self) -> "Protocol | None":
+        """The test protocol (:class:`Protocol`), or None for the relaxed start."""
         if self.dwell is None:
             return None
-        from .engine.protocol import Protocol   # lazy: the engine imports this module
         return Protocol(self.approach_rate, self.preload, self.dwell, self.dwell_hold)
 
     def to_dict(self) -> dict:

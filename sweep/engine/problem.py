@@ -24,7 +24,6 @@ from ..scene import Numerics, Scene
 from ..theory import jkr_contact_radius
 from . import diskcache, process_zone
 from .mesh import Mesh, crack_band, scene_mesh
-from .protocol import mesh_radius as protocol_mesh_radius
 
 #: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
 WINDOW_SAFETY = 10.0
@@ -271,7 +270,9 @@ def derive(scene: Scene, numerics: Numerics) -> Scales:
     dispatch, the mesh and the solver of one scene read the same object)."""
     h0, c = lj_constants(scene.mu)
     protocol = scene.protocol()
-    a_given = protocol_mesh_radius(protocol) if protocol else scene.a0
+    # a protocol's largest contact: the relaxed JKR radius at the preload (a dwell at force
+    # creeps toward it; the approach, stiffer, stays inside it)
+    a_given = float(jkr_contact_radius(load=protocol.preload)) if protocol else scene.a0
     if scene.delta0 is not None:
         d_est = scene.delta0
     else:

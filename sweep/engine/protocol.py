@@ -27,18 +27,16 @@ d_ref, :func:`cycle_work`).
 """
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
-from ..errors import check_choice, check_positive, check_range
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
 from ..kernels.solve import invalidate, load, new_jacobian_cache, newton, relax
 from ..theory import jkr_contact_radius
+from ..scene import Protocol
 from . import budget
 
-__all__ = ["Protocol", "PHASES", "mesh_radius", "run_phases", "cycle_work"]
+__all__ = ["Protocol", "PHASES", "first_contact", "run_phases", "cycle_work"]
 
 #: the phases' codes in the trajectory's ``phase`` array
 PHASES = {"approach": 0, "dwell": 1, "retract": 2}
@@ -62,40 +60,6 @@ MIN_STEP_FRACTION = 1.0 / 64.0
 #: ... by at most this many pseudo-transient iterations before Newton takes over, where
 #: Newton from the JKR contact failed (:meth:`_March._jump`)
 RELAX_ITER = 300
-
-
-@dataclasses.dataclass(frozen=True)
-class Protocol:
-    """Approach, dwell, retract (dimensionless, docs/design.md section 2).
-
-    Parameters
-    ----------
-    approach_rate : float
-        The approach's r-hat, d delta/dt = approach_rate h0 (the unloading rate's units).
-    preload : float
-        The load (pi dg R, compressive positive) at the end of the approach; > 0.
-    dwell : float
-        The dwell's duration (tau0), >= 0.
-    hold : {"force", "depth"}
-        What the instrument holds during the dwell.
-    """
-
-    approach_rate: float
-    preload: float
-    dwell: float
-    hold: str = "force"
-
-    def __post_init__(self):
-        check_positive("approach_rate", self.approach_rate)
-        check_positive("preload", self.preload)
-        check_range("dwell", self.dwell, lo=0.0)
-        check_choice("dwell_hold", self.hold, ("force", "depth"))
-
-
-def mesh_radius(protocol: Protocol) -> float:
-    """The largest contact radius the protocol reaches (a_ref): the relaxed JKR radius at the
-    preload (a dwell at force creeps toward it; the approach, stiffer, stays inside it)."""
-    return float(jkr_contact_radius(load=protocol.preload))
 
 
 class _March:
