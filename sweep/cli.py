@@ -514,6 +514,9 @@ def info_cmd(results, slowest, as_si, csv_out):
         if "si_pz_law" in df and (df["si_pz_law"] != "none").any():   # a process zone's
             varied += [c for c in ("si_pz_law", "si_pz_v0", "si_pz_xi")  # law and parameters
                        if c in df and c not in varied]
+        if "si_material" in df and df["si_material"].str.startswith("prony:").any() \
+                and "si_material" not in varied:      # a Prony table: its name and hash
+            varied.insert(0, "si_material")
         heads = [f"{c[3:]}[{_si_unit(c[3:])}]" if _si_unit(c[3:]) else c[3:] for c in varied]
         click.echo("scene_id          requested  used   status  "
                    + "".join(f"{h:<11} " for h in heads)

@@ -340,6 +340,6 @@ def si_row(si: SIScene, row) -> dict:
            "delta_pulloff": get("delta_pulloff"), "crack_speed": get("crack_speed"),
            "t_pulloff": get("t_pulloff"), "a0": get("a0_result"),
            "delta0": get("delta0_result")}
-    out = {f"si_{k}": v for k, v in si.to_dict().items() if v is not None and k != "material"}
+    out = {f"si_{k}": v for k, v in si.to_dict().items() if v is not None}
     out.update(_si_of(si, dim))
     return out
