@@ -108,3 +108,18 @@ def test_sls_one_term_table_is_the_sls():
     assert isinstance(st, SceneTable) and len(st.weights) == 1
     assert st.weights[0] == pytest.approx(1 - k, rel=1e-14)
     assert st.times[0] == pytest.approx(1.0, rel=1e-14)
+
+
+#: ids recorded on 2026-11-26 (branch prony-scenes, commit 5a3de8b): a results file of table
+#: scenes resumes only while these stay (full numerics, not a preset, as tests/data/scene_ids.yaml)
+V1_NUMERICS = Numerics(nodes=500, domain=None, tail_gap=60.0, step=0.1, min_step=0.0001,
+                       da_max=0.5, prony_rtol=0.0001, tol=1.0e-08, max_steps=200000,
+                       exact=False, zone_nodes=2.0)
+
+
+@pytest.mark.parametrize("material, sid", [
+    ({"prony": str(DATA / "pdms_prony.csv")}, "c75e4b2bd8de4563"),
+    ({"tau": [1.0], "c": [0.9], "E0": 1.0, "form": "kelvin"}, "d40be22fd25c883d"),
+])
+def test_recorded_table_scene_ids(material, sid):
+    assert scene_id(scene(material), V1_NUMERICS) == sid
