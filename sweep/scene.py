@@ -203,7 +203,8 @@ def scene_table(value, *, base_dir=None, nu=None) -> SceneTable:
         digest = hashlib.sha256(f"{digest};tau0={tau0:.9e}".encode()).hexdigest()[:16]
     col = "E" if value.form == "wiechert" else "c"
     spec = {"form": value.form, "tau": value.times.tolist(), col: value.weights.tolist(),
-            **({"Einf": value.Einf} if value.form == "wiechert" else {"E0": value.E0}),
+            **({"Einf": float(value.Einf)} if value.form == "wiechert"
+               else {"E0": float(value.E0)}),
             "name": value.name}
     if value.modulus_unit is not None:
         spec.update(modulus_unit=value.modulus_unit, time_unit=value.time_unit)
@@ -353,6 +354,9 @@ class Scene:
         if unknown:
             raise InputError(f"scene: unknown key(s) {', '.join(sorted(unknown))} "
                              f"(allowed: {', '.join(sorted(names))})")
+        if str(d.get("material", "")).startswith(f"{TABLE_MATERIAL}:"):
+            raise InputError(f"material: {d['material']} is a table's label (a results row); "
+                             f"give the table itself ({{prony: file}} or inline)")
         return cls(**d)
 
 

@@ -97,6 +97,8 @@ def test_label_names_the_table_in_the_row_and_repr():
     r = Result(scene=s, numerics=NUM)
     assert r.to_row()["material"] == label and f"scene {label} " in repr(r)
     assert repr(s.material).startswith(f"SceneTable({label}, k=")
+    with pytest.raises(InputError, match="is a table's label"):
+        Scene.from_dict(s.to_dict())
 
 
 def test_sls_one_term_table_is_the_sls():
