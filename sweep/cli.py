@@ -517,17 +517,21 @@ def info_cmd(results, slowest, as_si, csv_out):
         if "si_pz_law" in df and (df["si_pz_law"] != "none").any():   # a process zone's
             varied += [c for c in ("si_pz_law", "si_pz_v0", "si_pz_xi")  # law and parameters
                        if c in df and c not in varied]
+        if "si_material" in df and df["si_material"].str.startswith("prony:").any() \
+                and "si_material" not in varied:      # a Prony table: its name and hash
+            varied.insert(0, "si_material")
         heads = [f"{c[3:]}[{_si_unit(c[3:])}]" if _si_unit(c[3:]) else c[3:] for c in varied]
+        width = {c: max([11, *(len(v) for v in df[c] if isinstance(v, str))]) for c in varied}
         click.echo("scene_id          requested  used   status  "
-                   + "".join(f"{h:<11} " for h in heads)
+                   + "".join(f"{h:<{width[c]}} " for h, c in zip(heads, varied))
                    + "speed[um/s]  mu       l0[nm]  pull_off[mN]  jkr_pull_off[mN]  "
                      "crack_speed[um/s]")
         for r in df.sort_values(["model_used", *varied, "si_speed"]).to_dict("records"):
             cs = r["crack_speed_m_s"]
             click.echo(f"{r['scene_id']}  {r['model'] or '?':<9}  {r['model_used'] or '-':<5}  "
                        f"{r['status']:<6}  "
-                       + "".join(f"{r[c]:<11} " if isinstance(r[c], str) else
-                                 f"{r[c]:<11.4g} " for c in varied)
+                       + "".join(f"{r[c]:<{width[c]}} " if isinstance(r[c], str) else
+                                 f"{r[c]:<{width[c]}.4g} " for c in varied)
                        + f"{r['si_speed'] * 1e6:<11.4g}  {r['mu']:<7.4g}  "
                        f"{r['l0_m'] * 1e9:<6.4g}  "
                        f"{(r['pull_off_N'] or math.nan) * 1e3:<12.5g}  "

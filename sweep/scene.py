@@ -25,7 +25,10 @@ import numpy as np
 
 from .errors import InputError, check_choice, check_int, check_range
 
+#: The named materials; a scene's material may also be a Prony table (:class:`SceneTable`).
 MATERIALS = ("mpl", "sls")
+#: the ``material`` value (and results column prefix) of a scene whose material is a table
+TABLE_MATERIAL = "prony"
 MESHES = ("uniform", "graded")
 #: nodes of a uniform mesh whose ``Numerics.nodes`` is None (:attr:`Numerics.uniform_nodes`)
 UNIFORM_NODES = 500
@@ -134,6 +137,132 @@ def check_process_zone(pz_law, pz_v0, pz_xi, speed_unit: str) -> None:
                          f"({speed_unit}) and pz_xi > 0 (missing {', '.join(missing)})")
 
 
+@dataclass(frozen=True, eq=False)
+class SceneTable:
+    """A Prony table as a scene's material, normalized (docs/design.md sections 3 and 7).
+
+    Build it with :func:`scene_table` (or give the table to :class:`Scene` as its
+    ``material``). The solvers read the Kelvin form in units of tau0; the scene id reads
+    ``digest``, a hash of the table's numbers (not of its path or file format).
+
+    Attributes
+    ----------
+    weights : tuple of float
+        Kelvin weights ``c_i > 0`` with ``sum c_i < 1``:
+        ``Chat(t) = 1 - sum_i c_i exp(-t/theta_i)``, ``k = 1 - sum c_i``.
+    times : tuple of float
+        Retardation times ``theta_i`` in units of tau0, ascending.
+    tau0 : float
+        The scene's time unit in the table's time unit (s where the table states its units):
+        1 unless given (``{"prony": path, "tau0": ...}``).
+    E0, Einf : float
+        The table's relaxed and instantaneous moduli (Pa where it states its units).
+    name : str
+        The table's name (its file's stem, ``inline``, or the ``name`` given).
+    digest : str
+        16 hex digits: :meth:`sweep.materials.PronyTable.content_hash` of the table (with
+        ``tau0`` where it is not 1): equal for the same table in every format, different
+        when any of its numbers changes beyond 10 significant digits.
+    units_known : bool
+        Whether the table stated its units (moduli in Pa, times in s).
+    spec : dict
+        The table as an inline mapping that :func:`scene_table` reads back to the same
+        digest (a config's ``to_dict``).
+    """
+
+    weights: tuple
+    times: tuple
+    tau0: float
+    E0: float
+    Einf: float
+    name: str
+    digest: str
+    units_known: bool = False
+    spec: dict = field(default_factory=dict, repr=False)
+
+    def __eq__(self, other):
+        return isinstance(other, SceneTable) and other.digest == self.digest
+
+    def __hash__(self):
+        return hash(self.digest)
+
+    @property
+    def k(self) -> float:
+        """``1 - sum c_i`` = E0/Einf."""
+        return float(1.0 - math.fsum(self.weights))
+
+    @property
+    def label(self) -> str:
+        """``prony:<name>:<digest>``: the scene's ``material`` column in a results file."""
+        return f"{TABLE_MATERIAL}:{self.name}:{self.digest}"
+
+    def __str__(self):
+        return self.label
+
+    def __repr__(self):
+        return (f"SceneTable({self.label}, k={self.k:.6g}, {len(self.weights)} terms, "
+                f"tau0={self.tau0:g})")
+
+    def __format__(self, spec):
+        return format(self.label, spec)
+
+    def fixed_k(self, k, default) -> float:
+        """The scene's k: the table's; InputError if ``k`` is given (not ``default``) and
+        differs from it by more than 1e-9 relative."""
+        mine = self.k
+        if k is not None and k != default:
+            k = check_range("k", k, 0.0, 1.0, lo_open=True)
+            if not math.isclose(k, mine, rel_tol=1e-9):
+                raise InputError(f"k: the Prony table {self.name} fixes k = E0/Einf = "
+                                 f"{mine:.10g}; leave k out (got {k:g})")
+        return mine
+
+
+def scene_table(value, *, base_dir=None, nu=None) -> SceneTable:
+    """The :class:`SceneTable` of a table: a :class:`SceneTable`, a
+    :class:`~sweep.materials.PronyTable`, or a mapping :func:`~sweep.materials.read_prony`
+    reads (``{"prony": path, ...}`` or inline ``{"tau": [...], "E": [...], "E0": ...}``),
+    with an optional ``"tau0"`` key (the scene's time unit in the table's, > 0, default 1).
+
+    ``base_dir`` resolves a relative path (default the working directory); ``nu`` reads a
+    shear table. InputError (one line) for anything else or a bad table.
+    """
+    if isinstance(value, SceneTable):
+        return value
+    from .materials import PronyTable, read_prony  # lazy: sweep.materials loads numba
+
+    tau0 = 1.0
+    if isinstance(value, dict) and "tau0" in value:
+        value = dict(value)
+        tau0 = check_range("tau0", value.pop("tau0"), 0.0, lo_open=True)
+    if isinstance(value, dict):
+        value = read_prony(value, base_dir=base_dir, nu=nu)
+    if not isinstance(value, PronyTable):
+        raise InputError(f"material must be {', '.join(MATERIALS)} or a Prony table "
+                         f"({{prony: file}} or {{tau: [...], E: [...], E0: ...}}) "
+                         f"(got {value!r})")
+    mat = value.material
+    c, theta = mat.kelvin_weights, mat.kelvin_times / tau0
+    keep = c > 0.0
+    order = np.argsort(theta[keep], kind="stable")
+    digest = value.content_hash()
+    if tau0 != 1.0:
+        digest = hashlib.sha256(f"{digest};tau0={tau0:.9e}".encode()).hexdigest()[:16]
+    col = "E" if value.form == "wiechert" else "c"
+    spec = {"form": value.form, "tau": value.times.tolist(), col: value.weights.tolist(),
+            **({"Einf": float(value.Einf)} if value.form == "wiechert"
+               else {"E0": float(value.E0)}),
+            "name": value.name}
+    if value.modulus_unit is not None:
+        spec.update(modulus_unit=value.modulus_unit, time_unit=value.time_unit)
+    if tau0 != 1.0:
+        spec["tau0"] = tau0
+    return SceneTable(weights=tuple(c[keep][order].tolist()),
+                      times=tuple(theta[keep][order].tolist()), tau0=float(tau0),
+                      E0=float(value.E0), Einf=float(value.Einf), name=value.name,
+                      digest=digest, units_known=value.modulus_unit is not None, spec=spec)
+
+
 @dataclass(frozen=True, kw_only=True)
 class Scene:
     """One unloading experiment of a rigid sphere from a fully relaxed half-space.
@@ -161,9 +290,15 @@ class Scene:
     delta0 : float, optional
         Initial indentation in d_ref units (delta-hat). In units of h0 it is
         ``delta0 / h0_hat(mu)`` (see :func:`sweep.units.delta0_from_h0_units`).
-    material : {"mpl", "sls"}
+    material : {"mpl", "sls"} or a Prony table
         "mpl": MPL retardation spectrum, Chat = 1 - (1-k) 2 t^(n/2) K_n(2 sqrt t)/Gamma(n);
-        "sls": standard linear solid, Chat = 1 - (1-k) exp(-t).
+        "sls": standard linear solid, Chat = 1 - (1-k) exp(-t);
+        a Prony table (a :class:`~sweep.materials.PronyTable`, anything
+        :func:`~sweep.materials.read_prony` reads, ``{"prony": path}`` or an inline
+        ``{"tau": [...], "E": [...], "E0": ...}``, optionally with ``"tau0"``, the time unit
+        of the scene in the table's time unit, default 1), normalized on construction into a
+        :class:`SceneTable`: Chat = 1 - sum c_i exp(-t/theta_i). The table fixes k (a k other
+        than the default 0.1 must equal it) and n is unused, as for "sls".
     stop : {"pulloff", "separation"}
         Stop right after the load minimum has passed and recovered ("pulloff"), or follow
         the whole curve until the contact is lost ("separation").
@@ -214,7 +349,8 @@ class Scene:
     delta0: float | None = axis(None, help="initial indentation; alternative to a0",
                                 unit="d_ref", limits=(-5.0, 2500.0), label=r"$\hat\delta_0$",
                                 order=6)
-    material: str = axis("mpl", help="creep compliance: MPL retardation spectrum or SLS",
+    material: str = axis("mpl", help="creep compliance: MPL retardation spectrum, SLS, or a "
+                         "Prony table ({prony: file} or inline; k from the table, n unused)",
                          choices=MATERIALS, order=0)
     stop: str = axis("pulloff", help="stop after the pull-off, or follow the curve to "
                      "separation", choices=STOPS, order=1, plot_group=False)
@@ -243,8 +379,9 @@ class Scene:
                                        label=r"approach rate $\hat r_a$", order=-9)
     preload: float | None = axis(None, help="protocol: the load at the end of the approach "
                                  "(sweep scene --si: newtons, and without --dwell the "
-                                 "relaxed contact at that load)", unit="pi dg R", limits=(0.0, 1e6), lo_open=True,
-                                 label=r"$\hat P_0$", order=-8)
+                                 "relaxed contact at that load)", unit="pi dg R",
+                                 limits=(0.0, 1e6), lo_open=True, label=r"$\hat P_0$",
+                                 order=-8)
     dwell: float | None = axis(None, help="protocol: the dwell after the approach",
                                unit="tau0", limits=(0.0, 1e15), label=r"dwell $\hat t_d$",
                                order=-7)
@@ -254,6 +391,11 @@ class Scene:
     def __post_init__(self):
         info = _axes_of(type(self))
         protocol = check_protocol(self.approach_rate, self.preload, self.dwell, self.dwell_hold)
+        table = None
+        if not isinstance(self.material, str):
+            table = scene_table(self.material)
+            object.__setattr__(self, "material", table)
+            object.__setattr__(self, "k", table.fixed_k(self.k, info["k"].default))
         for f in dataclasses.fields(self):
             if f.name == "a0" and not protocol and (self.a0 is None) == (self.delta0 is None):
                 raise InputError("a0/delta0: give exactly one of a0 (initial contact radius) "
@@ -261,6 +403,8 @@ class Scene:
             if f.name == "a0" and protocol and (self.a0, self.delta0) != (None, None):
                 raise InputError("a0/delta0: a scene with a protocol (approach_rate, preload, "
                                  "dwell) starts at first contact: give neither a0 nor delta0")
+            if f.name == "material" and table is not None:
+                continue
             object.__setattr__(self, f.name, info[f.name].check(getattr(self, f.name)))
         check_process_zone(self.pz_law, self.pz_v0, self.pz_xi, "a_ref/tau0")
 
@@ -270,8 +414,18 @@ class Scene:
             return None
         return Protocol(self.approach_rate, self.preload, self.dwell, self.dwell_hold)
 
+    @property
+    def table(self) -> "SceneTable | None":
+        """The scene's Prony table (None for "mpl" and "sls")."""
+        return self.material if isinstance(self.material, SceneTable) else None
+
     def to_dict(self) -> dict:
-        return dataclasses.asdict(self)
+        """The fields as plain values; a table material as its label
+        (:attr:`SceneTable.label`, ``prony:<name>:<hash>``: the results column)."""
+        d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        if self.table is not None:
+            d["material"] = self.table.label
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> "Scene":
@@ -280,6 +434,9 @@ class Scene:
         if unknown:
             raise InputError(f"scene: unknown key(s) {', '.join(sorted(unknown))} "
                              f"(allowed: {', '.join(sorted(names))})")
+        if str(d.get("material", "")).startswith(f"{TABLE_MATERIAL}:"):
+            raise InputError(f"material: {d['material']} is a table's label (a results row); "
+                             f"give the table itself ({{prony: file}} or inline)")
         return cls(**d)
 
 
@@ -632,9 +789,17 @@ def scene_id(scene: Scene, numerics: Numerics) -> str:
     The same parameters always map to the same id (sorted keys, repr'd floats), which
     makes resume and de-duplication of sweeps trivial. The hashed form is that of
     :data:`SCENE_ID_VERSION` (see :func:`id_form`): adding a field with a default to Scene or
-    Numerics renames no scene, so existing results files keep resuming.
+    Numerics renames no scene, so existing results files keep resuming. A scene whose
+    material is a Prony table hashes the table's :attr:`SceneTable.digest` (its numbers, not
+    its path) in place of the material and k.
     """
-    text = _canonical({"scene": id_form(scene, ID_V1_FIELDS["scene"]),
+    form = id_form(scene, ID_V1_FIELDS["scene"])
+    if scene.table is not None:
+        # a table scene (after version 1; no older id to keep): the table by its digest, and
+        # no k, which the table fixes (its float may differ in the last bit between formats)
+        form["material"] = {TABLE_MATERIAL: scene.table.digest}
+        form.pop("k")
+    text = _canonical({"scene": form,
                        "numerics": id_form(numerics, ID_V1_FIELDS["numerics"])})
     return hashlib.sha1(text.encode()).hexdigest()[:16]
 

@@ -168,6 +168,8 @@ SETUP: dict[str, list[tuple[str, str]]] = {
 
 # yaml blocks: the loader of the format each page shows ({path}: the block written to a file)
 YAML_CHECKS = {
+    _R: "from sweep.campaign.config import load_config\n"
+        "cfg = load_config('{path}'); print(cfg.name, len(cfg.scenes()), 'scenes')",
     "docs/calibration.md": "from sweep.analysis.calibrate import load_calibration\n"
                            "import shutil; shutil.copy('configs/calibrate/pulloff.csv', "
                            "'pulloff.csv')\n"

@@ -179,6 +179,10 @@ BAD_CONFIGS = {
     "si_nu": ("name: x\nunits: si\ngrid: {R: 5e-3, E0: 1e6, Einf: 1e9, nu: 0.7, n: 0.2, "
               "tau0: 0.02, dg: 0.15, h0: 3e-8, preload: 1e-3, speed: 1e-6}\n",
               "grid.nu must be in [0, 0.5] (got 0.7)"),
+    "prony_file": ("name: x\ngrid: {material: {prony: nope.csv}, n: 0.8, rate: 1, a0: 2}\n",
+                   "grid.material: nope.csv: cannot read the Prony table (No such file"),
+    "prony_liquid": ("name: x\ngrid: {material: [{tau: [1], c: [1.2], E0: 1}], n: 0.8, "
+                     "rate: 1, a0: 2}\n", "grid.material[0]: "),
     "si_missing": ("name: x\nunits: si\ngrid: {R: 5e-3, E0: 1e6, Einf: 1e9, nu: 0.5, n: 0.2, "
                    "tau0: 0.02, h0: 3e-8, preload: 1e-3, speed: 1e-6}\n",
                    "grid.dg: required SI field is missing (work of adhesion, J/m^2)"),

@@ -55,8 +55,8 @@ import yaml
 
 from ..errors import InputError, as_float, check_choice, check_int, check_range
 from ..scene import AXES as SCENE_AXIS_INFO
-from ..scene import Numerics, Scene, scene_id
-from .si import SI_AXES, SI_INITIAL, SIScene
+from ..scene import Numerics, Scene, SceneTable, scene_id, scene_table
+from .si import SI_AXES, SI_INITIAL, TABLE_FIELDS, SIScene
 
 #: Top-level keys of a config file.
 TOP_KEYS = ("name", "description", "units", "grid", "numerics", "store", "output")
@@ -157,7 +157,8 @@ class SweepConfig:
         """A plain mapping that :func:`config_from_dict` turns back into this config."""
         grids = []
         for g in self.grids:
-            grids.append({a: list(v) for a, v in g.items()})
+            grids.append({a: [x.spec if isinstance(x, SceneTable) else x for x in v]
+                          for a, v in g.items()})
         return {
             "name": self.name,
             "description": self.description,
@@ -242,7 +243,10 @@ def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) ->
         for i, v in enumerate(vals):
             w = f"{where}[{i}]" if isinstance(spec, list) else where
             try:
-                out.append(check_choice(w, v, allowed))
+                if axis == "material" and not isinstance(v, str):
+                    out.append(_table(w, v))
+                else:
+                    out.append(check_choice(w, v, allowed))
             except InputError as exc:
                 problems.append(str(exc))
         return tuple(out) if len(out) == len(vals) else None
@@ -303,6 +307,18 @@ def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) ->
     return tuple(out) if len(out) == len(vals) else None
 
 
+def _table(where: str, spec) -> SceneTable:
+    """A ``material`` value that is a Prony table (``{prony: path}``, relative to the working
+    directory, or an inline table; :func:`sweep.scene.scene_table`): InputError naming it."""
+    if not isinstance(spec, (dict, SceneTable)):
+        raise InputError(f"{where} must be mpl, sls or a Prony table {{prony: file}} or "
+                         f"{{tau: [...], E: [...], E0: ...}} (got {spec!r})")
+    try:
+        return scene_table(spec)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
 def _check_grid(where: str, grid, problems: list[str]) -> dict | None:
     if not isinstance(grid, dict):
         problems.append(f"{where}: must be a mapping of axes ({_fmt_choices(AXES)}) "
@@ -357,7 +373,12 @@ def _check_si_grid(where: str, grid, problems: list[str]) -> dict | None:
         if key not in allowed:
             problems.append(f"{where}.{key}: unknown SI field (allowed: "
                             f"{_fmt_choices(allowed)})")
+    tables = any(not isinstance(m, str)
+                 for m in (grid.get("material") if isinstance(grid.get("material"), list)
+                           else [grid.get("material", "mpl")]))
     for name, info in SI_AXES.items():
+        if tables and name in TABLE_FIELDS:   # a table gives them (sweep.campaign.si)
+            continue
         if info.required and name not in grid:
             problems.append(f"{where}.{name}: required SI field is missing ({info.help}"
                             f"{', ' + info.unit if info.unit else ''})")

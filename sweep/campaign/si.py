@@ -13,7 +13,17 @@ and ``pz_xi`` (its exponent), converted to ``pz_v0`` in a_ref/tau0
 (:meth:`sweep.units.PhysicalScale.crack_speed_hat`).
 
 Derived: ``k = E0/Einf``, ``mu`` (Tabor), ``rate = speed tau0 / h0`` (the paper's r-hat), the
-initial ``a0_hat`` (a_ref) or ``delta0_hat`` (d_ref). The dimensionless scene holds everything
+initial ``a0_hat`` (a_ref) or ``delta0_hat`` (d_ref).
+
+A Prony table as the material (``material={"prony": path}``, an inline table, a
+:class:`~sweep.materials.PronyTable` or a :class:`sweep.scene.SceneTable`) replaces ``E0``,
+``Einf``, ``n`` and ``tau0``: ``E0`` and ``Einf`` are the table's relaxed and instantaneous
+moduli, in Pa (a table that states no units is taken as Pa and s), ``tau0`` is 1 s (the
+scene's time unit; its times are the table's retardation times in s) and ``n`` is unused
+(:data:`TABLE_N` in the dimensionless scene, for bookkeeping). The reference modulus of
+the scales (``a_ref``, ``mu``, ``l0``) is the relaxed ``E0* = E0 / (1 - nu^2)``, as for the
+MPL. Giving ``E0``, ``Einf`` or ``tau0`` with a table is an error unless it equals the
+table's. The dimensionless scene holds everything
 a model needs; a :class:`sweep.Scene` is built when its parameters are within the Scene's
 ranges (the BEM's), the crack-front and pb models run on the plain parameters at any ``mu``.
 """
@@ -25,8 +35,9 @@ from dataclasses import asdict, dataclass
 from .. import units
 from ..engine.crack_front import scene_law, unload
 from ..engine.models import PROCESS_ZONE_REFUSALS, choose_model, pb_estimate, simulate_model
-from ..errors import InputError, check_choice, check_positive, check_range
-from ..scene import AXES, PZ_LAWS, SCENE_LIMITS, Axis, Scene, check_process_zone
+from ..errors import InputError, as_float, check_choice, check_positive, check_range
+from ..scene import (AXES, MATERIALS, PZ_LAWS, SCENE_LIMITS, Axis, Scene, SceneTable,
+                     check_process_zone, scene_table)
 from ..theory import jkr_contact_radius, jkr_pull_off
 from ..units import PhysicalScale
 
@@ -67,6 +78,10 @@ SI_AXES = {a.name: a for a in (
 )}
 #: The initial-state fields of an SI grid: exactly one is given.
 SI_INITIAL = ("preload", "a0", "indentation")
+#: The SI fields a Prony table replaces (its moduli and times).
+TABLE_FIELDS = ("E0", "Einf", "n", "tau0")
+#: ``n`` of the dimensionless scene of a table material (unused, as for "sls")
+TABLE_N = 1.0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -74,27 +89,48 @@ class SIScene:
     """One unloading experiment in SI units (module docstring for the fields)."""
 
     R: float
-    E0: float
-    Einf: float
+    E0: float | None = None
+    Einf: float | None = None
     nu: float
-    n: float
-    tau0: float
+    n: float | None = None
+    tau0: float | None = None
     dg: float
     h0: float
     speed: float
     preload: float | None = None
     a0: float | None = None
     indentation: float | None = None
-    material: str = "mpl"
+    material: str | SceneTable = "mpl"
     pz_law: str = "none"
     pz_v0: float | None = None
     pz_xi: float | None = None
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
-        for name in ("R", "E0", "Einf", "n", "tau0", "dg", "h0", "speed"):
-            set_(name, check_positive(name, getattr(self, name)))
         set_("nu", check_range("nu", self.nu, 0.0, 0.5))
+        if isinstance(self.material, str):
+            check_choice("material", self.material, MATERIALS)
+            missing = [f for f in TABLE_FIELDS if getattr(self, f) is None]
+            if missing:
+                raise InputError(f"{', '.join(missing)}: required for material "
+                                 f"{self.material} (or give a Prony table as the material)")
+        else:
+            table = scene_table(self.material, nu=self.nu)
+            set_("material", table)
+            if self.n is not None:
+                raise InputError(f"n: unused with a Prony table (material {table.label}); "
+                                 f"leave it out")
+            for name, value in (("E0", table.E0), ("Einf", table.Einf), ("tau0", table.tau0)):
+                given = getattr(self, name)
+                if given is not None and not math.isclose(as_float(name, given), value,
+                                                          rel_tol=1e-12):
+                    raise InputError(f"{name}: the Prony table {table.name} gives {name} = "
+                                     f"{value:.6g}; leave {name} out (got {given!r})")
+                set_(name, value)
+        for name in ("R", "E0", "Einf", "tau0", "dg", "h0", "speed"):
+            set_(name, check_positive(name, getattr(self, name)))
+        if self.n is not None:
+            set_("n", check_positive("n", self.n))
         if self.Einf < self.E0:
             raise InputError(f"Einf must be >= E0 = {self.E0:.6g} Pa (got {self.Einf:.6g})")
         given = [f for f in ("preload", "a0", "indentation") if getattr(self, f) is not None]
@@ -108,7 +144,6 @@ class SIScene:
             set_("a0", check_positive("a0", self.a0))
         if self.indentation is not None:
             set_("indentation", check_range("indentation", self.indentation))
-        check_choice("material", self.material, ("mpl", "sls"))
         check_choice("pz_law", self.pz_law, PZ_LAWS)
         if self.pz_v0 is not None:
             set_("pz_v0", check_positive("pz_v0", self.pz_v0))
@@ -123,7 +158,15 @@ class SIScene:
 
     @property
     def k(self) -> float:
+        """``E0/Einf`` (a table's own, ``1 - sum c_i``)."""
+        if isinstance(self.material, SceneTable):
+            return self.material.k
         return self.E0 / self.Einf
+
+    @property
+    def table(self) -> SceneTable | None:
+        """The Prony table of the material (None for "mpl" and "sls")."""
+        return self.material if isinstance(self.material, SceneTable) else None
 
     @property
     def mu(self) -> float:
@@ -141,7 +184,8 @@ class SIScene:
         A preload becomes the relaxed JKR contact radius at that load.
         """
         sc = self.scale
-        d = {"n": self.n, "k": self.k, "mu": sc.mu, "rate": self.rate, "material": self.material,
+        n = TABLE_N if self.table is not None else self.n
+        d = {"n": n, "k": self.k, "mu": sc.mu, "rate": self.rate, "material": self.material,
              "a0": None, "delta0": None, "pz_law": self.pz_law,
              "pz_v0": (None if self.pz_v0 is None
                        else float(sc.crack_speed_hat(self.pz_v0, self.tau0))),
@@ -187,7 +231,11 @@ class SIScene:
                    speed=float(sc.rate_physical(rate, tau0)), material=material, **kw)
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """The fields as plain values (a table material as its label ``prony:<name>:<hash>``)."""
+        d = asdict(self)
+        if self.table is not None:
+            d["material"] = self.table.label
+        return d
 
 
 def _si_of(si: SIScene, dimless: dict) -> dict:
@@ -292,6 +340,6 @@ def si_row(si: SIScene, row) -> dict:
            "delta_pulloff": get("delta_pulloff"), "crack_speed": get("crack_speed"),
            "t_pulloff": get("t_pulloff"), "a0": get("a0_result"),
            "delta0": get("delta0_result")}
-    out = {f"si_{k}": v for k, v in si.to_dict().items() if v is not None and k != "material"}
+    out = {f"si_{k}": v for k, v in si.to_dict().items() if v is not None}
     out.update(_si_of(si, dim))
     return out

@@ -74,7 +74,7 @@ from .. import units
 from . import budget
 from ..errors import (NUMERICAL_ERRORS, InputError, check_choice, check_positive, check_range,
                       is_internal_error)
-from ..scene import Numerics, Result
+from ..scene import MATERIALS, Numerics, Result, SceneTable
 from ..theory import (A_PULL_OFF_FORCE, jkr_contact_radius, jkr_indentation, pb_gamma_eff,
                      pb_gamma_eff_spectrum)
 
@@ -167,6 +167,14 @@ class GentSchultzLaw:
         return f"GentSchultzLaw(v0={self.v0:g}, xi={self.xi:g}, c={self.c:g})"
 
 
+def _spectrum(material) -> tuple:
+    """(weights, times) of the discrete retardation spectrum of "sls" or a table (times in
+    tau0; :func:`sweep.theory.pb_gamma_eff_spectrum` normalizes the weights); () for "mpl"."""
+    if isinstance(material, SceneTable):
+        return material.weights, material.times
+    return ((1.0,), (1.0,)) if material == "sls" else ()
+
+
 @lru_cache(maxsize=32)
 def _pb_table(kind: str, n: float, k: float, weights: tuple, times: tuple):
     """log(vhat) as a monotone function of log(Gamma - 1) for the PB law (vhat = v tau0/l0)."""
@@ -197,24 +205,34 @@ class PerssonBrenerLaw:
     Parameters
     ----------
     n, k : float
-        MPL exponent and ``E0/Einf`` (material "mpl"); for "sls" ``n`` is ignored.
+        MPL exponent and ``E0/Einf`` (material "mpl"); for "sls" and a table ``n`` is
+        ignored.
     l0 : float
         Process-zone length in the model's length unit (``l0_hat(mu)`` in a_ref), > 0.
-    material : {"mpl", "sls"}
+    material : {"mpl", "sls"} or SceneTable
+        A table (:class:`sweep.scene.SceneTable`) gives its discrete retardation spectrum,
+        Kelvin weights ``c_i`` at times ``theta_i`` (tau0), to
+        :func:`sweep.theory.pb_gamma_eff_spectrum`; its ``k`` must be the table's.
     """
 
     def __init__(self, n, k, l0, material="mpl"):
-        material = check_choice("material", material, ("mpl", "sls"))
+        if not isinstance(material, SceneTable):
+            material = check_choice("material", material, MATERIALS)
         self.k = check_range("k", k, 0.0, 1.0, lo_open=True)
         self.n = check_positive("n", n)
         self.l0 = check_positive("l0", l0)
         self.material = material
         if self.k == 1.0:
             raise InputError("k must be < 1 for a rate-dependent Persson-Brener law (got 1)")
+        self._spectrum = _spectrum(material)
+        if isinstance(material, SceneTable) and not math.isclose(self.k, material.k,
+                                                                 rel_tol=1e-9):
+            raise InputError(f"k must be the table's {material.k:.10g} for material "
+                             f"{material} (got {self.k:g})")
         if material == "mpl":
             tab = _pb_table("mpl", self.n, self.k, (), ())
         else:
-            tab = _pb_table("sls", 0.0, self.k, (1.0,), (1.0,))
+            tab = _pb_table("spectrum", 0.0, self.k, *self._spectrum)
         self._spline, self._g_lo, self._g_hi, self._v_lo, self._v_hi, self._vh, self._g = tab
         self._dspline = self._spline.derivative()
         self._q = (self._g_lo - 1.0) / self._v_lo      # linear-regime slope (Gamma-1)/vhat
@@ -231,7 +249,7 @@ class PerssonBrenerLaw:
         v = np.asarray(v, dtype=float) / self.l0
         if self.material == "mpl":
             return pb_gamma_eff(self.n, self.k, v)
-        return pb_gamma_eff_spectrum([1.0], [1.0], self.k, v)
+        return pb_gamma_eff_spectrum(*self._spectrum, self.k, v)
 
     def speed(self, g):
         """``V(g)`` [l0 / tau0 units times l0] and ``dV/dg``."""

@@ -46,7 +46,7 @@ import numpy as np
 from .. import units
 from ..errors import (NUMERICAL_ERRORS, check_choice, check_positive, is_internal_error,
                       is_physical_refusal)
-from ..scene import Numerics, Result, Scene
+from ..scene import MATERIALS, Numerics, Result, Scene, SceneTable
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem, budget
 from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
@@ -77,7 +77,10 @@ def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171)
         Material exponent, ``E0/Einf``, Tabor parameter.
     rate : float or array_like
         The paper's r-hat ``r tau0 / h0`` (> 0).
-    material : {"mpl", "sls"}
+    material : {"mpl", "sls"} or SceneTable
+        A table (:class:`sweep.scene.SceneTable`): its discrete retardation spectrum in
+        :func:`sweep.theory.pb_gamma_eff_spectrum` (the estimate needs only Gamma_PB, which
+        every spectrum has; the v-r fit is the paper's, measured on the MPL, as for "sls").
     prefactor, exponent : float
         Constants of the v-r fit.
 
@@ -87,13 +90,17 @@ def pb_estimate(n, k, mu, rate, material="mpl", prefactor=2.887, exponent=1.171)
         ``pull_off`` (pi dg R), ``vhat`` (v tau0/l0), ``crack_speed`` (a_ref/tau0),
         ``gamma`` (Gamma/dg), ``rhat_pb``.
     """
-    material = check_choice("material", material, ("mpl", "sls"))
+    if isinstance(material, SceneTable):
+        weights, times = material.weights, material.times
+    else:
+        material = check_choice("material", material, MATERIALS)
+        weights, times = [1.0], [1.0]
     rhat = units.rhat_pb(rate, mu)
     vhat = paper_v_vs_r_fit(rhat, prefactor, exponent)
     if material == "mpl":
         gamma = pb_gamma_eff(n, k, vhat)
     else:
-        gamma = pb_gamma_eff_spectrum([1.0], [1.0], k, vhat)
+        gamma = pb_gamma_eff_spectrum(weights, times, k, vhat)
     return {"pull_off": 1.5 * gamma, "vhat": vhat,
             "crack_speed": units.crack_speed_from_vhat(vhat, mu), "gamma": gamma,
             "rhat_pb": rhat}

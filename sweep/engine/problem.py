@@ -18,9 +18,9 @@ import numpy as np
 
 from .. import materials, units
 from ..kernels.interface import TIP_GAP
-from ..materials import SLS, MPLRetardation
+from ..materials import SLS, MPLRetardation, Prony
 from ..materials.prony_series import PronySeries
-from ..scene import Numerics, Scene
+from ..scene import Numerics, Scene, SceneTable
 from ..theory import jkr_contact_radius
 from . import diskcache, process_zone
 from .mesh import Mesh, crack_band, scene_mesh
@@ -76,10 +76,13 @@ def jkr_radius(delta: float) -> float:
     return float(jkr_contact_radius(indentation=delta)) if delta >= -0.75 else 0.0
 
 
-def material(kind: str, n: float, k: float):
-    """The material object (units E0 = 1, tau0 = 1): "mpl" or "sls"."""
+def material(kind, n: float, k: float):
+    """The material object (units E0 = 1, tau0 = 1): "mpl", "sls", or a scene's Prony table
+    (:class:`sweep.scene.SceneTable`: its Kelvin form in tau0, k its own)."""
     if kind == "sls":
         return SLS(1.0, 1.0 / k, 1.0)
+    if isinstance(kind, SceneTable):
+        return Prony(kind.weights, kind.times, E0=1.0, kind="kelvin")
     return MPLRetardation(1.0, 1.0 / k, n, 1.0)
 
 
@@ -169,8 +172,9 @@ class Problem:
         ``tip_zone`` read from it.
     mesh : the mesh (``mesh.r`` node radii, ``mesh.spacing`` the fine spacing).
     A, wP : influence matrix and load weights of the mesh (read-only, cached).
-    prony_weights, prony_times : Prony modes of Chat (empty when elastic or exact).
-    prony_error : achieved max relative error of the series (0 when none).
+    prony_weights, prony_times : Prony modes of Chat (empty when elastic or exact): the
+        series fitted on the scene's time window, or a table material's own Kelvin terms.
+    prony_error : achieved max relative error of the series (0 when none, or a table's).
     """
 
     scene: Scene
@@ -338,7 +342,11 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"{numerics.max_nodes}); raise max_nodes or lower band_resolution; {other}")
     weights = times = np.zeros(0)
     error = 0.0
-    if scene.k < 1.0 and not numerics.exact:
+    if scene.table is not None and not numerics.exact:
+        # the table IS the series: its Kelvin form in tau0, every term, no fit (error 0)
+        weights = np.ascontiguousarray(scene.table.weights, dtype=float)
+        times = np.ascontiguousarray(scene.table.times, dtype=float)
+    elif scene.k < 1.0 and not numerics.exact:
         t_min, t_max = time_window(scene.rate, s, numerics.min_step)
         if protocol:        # the approach's steps and the dwell, before the retraction
             t_approach = time_window(protocol.approach_rate, s, numerics.min_step)

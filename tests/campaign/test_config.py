@@ -354,3 +354,79 @@ def test_numerics_asked_as_an_accuracy_resolve_to_the_cheapest_preset_with_refin
                             "numerics": {"pull_off_rtol": 0.01, "max_nodes": 800}})
     assert cfg.numerics == Numerics.for_tolerance(0.01, max_nodes=800)
     assert cfg.numerics.refinements > 0 and cfg.numerics.mesh == "graded"
+
+
+# ----------------------------------------------------------------------------- Prony tables
+PRONY = ROOT / "tests" / "data" / "prony"
+
+
+def test_a_table_is_a_material_value_file_or_inline():
+    """``material: [{prony: file}, inline, sls]``: one scene per table, k from the table (the
+    default k is replaced), the id from the table's numbers: the same table inline and from
+    its file is one scene (de-duplicated); to_dict and the YAML text read back to the same
+    config hash."""
+    from sweep.materials import read_prony
+    from sweep.scene import scene_table
+
+    inline = scene_table({"prony": str(PRONY / "pdms_prony_visco_sweep.csv")}).spec
+    cfg = config_from_dict(base(grid={"material": [{"prony": str(PRONY / "pdms_prony.csv")},
+                                                   inline, "sls",
+                                                   {"tau": [0.5], "E": [1.0], "E0": 1.0}],
+                                      "n": 0.8, "rate": [1, 100], "a0": 2.0}))
+    mats = [s.material for s in cfg.scenes()]
+    assert len(mats) == 6                        # the PDMS inline and from file: one table
+    table = read_prony(PRONY / "pdms_prony.csv")
+    assert str(mats[0]) == f"prony:pdms_prony:{table.content_hash()}"
+    assert cfg.scenes()[0].k == pytest.approx(table.k, rel=1e-12)
+    assert cfg.scenes()[4].k == pytest.approx(0.5, rel=1e-14)     # E0 / (E0 + E)
+    assert config_from_dict(cfg.to_dict()).config_hash == cfg.config_hash
+    assert parse_config(cfg.text).config_hash == cfg.config_hash
+
+
+def test_relative_table_paths_are_read_from_the_working_directory(monkeypatch):
+    monkeypatch.chdir(ROOT)
+    cfg = parse_config("name: p\ngrid: {material: {prony: tests/data/prony/pdms_prony.csv}, "
+                       "n: 0.8, rate: 1, a0: 2}\n")
+    assert cfg.scenes()[0].material.name == "pdms_prony"
+
+
+@pytest.mark.parametrize("material, needle", [
+    ("{prony: nope.csv}", "grid.material: nope.csv: cannot read the Prony table"),
+    ("[{tau: [1, 2], E: [1], E0: 1}]", "grid.material[0]: "),
+    ("[{tau: [1], E: [-1], E0: 1}]", "must be >= 0"),
+    ("[3]", "grid.material[0] must be mpl, sls or a Prony table"),
+])
+def test_bad_tables_in_a_config_one_line(material, needle):
+    with pytest.raises(InputError) as exc:
+        parse_config(f"name: p\ngrid: {{material: {material}, n: 0.8, rate: 1, a0: 2}}\n")
+    assert needle in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_conflicting_k_with_a_table_is_refused():
+    with pytest.raises(InputError, match=r"k: the Prony table inline fixes k = E0/Einf = 0\.5"):
+        parse_config("name: p\ngrid: {material: [{tau: [1], E: [1], E0: 1}], k: 0.2, n: 0.8, "
+                     "rate: 1, a0: 2}\n")
+
+
+def test_si_grid_with_a_table_needs_no_moduli_and_refuses_other_ones():
+    """In an SI grid a table replaces E0, Einf, n and tau0: E0/Einf the table's (Pa), tau0
+    1 s, k = E0/Einf; a given E0 that differs, or an n, is refused."""
+    from sweep.materials import read_prony
+
+    grid = {"material": {"prony": str(PRONY / "pdms_prony.csv")}, "R": 5.19e-3, "nu": 0.5,
+            "dg": 0.1523, "h0": 30.8e-9, "preload": 1.5e-3, "speed": 1e-4, "model": "crack"}
+    cfg = config_from_dict({"name": "s", "units": "si", "grid": grid})
+    [(sid, si)] = cfg.si_tasks()
+    t = read_prony(PRONY / "pdms_prony.csv")
+    assert (si.E0, si.Einf, si.tau0) == (pytest.approx(t.E0), pytest.approx(t.Einf), 1.0)
+    assert si.rate == pytest.approx(1e-4 * 1.0 / 30.8e-9, rel=1e-12)
+    assert cfg.scenes()[0].k == pytest.approx(t.E0 / t.Einf, rel=1e-12)
+    assert config_from_dict(cfg.to_dict()).config_hash == cfg.config_hash
+    for over, needle in (({"E0": 2e6}, "E0: the Prony table pdms_prony gives E0 = 1.45835e+06"),
+                         ({"n": 0.5}, "n: unused with a Prony table")):
+        with pytest.raises(InputError) as exc:
+            config_from_dict({"name": "s", "units": "si", "grid": {**grid, **over}})
+        assert needle in str(exc.value)
+    with pytest.raises(InputError, match="E0, Einf, n, tau0: required for material mpl"):
+        config_from_dict({"name": "s", "units": "si",
+                          "grid": {**grid, "material": ["mpl", grid["material"]]}})
