@@ -223,7 +223,8 @@ def scene_from_options(values: dict):
                     for name, v in values.items()})
 
 
-_SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "a0_si", "indentation", "speed")
+_SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "a0_si", "indentation", "speed",
+               "approach_speed")
 
 
 @cli.command("scene")
@@ -243,6 +244,9 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "a0_si", "indentatio
 @click.option("--indentation", "indentation", type=str, default=None,
               help="[--si] initial indentation [m].")
 @click.option("--speed", "speed", type=str, default=None, help="[--si] unloading speed [m/s].")
+@click.option("--approach-speed", "approach_speed", type=str, default=None,
+              help="[--si] test protocol: approach speed [m/s] (with --preload [N] and --dwell "
+                   "[s]).")
 @click.option("--preset", type=click.Choice(list(PRESETS)), default="balanced",
               show_default=True)
 @click.option("--pull-off-rtol", "pull_off_rtol", type=str, default=None,
@@ -397,7 +401,7 @@ def _scene_si(axes, as_json, values):
     from .campaign.si import SIScene, run_si
 
     ctx = click.get_current_context()
-    clash = [f"--{name}" for name in ("k", "mu", "a0", "delta0", "rate")
+    clash = [f"--{name}" for name in ("k", "mu", "a0", "delta0", "rate", "approach_rate")
              if ctx.get_parameter_source(name) == ParameterSource.COMMANDLINE]
     if clash:
         raise InputError(f"{', '.join(clash)}: dimensionless options cannot be combined with "
@@ -412,6 +416,9 @@ def _scene_si(axes, as_json, values):
     kw = {name: as_float(name, v) for name, v in values.items() if v is not None}
     if axes["preload"] is not None:         # the one --preload: newtons with --si
         kw["preload"] = as_float("preload", axes["preload"])
+    if axes["dwell"] is not None:           # and the one --dwell: seconds
+        kw["dwell"] = as_float("dwell", axes["dwell"])
+        kw["dwell_hold"] = axes["dwell_hold"]
     if "a0_si" in kw:
         kw["a0"] = kw.pop("a0_si")
     pz = {"pz_law": axes["pz_law"], **{name: as_float(name, axes[name])

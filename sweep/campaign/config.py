@@ -63,9 +63,9 @@ TOP_KEYS = ("name", "description", "units", "grid", "numerics", "store", "output
 #: Values of ``units``: the grid in the dimensionless Scene axes, or in SI (sweep.campaign.si.SI_AXES).
 UNITS = ("dimensionless", "si")
 #: Categorical Scene axes an SI grid takes as they are.
-SI_SCENE_AXES = ("model", "material", "stop", "pz_law")
+SI_SCENE_AXES = ("model", "material", "stop", "pz_law", "dwell_hold")
 #: Of those, the ones the SI scene holds (the rest pass to the Scene as they are).
-SI_SCENE_FIELDS = ("material", "pz_law")
+SI_SCENE_FIELDS = ("material", "pz_law", "dwell_hold")
 #: Grid axes, in the order the Cartesian product iterates them (last varies fastest).
 #: Grid axes in the order of expansion (the last varies fastest): the Scene fields by their
 #: ``order`` metadata.
@@ -332,7 +332,11 @@ def _check_grid(where: str, grid, problems: list[str]) -> dict | None:
     for axis in AXES:
         if SCENE_AXIS_INFO[axis].required and axis not in grid:
             problems.append(f"{where}.{axis}: required axis is missing")
-    if ("a0" in grid) == ("delta0" in grid):
+    if "dwell" in grid:
+        if "a0" in grid or "delta0" in grid:
+            problems.append(f"{where}: a grid with a test protocol (approach_rate, preload, "
+                            f"dwell) starts at first contact: give neither a0 nor delta0")
+    elif ("a0" in grid) == ("delta0" in grid):
         problems.append(f"{where}: give exactly one of the axes a0 (initial contact radius) "
                         f"and delta0 (initial indentation)")
     for axis in AXES:

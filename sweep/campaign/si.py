@@ -10,7 +10,11 @@ that load), a contact radius ``a0`` [m] or an indentation ``indentation`` [m]; t
 speed ``speed`` [m/s]; optionally a rate-dependent process zone, ``pz_law`` ("none" or
 "gent-schultz"), ``pz_v0`` [m/s] (the crack speed at which it doubles the work of adhesion)
 and ``pz_xi`` (its exponent), converted to ``pz_v0`` in a_ref/tau0
-(:meth:`sweep.units.PhysicalScale.crack_speed_hat`).
+(:meth:`sweep.units.PhysicalScale.crack_speed_hat`); optionally the test as run, a protocol:
+``approach_speed`` [m/s], ``preload`` [N] (then the force at the end of the approach),
+``dwell`` [s] and ``dwell_hold`` ("force" or "depth"), converted to the Scene's
+``approach_rate`` (r-hat), ``preload`` (pi dg R) and ``dwell`` (tau0); ``speed`` is then the
+retraction's.
 
 Derived: ``k = E0/Einf``, ``mu`` (Tabor), ``rate = speed tau0 / h0`` (the paper's r-hat), the
 initial ``a0_hat`` (a_ref) or ``delta0_hat`` (d_ref).
@@ -34,10 +38,11 @@ from dataclasses import asdict, dataclass
 
 from .. import units
 from ..engine.crack_front import scene_law, unload
-from ..engine.models import PROCESS_ZONE_REFUSALS, choose_model, pb_estimate, simulate_model
+from ..engine.models import (PROCESS_ZONE_REFUSALS, PROTOCOL_REFUSALS, choose_model,
+                             pb_estimate, simulate_model)
 from ..errors import InputError, as_float, check_choice, check_positive, check_range
-from ..scene import (AXES, MATERIALS, PZ_LAWS, SCENE_LIMITS, Axis, Scene, SceneTable,
-                     check_process_zone, scene_table)
+from ..scene import (AXES, DWELL_HOLDS, MATERIALS, PZ_LAWS, SCENE_LIMITS, Axis, Scene,
+                     SceneTable, check_process_zone, scene_table)
 from ..theory import jkr_contact_radius, jkr_pull_off
 from ..units import PhysicalScale
 
@@ -64,13 +69,18 @@ SI_AXES = {a.name: a for a in (
     _si_axis("tau0", "s", "MPL time", order=8),
     _si_axis("dg", "J/m^2", "work of adhesion", order=9),
     _si_axis("h0", "m", "LJ equilibrium distance", order=10),
-    _si_axis("preload", "N", "compressive preload after full relaxation (or a0 or "
-             "indentation)", lo_open=False, required=False, order=11),
+    _si_axis("preload", "N", "compressive preload: the relaxed start at that load (or a0 or "
+             "indentation); with dwell, the force at the end of the approach",
+             lo_open=False, required=False, order=11),
     _si_axis("a0", "m", "initial contact radius (or preload or indentation)",
              required=False, order=12),
     _si_axis("indentation", "m", "initial indentation (or preload or a0)", lo=None,
              lo_open=False, required=False, order=13),
-    _si_axis("speed", "m/s", "unloading speed", order=14),
+    _si_axis("speed", "m/s", "unloading (retraction) speed", order=14),
+    _si_axis("approach_speed", "m/s", "test protocol: approach speed (with preload and dwell)",
+             required=False, order=1),
+    _si_axis("dwell", "s", "test protocol: dwell at the preload (with approach_speed; "
+             "dwell_hold says what is held)", lo_open=False, required=False, order=1),
     _si_axis("pz_v0", "m/s", "process zone: crack speed at which it doubles the work of "
              "adhesion (with pz_law gent-schultz)", required=False, order=2),
     _si_axis("pz_xi", "", "process zone: exponent of Gamma_pz(v) (with pz_law gent-schultz)",
@@ -104,6 +114,9 @@ class SIScene:
     pz_law: str = "none"
     pz_v0: float | None = None
     pz_xi: float | None = None
+    approach_speed: float | None = None
+    dwell: float | None = None
+    dwell_hold: str = "force"
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
@@ -134,6 +147,23 @@ class SIScene:
         if self.Einf < self.E0:
             raise InputError(f"Einf must be >= E0 = {self.E0:.6g} Pa (got {self.Einf:.6g})")
         given = [f for f in ("preload", "a0", "indentation") if getattr(self, f) is not None]
+        if self.has_protocol or self.approach_speed is not None:
+            missing = [name for name in ("approach_speed", "preload", "dwell")
+                       if getattr(self, name) is None]
+            if missing:
+                raise InputError(f"{'/'.join(missing)}: a test protocol needs approach_speed "
+                                 f"[m/s], preload [N] and dwell [s] together (missing "
+                                 f"{', '.join(missing)})")
+            set_("approach_speed", check_positive("approach_speed", self.approach_speed))
+            set_("dwell", check_range("dwell", self.dwell, lo=0.0))
+            check_choice("dwell_hold", self.dwell_hold, DWELL_HOLDS)
+            if given != ["preload"]:
+                raise InputError("a0/indentation: a test protocol (approach_speed, preload, "
+                                 "dwell) starts at first contact: give neither a0 nor "
+                                 "indentation")
+        elif self.dwell_hold != "force":
+            raise InputError(f"dwell_hold: {self.dwell_hold!r} needs a test protocol "
+                             f"(approach_speed, preload, dwell)")
         if len(given) != 1:
             raise InputError("preload/a0/indentation: give exactly one initial state (a preload "
                              f"force [N], a contact radius [m] or an indentation [m]; got "
@@ -177,11 +207,18 @@ class SIScene:
         """The paper's r-hat, ``speed tau0 / h0``."""
         return float(self.scale.rate_hat(self.speed, self.tau0))
 
+    @property
+    def has_protocol(self) -> bool:
+        """Whether the scene is a test protocol (approach, dwell, retract)."""
+        return self.dwell is not None
+
     def dimensionless(self) -> dict:
         """``n, k, mu, rate, material``, ``a0`` (a_ref) or ``delta0`` (d_ref), and the process
-        zone ``pz_law``, ``pz_v0`` (a_ref/tau0), ``pz_xi`` (None without one).
+        zone ``pz_law``, ``pz_v0`` (a_ref/tau0), ``pz_xi`` (None without one); with a test
+        protocol ``approach_rate`` (r-hat), ``preload`` (pi dg R), ``dwell`` (tau0) and
+        ``dwell_hold`` instead of ``a0`` and ``delta0``.
 
-        A preload becomes the relaxed JKR contact radius at that load.
+        Without a protocol a preload becomes the relaxed JKR contact radius at that load.
         """
         sc = self.scale
         n = TABLE_N if self.table is not None else self.n
@@ -190,7 +227,11 @@ class SIScene:
              "pz_v0": (None if self.pz_v0 is None
                        else float(sc.crack_speed_hat(self.pz_v0, self.tau0))),
              "pz_xi": self.pz_xi}
-        if self.preload is not None:
+        if self.has_protocol:
+            d.update(approach_rate=float(sc.rate_hat(self.approach_speed, self.tau0)),
+                     preload=float(sc.load_hat(self.preload)), dwell=self.dwell / self.tau0,
+                     dwell_hold=self.dwell_hold)
+        elif self.preload is not None:
             d["a0"] = float(jkr_contact_radius(load=float(sc.load_hat(self.preload))))
         elif self.a0 is not None:
             d["a0"] = float(sc.radius_hat(self.a0))
@@ -200,11 +241,8 @@ class SIScene:
 
     def to_scene(self, **extra):
         """The :class:`sweep.Scene` (raises InputError outside the Scene's ranges, e.g. mu)."""
-        d = self.dimensionless()
-        if d["a0"] is None:
-            d.pop("a0")
-        else:
-            d.pop("delta0")
+        d = {k: v for k, v in self.dimensionless().items()
+             if not (k in ("a0", "delta0") and v is None)}
         return Scene(**d, **extra)
 
     @classmethod
@@ -306,6 +344,9 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
                "a_pulloff": r.a_pulloff, "delta_pulloff": r.delta_pulloff,
                "t_pulloff": r.t_pulloff, "crack_speed": r.crack_speed, "vhat": r.vhat,
                "a0": r.a0_result, "delta0": r.delta0_result}
+    elif model in PROTOCOL_REFUSALS and si.has_protocol:
+        dim = {"status": "failed", "reason": PROTOCOL_REFUSALS[model], "a0": None,
+               "delta0": None}
     elif model == "pb" and d["pz_law"] != "none":
         dim = {"status": "failed", "reason": PROCESS_ZONE_REFUSALS["pb"].format(**d),
                "a0": d["a0"], "delta0": d["delta0"]}
