@@ -37,6 +37,7 @@ help:
 	@echo "make calibrate-pz-demo - fit a process zone to synthetic PDMS data, bulk from DMA (results/calibrate/pdms-pz/, ~1 min)"
 	@echo "make model-errors - crack-front model and PB estimate vs the BEM over mu (the table auto reads)"
 	@echo "make pz-check - the BEM's process zone vs the crack-front model, and its cost (results/process_zone/)"
+	@echo "make protocol-cost - a protocol scene's wall time against its relaxed start (results/protocol/)"
 	@echo "make pz-map - the process zone's map from crack speed to opening rate (the table the BEM reads, ~1 min)"
 	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem (results/random/)"
 	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
@@ -209,6 +210,11 @@ pz-map: $(STAMP)
 .PHONY: pz-check
 pz-check: $(STAMP)
 	$(BIN)/python -m sweep.bench.process_zone_check
+
+# issue 36: what the test as run costs against its relaxed start
+.PHONY: protocol-cost
+protocol-cost: $(STAMP)
+	$(BIN)/python -m sweep.bench.protocol_cost
 
 .PHONY: calibrate-pz-demo
 calibrate-pz-demo: $(STAMP)

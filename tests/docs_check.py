@@ -460,13 +460,15 @@ def plan(page: str, quick: bool) -> list[Step]:
 
 
 def workdir(base: Path) -> Path:
-    """A working directory like a fresh checkout: tracked configs/ and results/, the Makefile
-    and the files its venv stamp depends on (their times kept), ``.venv`` linked."""
+    """A working directory like a fresh checkout: tracked configs/, results/ and the sample
+    Prony tables of tests/data/prony/ (the pages' table configs read them), the Makefile and
+    the files its venv stamp depends on (their times kept), ``.venv`` linked."""
+    dirs = ("configs", "results", "tests/data/prony")
     try:
-        tracked = subprocess.run(["git", "ls-files", "configs", "results"], cwd=ROOT,
+        tracked = subprocess.run(["git", "ls-files", *dirs], cwd=ROOT,
                                  capture_output=True, text=True, check=True).stdout.split()
     except (OSError, subprocess.CalledProcessError):
-        tracked = [str(p.relative_to(ROOT)) for d in ("configs", "results")
+        tracked = [str(p.relative_to(ROOT)) for d in dirs
                    for p in (ROOT / d).rglob("*") if p.is_file()]
     for rel in tracked + ["Makefile", "pyproject.toml", "constraints.txt"]:
         dst = base / rel

@@ -334,9 +334,13 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused(f"mesh too coarse: the tip zone {zone_length:.3g} a_ref spans {zone:.2g} "
                       f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
     if mesh.nodes > numerics.max_nodes:
-        other = ("the tip-following mesh carries no process zone: use model crack" if
-                 scene.pz_law != "none" else "or run it on the tip-following mesh "
-                 "(sweep.engine.tip_following; model bem does so)")
+        if protocol:
+            other = "a test protocol runs on this mesh only (its crack band starts at r = 0)"
+        elif scene.pz_law != "none":
+            other = "the tip-following mesh carries no process zone: use model crack"
+        else:
+            other = ("or run it on the tip-following mesh (sweep.engine.tip_following; model "
+                     "bem does so)")
         raise Refused(f"mesh too large: the crack band needs {mesh.nodes} nodes at "
                       f"band_resolution {numerics.band_resolution:g} (> max_nodes = "
                       f"{numerics.max_nodes}); raise max_nodes or lower band_resolution; {other}")

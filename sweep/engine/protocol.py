@@ -31,7 +31,7 @@ import numpy as np
 
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
-from ..kernels.solve import invalidate, load, new_jacobian_cache, newton, relax
+from ..kernels.solve import invalidate, load, new_jacobian_cache, newton, predict, relax
 from ..theory import jkr_contact_radius
 from ..scene import Protocol
 from . import budget
@@ -73,6 +73,8 @@ class _March:
         lj_traction(h, pb.h0, pb.c, self.sigma)
         self.q = np.repeat(self.sigma[None, :], M, axis=0)   # a step applied at t = 0
         self.h_prev, self.dt_prev = h.copy(), 0.0
+        self.h_prev2, self.dt_prev2 = h.copy(), 0.0
+        self.hold_slope = None      # dP/d delta of the last step held at force
         self.law = lennard_jones(pb.h0, pb.c, N)
         self.cache, self.stats = new_jacobian_cache(N), stats
         self.records = {k: [] for k in ("t", "delta", "P", "a", "a_inner", "phase")}
@@ -92,7 +94,7 @@ class _March:
 
     def solve(self, delta, dt, fold=False):
         """The state after a step to ``delta`` over ``dt`` (not accepted): (ok, h, sigma,
-        P, e, b), Newton from the linear extrapolation of the last two states; where that
+        P, e, b), Newton from the quadratic extrapolation of the last three states; where that
         fails and ``fold``, the stable state the pseudo-transient relaxation reaches from the
         last one (a dense factorization an iteration: for folds only)."""
         pb = self.pb
@@ -101,8 +103,8 @@ class _March:
         ceff = step_coefficients(pb.prony_weights, pb.prony_times, dt, e, b)
         history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
         g = -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
-        s = dt / self.dt_prev if self.dt_prev > 0 else 0.0
-        h = np.maximum(self.h + s * (self.h - self.h_prev), 0.3 * self.h)
+        h = np.empty(N)        # the kernel's predictor: quadratic through the last three
+        predict(self.h, self.h_prev, self.h_prev2, dt, self.dt_prev, self.dt_prev2, h)
         ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, MAX_ITER,
                     self.cache, self.stats)
         if not ok:
@@ -128,8 +130,9 @@ class _March:
     def accept(self, delta, dt, solved, phase):
         _, h, sig, _, e, b = solved
         update_modes(e, b, self.q, sig, self.sigma)
-        self.h_prev, self.h, self.sigma = self.h, h, sig
-        self.delta, self.t, self.dt_prev = float(delta), self.t + dt, dt
+        self.h_prev2, self.h_prev, self.h, self.sigma = self.h_prev, self.h, h, sig
+        self.dt_prev2, self.dt_prev = self.dt_prev, dt
+        self.delta, self.t = float(delta), self.t + dt
         self._record(phase)
 
 
@@ -211,10 +214,14 @@ def _dwell(m: _March, protocol: Protocol) -> None:
 
 def _held_step(m: _March, force: float, dt, fold=False):
     """The indentation at which the step ``dt`` ends at the load ``force``: secant from the
-    last indentation, the slope first from a step of 1e-3 h0 (``fold``: :meth:`_March.solve`)."""
+    last indentation, the first slope the last held step's (else from a step of 1e-3 h0;
+    ``fold``: :meth:`_March.solve`)."""
     d0 = m.delta
     s0 = m.solve(d0, dt, fold)
-    d1 = d0 + 1e-3 * m.pb.h0
+    if m.hold_slope is not None and s0[0]:      # the last held step's slope: one solve less
+        d1 = d0 + (force - s0[3]) / m.hold_slope
+    else:
+        d1 = d0 + 1e-3 * m.pb.h0
     s1 = m.solve(d1, dt, fold)
     best = (abs(s0[3] - force), d0, s0)
     for _ in range(HOLD_ITER):
@@ -224,6 +231,7 @@ def _held_step(m: _March, force: float, dt, fold=False):
         if best[0] <= HOLD_RTOL * force:
             break
         slope = (s1[3] - s0[3]) / (d1 - d0)
+        m.hold_slope = slope if slope > 0.0 else m.hold_slope
         step = (force - s1[3]) / slope if slope != 0.0 else 0.0
         if d1 + step == d1:              # as close as the indentation's rounding allows
             break
