@@ -15,19 +15,18 @@ stdout.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ..campaign.store import provenance, to_jsonable
+from ..campaign.store import provenance
 from ..engine import bem
 from ..engine.models import simulate
 from ..engine.process_zone import opening_rate_scale
 from ..scene import Numerics, Scene
+from . import measurement_main
 
 MU, A0 = 5.0, 1.5
 PZ = dict(pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5)
@@ -85,16 +84,7 @@ def measure() -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m sweep.bench.process_zone_check",
-                                 description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(OUT), help="where to write the results (JSON)")
-    args = ap.parse_args(argv)
-    data = measure()
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(to_jsonable(data), indent=1) + "\n", encoding="utf-8")
-    print(f"wrote {out}")
-    return 0
+    return measurement_main("python -m sweep.bench.process_zone_check", __doc__, measure, OUT, argv)
 
 
 if __name__ == "__main__":

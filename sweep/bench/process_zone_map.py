@@ -13,8 +13,6 @@ stated per mu.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 import time
 
@@ -23,6 +21,7 @@ import numpy as np
 from ..campaign.store import provenance
 from ..engine.process_zone import MAP, slope_scale
 from ..engine.quasistatic import ElasticBranch
+from . import measurement_main
 
 #: Tabor parameters of the table (the BEM's range, log-spaced; beta ~ mu beyond it)
 MUS = (0.5, 1.0, 2.0, 3.24, 5.0, 7.0, 10.0, 15.0, 20.0, 30.0, 50.0, 100.0)
@@ -69,16 +68,8 @@ def measure() -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m sweep.bench.process_zone_map",
-                                 description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(MAP), help="where to write the table (JSON)")
-    args = ap.parse_args(argv)
-    table = measure()
-    with open(args.out, "w", encoding="utf-8") as f:
-        json.dump(table, f, indent=1)
-        f.write("\n")
-    print(f"wrote {args.out}")
-    return 0
+    return measurement_main("python -m sweep.bench.process_zone_map", __doc__, measure, MAP,
+                            argv)
 
 
 if __name__ == "__main__":

@@ -11,17 +11,16 @@ contact), in one process, the kernels compiled first, each scene run once untime
 """
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ..campaign.store import provenance, to_jsonable
+from ..campaign.store import provenance
 from ..engine import bem
 from ..scene import Numerics, Scene
+from . import measurement_main
 
 #: (name, scene fields) of the protocol scenes
 SCENES = (
@@ -74,16 +73,7 @@ def measure() -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m sweep.bench.protocol_cost",
-                                 description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(OUT), help="where to write the results (JSON)")
-    args = ap.parse_args(argv)
-    data = measure()
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(to_jsonable(data), indent=1) + "\n", encoding="utf-8")
-    print(f"wrote {out}")
-    return 0
+    return measurement_main("python -m sweep.bench.protocol_cost", __doc__, measure, OUT, argv)
 
 
 if __name__ == "__main__":
