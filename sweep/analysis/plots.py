@@ -402,27 +402,41 @@ def _reference_lines(axes: list, frames: list, handles: dict) -> None:
 
 def _trajectories(fig, ok, lay: PlotLayout, colour_of: dict, trajectory, handles: dict):
     """P(a) of every ok scene on one panel of ``fig`` (a subfigure): the colour of its line
-    on the pull-off panels, darker for faster unloading; the relaxed JKR curve dashed."""
+    on the pull-off panels, darker for faster unloading; the relaxed JKR curve dashed. Scenes
+    with a test protocol (a ``phase`` in their trajectory) draw their load cycle P(delta)
+    instead: approach and dwell dotted, retraction solid."""
     ax = fig.subplots()
     rates = np.log10(ok["rate"].astype(float))
     span = float(rates.max() - rates.min())
+    cycles = False
     for _, row in ok.sort_values("rate").iterrows():
         tr = trajectory(str(row["scene_id"]))
         key = row[lay.colour] if lay.colour else None
         shade = 0.35 + 0.65 * (math.log10(float(row["rate"])) - float(rates.min())) / span \
             if span > 0 else 1.0              # one rate: every line at full strength
-        ax.plot(tr["a"], tr["P"], lw=1, alpha=shade,
-                color=colour_of[str(None if _missing(key) else key)])
-    a = np.linspace(0.5, float(ok["a0_result"].max()), 200)
-    ax.plot(a, jkr_load(a), color="black", ls="--", lw=1.0)
-    ax.set_xlabel(r"contact radius $\hat a$", fontsize=8)
+        colour = colour_of[str(None if _missing(key) else key)]
+        if "phase" in tr:                     # the load cycle of a test protocol
+            cycles = True
+            back = np.asarray(tr["phase"]) == 2
+            ax.plot(tr["delta"][~back], tr["P"][~back], lw=1, ls=":", alpha=shade,
+                    color=colour)
+            ax.plot(tr["delta"][back], tr["P"][back], lw=1, alpha=shade, color=colour)
+        else:
+            ax.plot(tr["a"], tr["P"], lw=1, alpha=shade, color=colour)
+    if cycles:
+        ax.set_xlabel(r"indentation $\hat\delta$", fontsize=8)
+        ax.set_title("load cycles P(delta); dotted: approach, dwell", fontsize=8)
+    else:
+        a = np.linspace(0.5, float(ok["a0_result"].max()), 200)
+        ax.plot(a, jkr_load(a), color="black", ls="--", lw=1.0)
+        ax.set_xlabel(r"contact radius $\hat a$", fontsize=8)
+        ax.set_title("trajectories P(a)" + ("; darker: faster unloading" if span > 0 else ""),
+                     fontsize=8)
     ax.set_ylabel(r"load $\hat P$ ($\pi\Delta\gamma_0 R$)", fontsize=8)
-    ax.set_title("trajectories P(a)" + ("; darker: faster unloading" if span > 0 else ""),
-                 fontsize=8)
     ax.tick_params(labelsize=7)
     jkr = f"JKR relaxed pull-off, {JKR_PULL_OFF:g}"      # one entry for both dashed lines
-    merged = {(f"JKR relaxed: pull-off {JKR_PULL_OFF:g}, P(a)" if k == jkr else k): h
-              for k, h in handles.items()}
+    merged = {(f"JKR relaxed: pull-off {JKR_PULL_OFF:g}, P(a)" if k == jkr and not cycles
+               else k): h for k, h in handles.items()}
     handles.clear()
     handles.update(merged)
 

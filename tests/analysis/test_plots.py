@@ -198,3 +198,29 @@ def test_an_older_results_file_plots(tmp_path):
         warnings.simplefilter("error")
         png = plot_sweep(v1, tmp_path / "v1.png")
     assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_protocol_campaign_draws_its_load_cycles(tmp_path):
+    """Scenes with a test protocol (issue 36): the trajectory panel draws P(delta), the
+    approach and the dwell dotted, the retraction solid, every phase of every scene."""
+    from sweep.scene import Numerics
+
+    out = tmp_path / "cycles.h5"
+    run_sweep({"name": "cycles", "output": str(out), "store": {"trajectories": True},
+               "grid": {"material": "sls", "n": 0.5, "k": 0.1, "mu": 5, "preload": 1.0,
+                        "dwell": 1.0, "approach_rate": 1.0, "rate": [0.1, 10.0]},
+               "numerics": {"preset": "fast"}}, jobs=1, progress="none")
+    df = load(out)
+    assert (df.status == "ok").all() and len(df) == 2
+    ok = df[df.status == "ok"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = sweep_figure(ok, "cycles", lambda sid: load_trajectory(out, sid))
+    (cycles,) = {ax for ax in all_axes(fig) if ax.get_xlabel().startswith("indentation")}
+    lines = cycles.get_lines()
+    assert len(lines) == 4                                  # two phases' lines a scene
+    assert sorted(ln.get_linestyle() for ln in lines) == ["-", "-", ":", ":"]
+    traj = load_trajectory(out, str(ok.scene_id.iloc[0]))
+    drawn = sum(len(ln.get_xdata()) for ln in lines[:2])
+    assert drawn == len(traj["P"])                          # every record, every phase
+    pyplot().close(fig)
