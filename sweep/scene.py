@@ -312,8 +312,8 @@ class Scene:
         Gamma_pz(v) = dg (1 + (v/pz_v0)^pz_xi) at an opening crack speed v > 0 and dg at
         v <= 0. The crack-front model multiplies it with the bulk's Persson-Brener factor
         (:mod:`sweep.engine.crack_front`); the BEM runs it as a local law on the opening
-        rate (:mod:`sweep.engine.process_zone`); the pb estimate refuses it, "auto" sends it
-        to the crack-front model.
+        rate (:mod:`sweep.engine.process_zone`); the pb estimate refuses it, "auto" runs the
+        crack-front model and the BEM where that row's error misses ``pull_off_rtol``.
     pz_v0 : float, optional
         Crack speed at which the process zone doubles the work of adhesion, in a_ref/tau0
         (the crack-speed unit of docs/design.md section 2), > 0; given exactly when

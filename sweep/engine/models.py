@@ -20,7 +20,9 @@ elastic  the quasi-static elastic branch (:func:`sweep.engine.quasistatic.simula
          hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100; "bem" and
          "auto" scenes that are elastic and quasi-static run it (:func:`wants_quasistatic`)
 auto     the cheapest model whose error meets ``numerics.pull_off_rtol`` (:func:`model_choice`):
-         the crack-front model for a scene with a process zone; the elastic branch for
+         the BEM for a test protocol; the crack-front model first for a scene with a
+         process zone (the BEM where its error, the process zone's term included, misses
+         the tolerance); the elastic branch for
          elastic quasi-static scenes; the PB estimate or the crack-front model where their
          error against the BEM, measured over a random sample (:func:`measured_error`,
          ``make model-errors``), fits; else the BEM (graded or
@@ -290,8 +292,9 @@ def _accepts(model: str, scene) -> bool:
 
 
 def model_choice(scene, numerics=None) -> Choice:
-    """The model "auto" runs first for ``scene``: the crack-front model for a scene with a
-    process zone (``pz_law``; the other models refuse it); the quasi-static elastic branch
+    """The model "auto" runs first for ``scene``: the BEM for a test protocol (the one model
+    that runs one); the crack-front model for a scene with a process zone (``pz_law``; the
+    elastic branch and pb refuse it); the quasi-static elastic branch
     for an elastic quasi-static scene; beyond the BEM's Tabor range the crack-front model, its
     mu -> infinity limit; else the cheapest model (:data:`BY_COST`) whose
     :func:`measured_error` at the smallest amplification meets ``numerics.pull_off_rtol``,
@@ -303,7 +306,8 @@ def model_choice(scene, numerics=None) -> Choice:
                              "retract)")
     if scene.pz_law != "none":
         return Choice("crack", f"auto: crack-front model with the process zone (pz_law "
-                               f"{scene.pz_law}; model bem runs its local law)")
+                               f"{scene.pz_law}), the BEM's local law where its error "
+                               f"exceeds pull_off_rtol")
     bem_ok = _accepts("bem", scene)
     if wants_quasistatic(scene, numerics) and bem_ok:
         return Choice("elastic", "auto: k = 1, quasi-static: the elastic branch")
@@ -455,7 +459,7 @@ def _simulate_model(scene, model: str, numerics) -> Result:
 
     res = run(choice.model)
     if model == "auto" and choice.model in ("crack", "pb") and scene.mu <= BEM_MU_RANGE[1] \
-            and scene.pz_law == "none" and not res.error_estimate <= numerics.pull_off_rtol:
+            and not res.error_estimate <= numerics.pull_off_rtol:
         miss = (f"auto: BEM: the {NAMES[choice.model]}'s measured error at its amplification "
                 f"{amplification(res.pull_off):.3g}, {res.error_estimate:.2g}, exceeds "
                 f"pull_off_rtol {numerics.pull_off_rtol:g}" if res.ok else

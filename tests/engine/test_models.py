@@ -204,16 +204,25 @@ PZ = dict(pz_law="gent-schultz", pz_v0=0.1, pz_xi=0.4154)
 @pytest.mark.parametrize("k", [1.0, 0.1])
 def test_a_process_zone_runs_the_crack_front_model_and_the_others_refuse_it(k):
     sc = dict(n=0.8, k=k, mu=3.24, a0=3.0, rate=10.0, **PZ)
-    # auto: the crack-front model, never the elastic branch (k = 1)
+    # auto: the crack-front model first, never the elastic branch (k = 1); the BEM where the
+    # crack-front row's error (the process zone's term included) misses pull_off_rtol
     choice = models.model_choice(Scene(**sc, model="auto"))
     assert choice.model == "crack" and "process zone" in choice.reason
     assert not models.wants_quasistatic(Scene(**sc), Numerics.preset("balanced"))
     res = models.simulate(Scene(**sc, model="auto"))
-    assert res.ok and res.model_used == "crack"
-    direct = simulate_crack(Scene(**sc, model="crack"))
-    assert res.pull_off == direct.pull_off
+    crack = models.simulate(Scene(**sc, model="crack"))
+    assert crack.ok and crack.pull_off == simulate_crack(Scene(**sc, model="crack")).pull_off
+    assert crack.error_estimate > Numerics.preset("balanced").pull_off_rtol   # a large term
+    if k < 1.0:
+        assert res.ok and res.model_used == "bem" and "exceeds pull_off_rtol" in res.model_reason
+    else:   # an elastic bulk whose process zone multiplies the tension by ~2.7 at the first
+        # step: the BEM's first step finds no equilibrium (a known limit, docs/design.md);
+        # auto falls back to the crack-front row, its error stated
+        assert res.ok and res.model_used == "crack" and "the BEM failed" in res.model_reason
+        assert "above pull_off_rtol" in res.model_reason
     # the process zone raises the pull-off above the same scene without one
-    plain = models.simulate(Scene(n=0.8, k=k, mu=3.24, a0=3.0, rate=10.0, model="crack"))
+    plain = models.simulate(Scene(n=0.8, k=k, mu=3.24, a0=3.0, rate=10.0,
+                                  model=res.model_used))
     assert res.pull_off > plain.pull_off
     for model, words in (("elastic", "the elastic branch is quasi-static"),
                          ("pb", "the pb estimate's v-r fit was measured without")):
