@@ -43,7 +43,6 @@ from functools import lru_cache
 from pathlib import Path
 from typing import NamedTuple
 
-import numpy as np
 
 from .. import units
 from ..errors import (NUMERICAL_ERRORS, check_choice, check_positive, is_internal_error,
