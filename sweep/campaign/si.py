@@ -247,20 +247,33 @@ class SIScene:
 
     @classmethod
     def from_dimensionless(cls, *, n, k, mu, rate, R, E0, nu, tau0, dg, a0=None, delta0=None,
-                           material="mpl") -> "SIScene":
+                           material="mpl", pz_law="none", pz_v0=None, pz_xi=None,
+                           approach_rate=None, preload=None, dwell=None,
+                           dwell_hold="force") -> "SIScene":
         """The SI scene of a dimensionless one for a chosen sphere and material.
 
         ``h0`` follows from ``mu`` (``mu^3 = R dg^2 / (E0*^2 h0^3)``), the speed from ``rate``,
-        the initial state from ``a0`` (-> contact radius [m]) or ``delta0`` (-> indentation).
+        the initial state from ``a0`` (-> contact radius [m]) or ``delta0`` (-> indentation);
+        a process zone's ``pz_v0`` (a_ref/tau0 -> m/s); a test protocol's ``approach_rate``
+        (-> ``approach_speed`` [m/s]), ``preload`` (pi dg R -> N) and ``dwell`` (tau0 -> s)
+        instead of ``a0`` and ``delta0``.
         """
         E0s = check_positive("E0", E0) / (1.0 - check_range("nu", nu, 0.0, 0.5) ** 2)
         h0 = (check_positive("R", R) * check_positive("dg", dg) ** 2 / E0s**2) ** (1.0 / 3.0) \
             / check_positive("mu", mu)
         sc = PhysicalScale(R=R, dg=dg, E0_star=E0s, h0=h0)
-        kw = {}
-        if (a0 is None) == (delta0 is None):
+        kw = {"pz_law": pz_law, "pz_xi": pz_xi, "dwell_hold": dwell_hold}
+        if pz_v0 is not None:
+            kw["pz_v0"] = float(sc.crack_speed_physical(pz_v0, tau0))
+        if dwell is not None or approach_rate is not None:
+            if a0 is not None or delta0 is not None or None in (approach_rate, preload, dwell):
+                raise InputError("approach_rate/preload/dwell: a protocol gives all three, and "
+                                 "neither a0 nor delta0")
+            kw.update(approach_speed=float(sc.rate_physical(approach_rate, tau0)),
+                      preload=float(sc.load_physical(preload)), dwell=float(dwell) * tau0)
+        elif (a0 is None) == (delta0 is None):
             raise InputError("a0/delta0: give exactly one of a0 and delta0")
-        if a0 is not None:
+        elif a0 is not None:
             kw["a0"] = float(sc.radius_physical(a0))
         else:
             kw["indentation"] = float(sc.normal_physical(delta0))

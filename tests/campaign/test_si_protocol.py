@@ -73,3 +73,21 @@ def test_a_prony_table_config_with_a_60_s_dwell_runs_and_info_si_shows_it(tmp_pa
     assert all(r[4].startswith("prony:pdms_prony:") for r in rows)
     pull_off_mN = [float(r[lines[0].split().index("pull_off[mN]")]) for r in rows]
     assert pull_off_mN[1] > pull_off_mN[0] > 0          # faster retraction, larger pull-off
+
+
+def test_a_dimensionless_scene_with_a_process_zone_and_a_protocol_goes_to_si_and_back():
+    """SIScene.from_dimensionless and SIScene.dimensionless are inverse: n, k, mu, rate, the
+    process zone's pz_v0 and the protocol's approach_rate, preload and dwell come back."""
+    dimless = dict(n=0.5, k=0.2, mu=5.0, rate=3.0, pz_law="gent-schultz", pz_v0=0.7,
+                   pz_xi=0.45, approach_rate=0.2, preload=2.5, dwell=40.0, dwell_hold="depth")
+    si = SIScene.from_dimensionless(**dimless, R=1e-4, E0=1e6, nu=0.5, tau0=0.01, dg=0.05)
+    back = si.dimensionless()
+    for key, value in dimless.items():
+        if isinstance(value, str):
+            assert back[key] == value, key
+        else:
+            assert back[key] == pytest.approx(value, rel=1e-12), key
+    assert back["a0"] is None and back["delta0"] is None
+    with pytest.raises(InputError, match="a protocol gives all three"):
+        SIScene.from_dimensionless(n=0.5, k=0.2, mu=5.0, rate=3.0, R=1e-4, E0=1e6, nu=0.5,
+                                   tau0=0.01, dg=0.05, a0=2.0, dwell=1.0)
