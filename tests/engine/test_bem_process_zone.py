@@ -44,10 +44,11 @@ def test_a_huge_v0_is_no_process_zone():
     plain = simulate(Scene(**sc))
     far = simulate(Scene(**sc, pz_law="gent-schultz", pz_v0=1e12, pz_xi=XI))
     assert plain.ok and far.ok
-    # the same steps and states to Newton's tolerance (1e-10 h0): the first step starts from
-    # another gap (the rigid opening) and converges to the same one (measured 1.4e-9)
-    assert far.pull_off == pytest.approx(plain.pull_off, rel=1e-8)
-    assert far.steps == plain.steps
+    # the same states to Newton's tolerance (1e-10 h0): the first step starts from another gap
+    # (the rigid opening) and converges to the same one (measured 1.4e-9, the same steps);
+    # compared to the committed results' engine check tolerance, 1e-5, so that a step-control
+    # decision another processor takes the other way cannot fail it
+    assert far.pull_off == pytest.approx(plain.pull_off, rel=1e-5)
 
 
 @pytest.mark.parametrize("rate", sorted(ELASTIC_RTOL))

@@ -31,7 +31,8 @@ def test_the_tabulated_map_is_what_the_code_measures():
     i = data["mu"].index(5.0)
     r, h = profile(5.0)
     for j in (XIS.index(0.3), XIS.index(1.0)):
-        assert pz.slope_scale(r, h, 5.0, XIS[j]) == pytest.approx(data["beta"][i][j], rel=1e-9)
+        # the profile is solved to 1e-10 h0: another processor moves beta in its ninth digit
+        assert pz.slope_scale(r, h, 5.0, XIS[j]) == pytest.approx(data["beta"][i][j], rel=1e-6)
         assert pz.opening_rate_scale(5.0, XIS[j]) == pytest.approx(data["beta"][i][j], rel=1e-12)
     # beyond the table beta grows as mu (the JKR limit)
     top = data["mu"][-1]
