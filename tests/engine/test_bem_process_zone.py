@@ -121,5 +121,6 @@ def test_the_committed_check_is_what_main_computes():
     assert CHECK_PZ == PZ
     with_pz, _ = _run("bem", CASES[0][1], 1.0, True)
     crack, _ = _run("crack", CASES[0][1], 1.0, True)
-    assert with_pz.pull_off == pytest.approx(row["bem_pz_pull_off"], rel=1e-6)
-    assert crack.pull_off == pytest.approx(row["crack_pz_pull_off"], rel=1e-6)
+    # the committed results' engine check tolerance (sweep.paper.engine_check: 1e-5)
+    assert with_pz.pull_off == pytest.approx(row["bem_pz_pull_off"], rel=1e-5)
+    assert crack.pull_off == pytest.approx(row["crack_pz_pull_off"], rel=1e-5)
