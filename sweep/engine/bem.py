@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..kernels.solve import (STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND, STATUS_STEP_LIMIT,
-                             MeshArrays, Physics, Records, RunState, StepControl, invalidate,
-                             unload)
+from ..kernels.solve import (N_STATS, STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND,
+                             STATUS_STEP_LIMIT, MeshArrays, Physics, Records, RunState,
+                             StepControl, invalidate, unload)
 from ..errors import NUMERICAL_ERRORS, is_internal_error
 from ..kernels.interface import lj_traction
 from ..scene import Numerics, Result, Scene
@@ -198,9 +198,9 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
     res.spacing, res.domain_used, res.nodes_used = dr, mesh.domain, mesh.nodes
     res.prony_terms, res.prony_error = int(pb.prony_weights.size), pb.prony_error
 
-    el = ElasticSolver(pb.A, r, pb.h0, pb.c, numerics.tol)
     if scene.protocol() is not None:
-        return _simulate_protocol(pb, res, el, deadline)
+        return _simulate_protocol(pb, res, deadline)
+    el = ElasticSolver(pb.A, r, pb.h0, pb.c, numerics.tol)
     try:
         h_init, delta0 = relaxed_state(el, delta0=scene.delta0, a0=scene.a0,
                                        mesh_key=(mesh.key, mesh.spacing))
@@ -267,14 +267,15 @@ def _finish(pb: Problem, res: Result, status: int, stats) -> str | None:
     return None
 
 
-def _simulate_protocol(pb: Problem, res: Result, el: ElasticSolver, deadline: float):
+def _simulate_protocol(pb: Problem, res: Result, deadline: float):
     """A scene with a test protocol (:mod:`sweep.engine.protocol`): approach and dwell, then
     the unloading kernel from the dwell's last state, its modes and its records. The row's
     initial state (``a0_result``, ``delta0_result``, ``a0_inner``) is the dwell's last, the
     retraction's start; ``hysteresis_energy`` the work of the whole path; the trajectory's
     ``phase`` says which phase made each record."""
+    stats = np.zeros(N_STATS, dtype=np.int64)
     try:
-        march = run_phases(pb, pb.scene.protocol(), el)
+        march = run_phases(pb, pb.scene.protocol(), stats)
     except OverBudget:
         raise
     except RuntimeError as exc:
@@ -290,7 +291,6 @@ def _simulate_protocol(pb: Problem, res: Result, el: ElasticSolver, deadline: fl
     # the retraction's records follow the march's: room for both
     pb = dataclasses.replace(pb, numerics=dataclasses.replace(
         pb.numerics, max_steps=pb.numerics.max_steps + n0))
-    stats = el.stats.copy()
     invalidate(march.cache)
     run = UnloadingState.start(pb, march.h, march.delta, march.cache, stats)
     for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):

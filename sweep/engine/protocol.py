@@ -264,11 +264,12 @@ def first_contact(pb, stats):
     return h, float(delta)
 
 
-def run_phases(pb, protocol: Protocol, el):
-    """Approach and dwell on the prepared problem ``pb`` (``el`` its elastic solver, for the
-    start): the march (:class:`_March`) whose state and records the retraction continues."""
-    h, delta = first_contact(pb, el.stats)
-    m = _March(pb, h, delta, el.stats)
+def run_phases(pb, protocol: Protocol, stats):
+    """Approach and dwell on the prepared problem ``pb``, the solver's counters into
+    ``stats`` (:data:`sweep.kernels.solve.N_STATS`): the march (:class:`_March`) whose state
+    and records the retraction continues."""
+    h, delta = first_contact(pb, stats)
+    m = _March(pb, h, delta, stats)
     _approach(m, protocol)
     _dwell(m, protocol)
     return m
