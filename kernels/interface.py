@@ -72,8 +72,11 @@ ZONE_XI = 1
 ZONE_SMOOTH = 2
 ZONE_SIZE = 3
 #: the process zone's term m - 1 below which its law is smoothed: q_s = ZONE_SMOOTH_TERM^(1/xi)
-#: (:func:`zone_factor`); above it the law is the power law exactly
-ZONE_SMOOTH_TERM = 1e-2
+#: (:func:`zone_factor`); above it the law is the power law exactly. 0.03, not 1e-2: the
+#: cubic's slope near q = 0, about q_s^(xi - 1), stalled Newton where a node opened slowly;
+#: not 0.1: that moved a weak process zone's pull-off by 1.3 % (docs/design.md, "The
+#: process zone in the BEM")
+ZONE_SMOOTH_TERM = 3e-2
 
 
 @njit(cache=True)

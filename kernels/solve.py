@@ -233,6 +233,12 @@ REJECT_TARGET = 0.8
 #: SMOOTH_DA_FRACTION da_max per step
 SMOOTH_STEP_FACTOR = 8.0
 SMOOTH_DA_FRACTION = 0.6
+#: a process zone's first step may take this many times max_iter Newton iterations: its factor
+#: jumps from 1 at rest to 1 + (rate h0/hdot_c)^xi at once, and Newton converges slowly but
+#: surely there (25-34 iterations on n 0.4, k 0.1, mu 3.24, delta0 4.95, rate 10^0.5, pz_v0 the
+#: crack speed; with max_iter alone that scene failed at the minimum step, and the rate-100
+#: scene of ``make pz-check`` halved its first step three times and refactorized 107 times)
+FIRST_ZONE_ITER = 4
 #: the predictor never puts a gap below this fraction of the last accepted one
 PREDICT_FLOOR = 0.5
 #: the tip predictor (:func:`predict_lattice`) looks this many accepted states back for the
@@ -839,13 +845,16 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     A, h0, hp = mesh.A, physics.h0, work.hp
     law = Interface(h0, physics.c, work.ref, work.zone)
     ceff, tol = run[RUN_CEFF], control.tol * h0
-    ok = newton(hp, work.g, A, ceff, work.H, law, tol, control.max_iter, cache, stats)
+    max_iter = control.max_iter
+    if not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0:
+        max_iter *= FIRST_ZONE_ITER
+    ok = newton(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats)
     if not ok and cubic:
         # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
         # cubic start can overshoot: again from the quadratic one before the step halves
         stats[STAT_FAILED_SOLVES] += 1
         _copy(work.h_pred, hp)
-        ok = newton(hp, work.g, A, ceff, work.H, law, tol, control.max_iter, cache, stats)
+        ok = newton(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats)
     if ok:
         return SOLVED
     stats[STAT_FAILED_SOLVES] += 1

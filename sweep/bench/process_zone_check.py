@@ -8,13 +8,20 @@ elastic branch ``model: bem`` would pick without a process zone) and from the cr
 model, their amplifications P(pz)/P(none), and the BEM's wall time with the process zone
 over the same scene's without it: one process, the kernels compiled first, each scene run
 once before it is timed (the relaxed start is cached per mesh: the first of the pair would
-pay for both), then the two timed in alternation, :data:`REPEATS` times each, the median. Written to ``results/process_zone/check.json`` with a table on
-stdout.
+pay for both), then the two timed in alternation, :data:`REPEATS` times each, the median.
+
+The cost the issue bounds is measured on the bench scenes (``make bench``'s vs-numpy and
+trade-off scenes, :func:`bench_cost`): each LJ scene, then the same scene with the
+Gent-Schultz process zone whose pz_v0 is :data:`BENCH_SPEED_MULTIPLES` times the LJ scene's
+crack speed at pull-off (1: the zone doubles the work of adhesion at the crack's own speed,
+a strong one; 10: a moderate one), timed in the same way. Written to
+``results/process_zone/check.json`` with a table on stdout.
 
 ``python -m sweep.bench.process_zone_check [--out PATH]``
 """
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 from pathlib import Path
@@ -27,6 +34,7 @@ from ..engine.models import simulate
 from ..engine.process_zone import opening_rate_scale
 from ..scene import Numerics, Scene
 from . import measurement_main
+from .tradeoff import TRADEOFF_SCENES, VS_NUMPY_SCENES
 
 MU, A0 = 5.0, 1.5
 PZ = dict(pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5)
@@ -37,6 +45,41 @@ CASES = (("elastic", dict(n=0.5, k=1.0), (0.1, 1.0, 10.0, 100.0)),
 OUT = Path("results") / "process_zone" / "check.json"
 #: timed runs of each scene (after the untimed first)
 REPEATS = 3
+#: the bench scenes' process zones: pz_v0 = these multiples of the LJ scene's crack speed
+BENCH_SPEED_MULTIPLES = (1.0, 10.0)
+#: the bench scenes' process-zone exponent
+BENCH_XI = 0.5
+
+
+def _wall(scene: Scene):
+    t0 = time.perf_counter()
+    res = bem.simulate(scene, Numerics.preset("balanced"))
+    return res, time.perf_counter() - t0
+
+
+def bench_cost() -> list[dict]:
+    """The BEM's wall time with a process zone over without it on the bench scenes (module
+    docstring): one row per scene and pz_v0 multiple."""
+    rows = []
+    for name, fields in {**VS_NUMPY_SCENES, **TRADEOFF_SCENES}.items():
+        plain = Scene(model="bem", **fields)
+        lj, _ = _wall(plain)
+        for multiple in BENCH_SPEED_MULTIPLES:
+            scene = dataclasses.replace(plain, pz_law="gent-schultz", pz_xi=BENCH_XI,
+                                        pz_v0=float(multiple * lj.crack_speed))
+            res, _ = _wall(scene)
+            timed = [(_wall(scene)[1], _wall(plain)[1]) for _ in range(REPEATS)]
+            w_pz, w = (float(np.median(x)) for x in zip(*timed))
+            row = {"scene": name, "speed_multiple": multiple, "pz_v0": scene.pz_v0,
+                   "status": res.status, "amplification": res.pull_off / lj.pull_off,
+                   "wall_s": w, "pz_wall_s": w_pz, "ratio": w_pz / w, "steps": lj.steps,
+                   "pz_steps": res.steps, "factorizations": lj.factorizations,
+                   "pz_factorizations": res.factorizations}
+            rows.append(row)
+            print(f"{name:28s} pz_v0 {multiple:g} x v: amplification {row['amplification']:.3f}"
+                  f" ({res.status}), cost {row['ratio']:.2f} ({w_pz * 1e3:.0f} / {w * 1e3:.0f} ms,"
+                  f" steps {res.steps} / {lj.steps})", flush=True)
+    return rows
 
 
 def _run(model: str, fields: dict, rate: float, pz: bool):
@@ -73,14 +116,19 @@ def measure() -> dict:
             print(f"{name:16s} rate {rate:7g}: amplification BEM {row['bem_amplification']:.4f}"
                   f" crack-front {row['crack_amplification']:.4f} ({row['difference']:+.2%}); "
                   f"BEM wall {w_pz:.2f} s with, {w:.2f} s without ({bem_pz.status})", flush=True)
-    walls = np.array([[r["bem_pz_wall_s"], r["bem_wall_s"]] for r in rows])
-    ratio = float(walls[:, 0].sum() / walls[:, 1].sum())
-    print(f"cost: the BEM with the process zone over without it, summed over the scenes: "
-          f"{ratio:.2f}")
+    bench = bench_cost()
+    ratios = {m: [r["ratio"] for r in bench if r["speed_multiple"] == m]
+              for m in BENCH_SPEED_MULTIPLES}
+    summary = {f"{m:g}": {"median": float(np.median(v)), "max": float(np.max(v))}
+               for m, v in ratios.items()}
+    for m, v in summary.items():
+        print(f"cost on the bench scenes, pz_v0 = {m} x the crack speed: median {v['median']:.2f},"
+              f" max {v['max']:.2f}")
     return {"what": "BEM vs crack-front model with a Gent-Schultz process zone; the BEM's cost",
             "command": "make pz-check", "mu": MU, "a0": A0, "process_zone": PZ,
             "beta": opening_rate_scale(MU, PZ["pz_xi"]), "rows": rows,
-            "cost_ratio": ratio, "provenance": provenance()}
+            "bench_xi": BENCH_XI, "bench_cost": bench, "bench_cost_ratio": summary,
+            "provenance": provenance()}
 
 
 def main(argv=None) -> int:
