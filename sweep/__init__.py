@@ -14,8 +14,10 @@ from importlib import import_module
 from . import threads as _threads
 from ._version import __version__
 
-# One BLAS thread per process unless the user says otherwise (see sweep.threads); before
-# numpy is imported by the modules below.
+# One BLAS thread per process unless the user says otherwise (see sweep.threads): the pools
+# loaded before sweep (scipy.linalg imported first) limited now, the others by the variables,
+# set before numpy is imported by the modules below.
+_threads.limit_preloaded()
 _threads.limit_env(_threads.BLAS_VARS)
 
 from .errors import InputError  # noqa: E402

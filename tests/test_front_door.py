@@ -27,13 +27,13 @@ SCENES = {
                                                              rate=1.0),
     "viscoelastic, mu = 15 (bem: the tip-following mesh)": Scene(n=0.8, k=0.5, mu=15.0,
                                                                  a0=1.5, rate=1.0),
-    "auto, a process zone (the crack-front model)": Scene(
-        **VISCO, model="auto", pz_law="gent-schultz", pz_v0=0.1, pz_xi=0.4154),
+    "auto, a process zone (the BEM after the crack-front model)": Scene(
+        **VISCO, model="auto", pz_law="gent-schultz", pz_v0=10.0, pz_xi=0.4154),
 }
 EXPECTED_MODEL = {"bem (graded mesh)": "bem", "crack": "crack", "pb": "pb", "auto": "bem",
                   "elastic": "elastic", "elastic, mu = 30 (bem: the quasi-static branch)":
                   "elastic", "viscoelastic, mu = 15 (bem: the tip-following mesh)": "bem",
-                  "auto, a process zone (the crack-front model)": "crack"}
+                  "auto, a process zone (the BEM after the crack-front model)": "bem"}
 
 
 #: columns that depend on what the process ran before, not on the scene: the wall time, and

@@ -198,7 +198,11 @@ def test_an_elastic_branch_failure_is_not_the_answer_of_auto():
 
 
 # -- a rate-dependent process zone (issue 35): the crack-front model and the BEM have its law --
-PZ = dict(pz_law="gent-schultz", pz_v0=0.1, pz_xi=0.4154)
+#: a zone whose crack-front row's error (0.23 at k 1, 0.48 at k 0.1) misses pull_off_rtol by
+#: far and whose BEM row's (0.002) meets it by far (pz_v0 0.1, a factor of 2.7 at the first
+#: step, put the BEM's first step at the edge of convergence: converged or not with the last
+#: digits of the BLAS, docs/design.md)
+PZ = dict(pz_law="gent-schultz", pz_v0=10.0, pz_xi=0.4154)
 
 
 @pytest.mark.parametrize("k", [1.0, 0.1])
@@ -213,13 +217,8 @@ def test_a_process_zone_runs_the_crack_front_model_and_the_others_refuse_it(k):
     crack = models.simulate(Scene(**sc, model="crack"))
     assert crack.ok and crack.pull_off == simulate_crack(Scene(**sc, model="crack")).pull_off
     assert crack.error_estimate > Numerics.preset("balanced").pull_off_rtol   # a large term
-    if k < 1.0:
-        assert res.ok and res.model_used == "bem" and "exceeds pull_off_rtol" in res.model_reason
-    else:   # an elastic bulk whose process zone multiplies the tension by ~2.7 at the first
-        # step: the BEM's row misses pull_off_rtol too (unresolved: its half-resolution
-        # pull-off differs by 0.011); auto keeps the crack-front row, its error stated
-        assert res.ok and res.model_used == "crack" and "the BEM failed" in res.model_reason
-        assert "above pull_off_rtol" in res.model_reason
+    assert res.ok and res.model_used == "bem" and "exceeds pull_off_rtol" in res.model_reason
+    assert res.error_estimate <= Numerics.preset("balanced").pull_off_rtol
     # the process zone raises the pull-off above the same scene without one
     plain = models.simulate(Scene(n=0.8, k=k, mu=3.24, a0=3.0, rate=10.0,
                                   model=res.model_used))
