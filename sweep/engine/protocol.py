@@ -92,19 +92,23 @@ class _March:
     def load(self) -> float:
         return self.records["P"][-1]
 
-    def solve(self, delta, dt, fold=False):
+    def solve(self, delta, dt, fold=False, start=None):
         """The state after a step to ``delta`` over ``dt`` (not accepted): (ok, h, sigma,
-        P, e, b), Newton from the quadratic extrapolation of the last three states; where that
-        fails and ``fold``, the stable state the pseudo-transient relaxation reaches from the
-        last one (a dense factorization an iteration: for folds only)."""
+        P, e, b), Newton from ``start`` (a gap) or else from the quadratic extrapolation of
+        the last three states; where that fails and ``fold``, the stable state the
+        pseudo-transient relaxation reaches from the last one (a dense factorization an
+        iteration: for folds only)."""
         pb = self.pb
         M, N = pb.prony_weights.size, self.h.size
         e, b, H = np.empty(M), np.empty(M), np.zeros(N)
         ceff = step_coefficients(pb.prony_weights, pb.prony_times, dt, e, b)
         history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
         g = -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
-        h = np.empty(N)        # the kernel's predictor: quadratic through the last three
-        predict(self.h, self.h_prev, self.h_prev2, dt, self.dt_prev, self.dt_prev2, h)
+        if start is not None:
+            h = start.copy()
+        else:                  # the kernel's predictor: quadratic through the last three
+            h = np.empty(N)
+            predict(self.h, self.h_prev, self.h_prev2, dt, self.dt_prev, self.dt_prev2, h)
         ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, MAX_ITER,
                     self.cache, self.stats)
         if not ok:
@@ -213,16 +217,19 @@ def _dwell(m: _March, protocol: Protocol) -> None:
 
 
 def _held_step(m: _March, force: float, dt, fold=False):
-    """The indentation at which the step ``dt`` ends at the load ``force``: secant from the
-    last indentation, the first slope the last held step's (else from a step of 1e-3 h0;
-    ``fold``: :meth:`_March.solve`)."""
-    d0 = m.delta
+    """The indentation at which the step ``dt`` ends at the load ``force``: a secant from the
+    indentation the dwell's last steps extrapolate to (:func:`_held_guess`), the first slope
+    the last held step's (else from a step of 1e-3 h0), each solve after the first
+    starting from the one before (``fold``: :meth:`_March.solve`)."""
+    d0 = _held_guess(m, dt)
     s0 = m.solve(d0, dt, fold)
+    if s0[0] and abs(s0[3] - force) <= HOLD_RTOL * force:
+        return d0, s0
     if m.hold_slope is not None and s0[0]:      # the last held step's slope: one solve less
         d1 = d0 + (force - s0[3]) / m.hold_slope
     else:
         d1 = d0 + 1e-3 * m.pb.h0
-    s1 = m.solve(d1, dt, fold)
+    s1 = _solve_near(m, d1, dt, fold, s0)
     best = (abs(s0[3] - force), d0, s0)
     for _ in range(HOLD_ITER):
         if not (s0[0] and s1[0]):
@@ -237,10 +244,38 @@ def _held_step(m: _March, force: float, dt, fold=False):
             break
         d0, s0 = d1, s1
         d1 = d1 + step
-        s1 = m.solve(d1, dt, fold)
+        s1 = _solve_near(m, d1, dt, fold, s0)
     if best[0] <= HOLD_ACCEPT * force:
         return best[1], best[2]
     raise RuntimeError(f"dwell at force: the load stayed at {best[2][3]:.8g}, not {force:.8g}")
+
+
+def _solve_near(m: _March, delta, dt, fold, near):
+    """:meth:`_March.solve` from the gap of the solved state ``near`` (the same step at a
+    nearby indentation), else from the extrapolation of the last states."""
+    if near[0]:
+        solved = m.solve(delta, dt, start=near[1])
+        if solved[0]:
+            return solved
+    return m.solve(delta, dt, fold)
+
+
+def _held_guess(m: _March, dt) -> float:
+    """The indentation the dwell at force is expected at after the step ``dt``: the
+    quadratic extrapolation in time through its last three states (the dwell's start among
+    them; linear through two, the last indentation at the dwell's first step)."""
+    t, d, phase = m.records["t"], m.records["delta"], m.records["phase"]
+    k = 1
+    while k < 3 and phase[-k] == PHASES["dwell"]:
+        k += 1
+    x, guess = t[-1] + dt, 0.0
+    for j in range(1, k + 1):
+        weight = 1.0
+        for i in range(1, k + 1):
+            if i != j:
+                weight *= (x - t[-i]) / (t[-j] - t[-i])
+        guess += weight * d[-j]
+    return guess
 
 
 def first_contact(pb, stats):
