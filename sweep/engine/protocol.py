@@ -31,7 +31,9 @@ import numpy as np
 
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
-from ..kernels.solve import invalidate, load, new_jacobian_cache, newton, predict, relax
+from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
+                             invalidate, load, new_jacobian_cache, newton, predict,
+                             predict_lattice, relax, score_starts)
 from ..theory import jkr_contact_radius
 from ..scene import Protocol
 from . import budget
@@ -64,7 +66,10 @@ RELAX_ITER = 300
 
 class _March:
     """The hereditary march of the approach and the dwell on one prepared problem: the state
-    (gap, Prony modes, traction), the records, and one step's solve."""
+    (gap, Prony modes, traction), the records, and one step's solve. Newton's start is the
+    unloading kernel's: the quadratic extrapolation, replaced near the crack tip by the tip
+    predictor's (:func:`sweep.kernels.solve.predict_lattice`, from a ring of the last
+    accepted states) where that has been the nearer of the two on the last steps."""
 
     def __init__(self, pb, h, delta, stats):
         self.pb, self.h, self.delta, self.t = pb, h, float(delta), 0.0
@@ -78,6 +83,8 @@ class _March:
         self.law = lennard_jones(pb.h0, pb.c, N)
         self.cache, self.stats = new_jacobian_cache(N), stats
         self.records = {k: [] for k in ("t", "delta", "P", "a", "a_inner", "phase")}
+        self.past, self.past_ta = np.empty((LATTICE_HISTORY, N)), np.empty((2, LATTICE_HISTORY))
+        self.past_count, self.tip_score = 0, 0.0
         self._record(0)
 
     def _record(self, phase):
@@ -87,6 +94,9 @@ class _March:
                            ("a", crossing_radius(self.h, r, pb.hm)),
                            ("a_inner", crossing_radius(self.h, r, pb.h0)), ("phase", phase)):
             self.records[key].append(value)
+        k = self.past_count % LATTICE_HISTORY       # the tip predictor's ring
+        self.past[k], self.past_ta[:, k] = self.h, (self.t, self.records["a"][-1])
+        self.past_count += 1
 
     @property
     def load(self) -> float:
@@ -94,21 +104,18 @@ class _March:
 
     def solve(self, delta, dt, fold=False, start=None):
         """The state after a step to ``delta`` over ``dt`` (not accepted): (ok, h, sigma,
-        P, e, b), Newton from ``start`` (a gap) or else from the quadratic extrapolation of
-        the last three states; where that fails and ``fold``, the stable state the
-        pseudo-transient relaxation reaches from the last one (a dense factorization an
-        iteration: for folds only)."""
+        P, e, b, starts), Newton from ``start`` (a gap) or else from the predictor
+        (:meth:`_start`; ``starts`` its two starts where the tip predictor's was made, else
+        None); where that fails and ``fold``, the stable state the pseudo-transient
+        relaxation reaches from the last one (a dense factorization an iteration: for folds
+        only)."""
         pb = self.pb
         M, N = pb.prony_weights.size, self.h.size
         e, b, H = np.empty(M), np.empty(M), np.zeros(N)
         ceff = step_coefficients(pb.prony_weights, pb.prony_times, dt, e, b)
         history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
         g = -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
-        if start is not None:
-            h = start.copy()
-        else:                  # the kernel's predictor: quadratic through the last three
-            h = np.empty(N)
-            predict(self.h, self.h_prev, self.h_prev2, dt, self.dt_prev, self.dt_prev2, h)
+        h, starts = (start.copy(), None) if start is not None else self._start(dt)
         ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, MAX_ITER,
                     self.cache, self.stats)
         if not ok:
@@ -117,7 +124,18 @@ class _March:
             h, ok = self._jump(delta, g, ceff, H)
         sig = np.empty(N)
         lj_traction(h, pb.h0, pb.c, sig)
-        return ok, h, sig, load(sig, pb.wP), e, b
+        return ok, h, sig, load(sig, pb.wP), e, b, starts
+
+    def _start(self, dt):
+        """Newton's start for the step ``dt`` and the two starts, quadratic and tip
+        predictor's (None where the tip predictor made none)."""
+        starts = np.empty((2, self.h.size))
+        predict(self.h, self.h_prev, self.h_prev2, dt, self.dt_prev, self.dt_prev2, starts[0])
+        starts[1] = starts[0]
+        if not predict_lattice(self.pb.mesh.r, self.h, self.past, self.past_ta,
+                               self.past_count, dt, starts[1]):
+            return starts[0].copy(), None
+        return starts[int(self.tip_score < LATTICE_SCORE_USE)].copy(), starts
 
     def _jump(self, delta, g, ceff, H):
         """The state across a fold of the path (the crack tip snapping along the contact):
@@ -132,8 +150,12 @@ class _March:
         return h, newton(h, g, pb.A, ceff, H, self.law, tol, MAX_ITER, self.cache, self.stats)
 
     def accept(self, delta, dt, solved, phase):
-        _, h, sig, _, e, b = solved
+        _, h, sig, _, e, b, starts = solved
         update_modes(e, b, self.q, sig, self.sigma)
+        if starts is not None:
+            a = crossing_radius(h, self.pb.mesh.r, self.pb.hm)
+            self.tip_score += LATTICE_SCORE_WEIGHT * (
+                score_starts(self.pb.mesh.r, starts, h, a) - self.tip_score)
         self.h_prev2, self.h_prev, self.h, self.sigma = self.h_prev, self.h, h, sig
         self.dt_prev2, self.dt_prev = self.dt_prev, dt
         self.delta, self.t = float(delta), self.t + dt
