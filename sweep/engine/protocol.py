@@ -57,6 +57,11 @@ HOLD_ACCEPT = 1e-5
 #: most Newton iterations of one solve, and secant iterations of a held step
 MAX_ITER = 40
 HOLD_ITER = 30
+#: most Newton iterations of an approach step that may still be halved: those of the
+#: unloading kernel's solves (``sweep.engine.bem.MAX_NEWTON_ITER``); a solve that needs more
+#: is retried with half the step (the approach's first step, from the glassy contact,
+#: took 21, 21, 40, 17 and 19 iterations on trials that were all halved)
+TRIAL_ITER = 12
 #: the approach's smallest step, as a fraction of the largest (then the fold is relaxed) ...
 MIN_STEP_FRACTION = 1.0 / 64.0
 #: ... by at most this many pseudo-transient iterations before Newton takes over, where
@@ -102,13 +107,13 @@ class _March:
     def load(self) -> float:
         return self.records["P"][-1]
 
-    def solve(self, delta, dt, fold=False, start=None):
+    def solve(self, delta, dt, fold=False, start=None, max_iter=MAX_ITER):
         """The state after a step to ``delta`` over ``dt`` (not accepted): (ok, h, sigma,
         P, e, b, starts), Newton from ``start`` (a gap) or else from the predictor
         (:meth:`_start`; ``starts`` its two starts where the tip predictor's was made, else
-        None); where that fails and ``fold``, the stable state the pseudo-transient
-        relaxation reaches from the last one (a dense factorization an iteration: for folds
-        only)."""
+        None), at most ``max_iter`` iterations; where that fails and ``fold``, the stable
+        state the pseudo-transient relaxation reaches from the last one (a dense
+        factorization an iteration: for folds only)."""
         pb = self.pb
         M, N = pb.prony_weights.size, self.h.size
         e, b, H = np.empty(M), np.empty(M), np.zeros(N)
@@ -116,7 +121,7 @@ class _March:
         history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
         g = -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
         h, starts = (start.copy(), None) if start is not None else self._start(dt)
-        ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, MAX_ITER,
+        ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, max_iter,
                     self.cache, self.stats)
         if not ok:
             invalidate(self.cache)
@@ -174,7 +179,8 @@ def _approach(m: _March, protocol: Protocol) -> None:
     while m.load < protocol.preload * (1.0 - PRELOAD_RTOL):
         budget.check("the approach")
         smallest = dd <= MIN_STEP_FRACTION * dd_max
-        solved = m.solve(m.delta + dd, dd / speed, fold=smallest)
+        solved = m.solve(m.delta + dd, dd / speed, fold=smallest,
+                         max_iter=MAX_ITER if smallest else TRIAL_ITER)
         ok, h = solved[0], solved[1]
         moved = abs(crossing_radius(h, pb.mesh.r, pb.hm) - m.records["a"][-1])
         if (not ok or moved > da_max) and not smallest:
