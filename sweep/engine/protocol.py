@@ -31,6 +31,7 @@ import numpy as np
 
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
+from ..kernels.protocol import newton_at_load
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
                              invalidate, load, new_jacobian_cache, newton, predict,
                              predict_lattice, relax, score_starts)
@@ -115,11 +116,7 @@ class _March:
         state the pseudo-transient relaxation reaches from the last one (a dense
         factorization an iteration: for folds only)."""
         pb = self.pb
-        M, N = pb.prony_weights.size, self.h.size
-        e, b, H = np.empty(M), np.empty(M), np.zeros(N)
-        ceff = step_coefficients(pb.prony_weights, pb.prony_times, dt, e, b)
-        history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
-        g = -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
+        e, b, ceff, H, g = self._equation(delta, dt)
         h, starts = (start.copy(), None) if start is not None else self._start(dt)
         ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, max_iter,
                     self.cache, self.stats)
@@ -127,9 +124,37 @@ class _March:
             invalidate(self.cache)
         if not ok and fold:
             h, ok = self._jump(delta, g, ceff, H)
-        sig = np.empty(N)
-        lj_traction(h, pb.h0, pb.c, sig)
-        return ok, h, sig, load(sig, pb.wP), e, b, starts
+        return self._state(ok, h, e, b, starts)
+
+    def solve_at_load(self, delta, dt, force):
+        """The state after the step ``dt`` whose load is ``force`` (to HOLD_RTOL), its
+        indentation solved with the gap from the guess ``delta``
+        (:func:`sweep.kernels.protocol.newton_at_load`): (indentation, :meth:`solve`'s
+        tuple), or None where that did not converge."""
+        pb = self.pb
+        e, b, ceff, H, g = self._equation(delta, dt)
+        h, starts = self._start(dt)
+        tols = np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * force])
+        ok, shift = newton_at_load(h, g, pb.A, pb.wP, ceff, H, self.law, force, tols,
+                                   MAX_ITER, self.cache, self.stats)
+        if not ok:
+            invalidate(self.cache)
+            return None
+        return delta + shift, self._state(True, h, e, b, starts)
+
+    def _equation(self, delta, dt):
+        """The step's Prony coefficients e, b, C_eff, history H and gap g at ``delta``."""
+        pb = self.pb
+        M, N = pb.prony_weights.size, self.h.size
+        e, b, H = np.empty(M), np.empty(M), np.zeros(N)
+        ceff = step_coefficients(pb.prony_weights, pb.prony_times, dt, e, b)
+        history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
+        return e, b, ceff, H, -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
+
+    def _state(self, ok, h, e, b, starts):
+        sig = np.empty(h.size)
+        lj_traction(h, self.pb.h0, self.pb.c, sig)
+        return ok, h, sig, load(sig, self.pb.wP), e, b, starts
 
     def _start(self, dt):
         """Newton's start for the step ``dt`` and the two starts, quadratic and tip
@@ -245,11 +270,16 @@ def _dwell(m: _March, protocol: Protocol) -> None:
 
 
 def _held_step(m: _March, force: float, dt, fold=False):
-    """The indentation at which the step ``dt`` ends at the load ``force``: a secant from the
-    indentation the dwell's last steps extrapolate to (:func:`_held_guess`), the first slope
-    the last held step's (else from a step of 1e-3 h0), each solve after the first
-    starting from the one before (``fold``: :meth:`_March.solve`)."""
+    """The indentation at which the step ``dt`` ends at the load ``force`` and its state:
+    the gap and the indentation solved together from the indentation the dwell's last steps
+    extrapolate to (:func:`_held_guess`, :meth:`_March.solve_at_load`); where that does
+    not converge, a secant of ordinary solves from there, the first slope the last held
+    step's (else from a step of 1e-3 h0), each solve after the first starting from the one
+    before (``fold``: :meth:`_March.solve`)."""
     d0 = _held_guess(m, dt)
+    held = m.solve_at_load(d0, dt, force)
+    if held is not None:
+        return held
     s0 = m.solve(d0, dt, fold)
     if s0[0] and abs(s0[3] - force) <= HOLD_RTOL * force:
         return d0, s0
