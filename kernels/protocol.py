@@ -25,7 +25,7 @@ from .interface import traction_and_stiffness
 from .solve import (STAT_FACTOR, STAT_ITER, STAT_REFACTOR_SLOW, STAT_REFACTOR_ZONE,
                     STAT_RESIDUALS, STAT_SUBSET, STAT_ZONE, positive_step, residual)
 
-#: an iteration whose residual max |F| falls by less than this factor refactorizes before
+#: an iteration whose residual ``max |F|`` falls by less than this factor refactorizes before
 #: the next (the unloading Newton's SLOW_CONTRACTION, :mod:`kernels.solve`)
 HELD_SLOW_CONTRACTION = 0.1
 #: an iteration whose residual grows by more than this factor ends the solve unconverged
@@ -80,9 +80,9 @@ def _bordered_update(h, F, A, ceff, law, P, force, wP, cache, stats, y, out):
 @njit(cache=True)
 def newton_at_load(h, g, A, wP, ceff, H, law, force, tols, max_iter, cache, stats):
     """Solve F(h, s) = 0 and G(h) = 0 (module docstring) in place of ``h`` from ``h`` and
-    s = 0, the gap g of the guessed indentation; ``tols`` = (max |F| in units of d_ref, |G|
-    in units of pi dg R). Returns (converged, s): the step's indentation is the guess plus
-    s. The cache's factorization is kept and made again where its iteration contracts the
+    s = 0, the gap g of the guessed indentation; ``tols`` = (``max |F|`` in units of d_ref,
+    ``|G|`` in units of pi dg R). Returns (converged, s): the step's indentation is the
+    guess plus s. The cache's factorization is kept and made again where its iteration contracts the
     residual by less than HELD_SLOW_CONTRACTION; a residual growing by HELD_DIVERGENCE ends
     the solve unconverged."""
     N = h.size

@@ -12,15 +12,20 @@ Then
    units, docs/design.md section 2) until the load reaches the preload; the last step is cut
    so that it ends at the preload (a secant on its length, to PRELOAD_RTOL);
 2. *dwell* for the time ``dwell`` (tau0), holding either the load at the preload (``hold``
-   "force", the indentation solved at each step by a secant on it) or the indentation
-   (``hold`` "depth"), with time steps growing by DWELL_GROWTH from the approach's last one;
+   "force", the gap and the indentation of each step solved together,
+   :func:`sweep.kernels.protocol.newton_at_load`, a secant on the indentation where that
+   fails) or the indentation (``hold`` "depth"), with time steps growing by DWELL_GROWTH
+   from the approach's last one;
 3. *retract*: the unloading kernel (:func:`sweep.kernels.solve.unload`) continues from the
    dwell's last state, its Prony modes and records, at the scene's rate, to the pull-off (or
    separation), as every scene's unloading.
 
 Phases 1 and 2 march the same hereditary integral as the kernel (the Prony recursion of
 :mod:`sweep.kernels.history`, the Newton solve of :func:`sweep.kernels.solve.newton` on the
-Lennard-Jones law), step by step from Python: a few hundred solves, each a kernel call. The
+Lennard-Jones law), step by step from Python: a few hundred solves, each a kernel call, Newton
+starting from the unloading kernel's predictors (:class:`_March`). Python's share of the
+time is a few per cent; the rest is Newton's at the advancing crack tip (docs/design.md, "The
+test protocol", for what it costs). The
 trajectory keeps every phase (``phase``: 0 approach, 1 dwell, 2 retraction); the row adds
 the work the machine did on the sphere over the whole path, ``hysteresis_energy`` (pi dg R
 d_ref, :func:`cycle_work`).
