@@ -36,7 +36,7 @@ import numpy as np
 
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
-from ..kernels.protocol import newton_at_load
+from ..kernels.protocol import newton_at_load, settle_tip
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
                              invalidate, load, new_jacobian_cache, newton, predict,
                              predict_lattice, relax, score_starts)
@@ -60,6 +60,10 @@ DWELL_MIN_STEP = 1e-9
 HOLD_RTOL = 1e-7
 #: ... and accepts the nearest of its iterations within this fraction where the secant stalls
 HOLD_ACCEPT = 1e-5
+#: Newton's start is settled at the crack tip first, on this many nodes either side of it,
+#: by this many Newton iterations on those nodes alone (:meth:`_March._settle`)
+TIP_NODES = 8
+TIP_ITER = 3
 #: most Newton iterations of one solve, and secant iterations of a held step
 MAX_ITER = 40
 HOLD_ITER = 30
@@ -122,7 +126,11 @@ class _March:
         factorization an iteration: for folds only)."""
         pb = self.pb
         e, b, ceff, H, g = self._equation(delta, dt)
-        h, starts = (start.copy(), None) if start is not None else self._start(dt)
+        if start is not None:
+            h, starts = start.copy(), None
+        else:
+            h, starts = self._start(dt)
+            self._settle(h, g, ceff, H)
         ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, max_iter,
                     self.cache, self.stats)
         if not ok:
@@ -139,6 +147,7 @@ class _March:
         pb = self.pb
         e, b, ceff, H, g = self._equation(delta, dt)
         h, starts = self._start(dt)
+        self._settle(h, g, ceff, H)
         tols = np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * force])
         ok, shift = newton_at_load(h, g, pb.A, pb.wP, ceff, H, self.law, force, tols,
                                    MAX_ITER, self.cache, self.stats)
@@ -146,6 +155,13 @@ class _March:
             invalidate(self.cache)
             return None
         return delta + shift, self._state(True, h, e, b, starts)
+
+    def _settle(self, h, g, ceff, H):
+        """Newton's start ``h`` settled at the crack tip of the last state (TIP_NODES nodes
+        either side, TIP_ITER iterations: :func:`sweep.kernels.protocol.settle_tip`)."""
+        tip = int(np.searchsorted(self.pb.mesh.r, self.records["a"][-1]))
+        settle_tip(h, g, self.pb.A, ceff, H, self.law, max(tip - TIP_NODES, 0),
+                   min(tip + TIP_NODES, h.size), TIP_ITER)
 
     def _equation(self, delta, dt):
         """The step's Prony coefficients e, b, C_eff, history H and gap g at ``delta``."""
