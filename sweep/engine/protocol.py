@@ -23,9 +23,9 @@ Then
 Phases 1 and 2 march the same hereditary integral as the kernel (the Prony recursion of
 :mod:`sweep.kernels.history`, the Newton solve of :func:`sweep.kernels.solve.newton` on the
 Lennard-Jones law), step by step from Python: a few hundred solves, each a kernel call, Newton
-starting from the unloading kernel's predictors (:class:`_March`). Python's share of the
-time is a few per cent; the rest is Newton's at the advancing crack tip (docs/design.md, "The
-test protocol", for what it costs). The
+starting from the unloading kernel's predictors settled at the crack tip (:class:`_March`).
+Python's own share of the time is under a tenth; the rest is Newton's at the advancing crack
+tip (docs/design.md, "The test protocol", for what it costs). The
 trajectory keeps every phase (``phase``: 0 approach, 1 dwell, 2 retraction); the row adds
 the work the machine did on the sphere over the whole path, ``hysteresis_energy`` (pi dg R
 d_ref, :func:`cycle_work`).
