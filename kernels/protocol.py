@@ -34,7 +34,7 @@ HELD_SLOW_CONTRACTION = 0.1
 HELD_DIVERGENCE = 10.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def _factorize_counted(h, A, ceff, law, cache, stats):
     """The Jacobian at ``h`` factorized into ``cache`` (:func:`kernels.jacobian.factorize`),
     counted in ``stats`` (STAT_FACTOR, STAT_SUBSET)."""
@@ -42,7 +42,7 @@ def _factorize_counted(h, A, ceff, law, cache, stats):
     stats[STAT_FACTOR] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline='always')
 def _bordered_update(h, F, A, ceff, law, P, force, wP, cache, stats, y, out):
     """The Newton update (dh into ``out``, returns (ds, ok)) of the bordered system at
     ``h`` (residual ``F``, load ``P``) with the cache's factorization, made again once where
