@@ -216,28 +216,58 @@ class _March:
 def _approach(m: _March, protocol: Protocol) -> None:
     """Indentation steps of ``numerics.step`` h0 (halved where Newton fails or the contact
     radius moves by more than ``da_max`` spacings) until the load reaches the preload; the
-    step that passes it is cut to end there."""
+    step that passes it is cut to end there. The first step is the one halving would give,
+    found from below (:func:`_first_step`)."""
     pb = m.pb
     speed = protocol.approach_rate * pb.h0
     dd_max = pb.numerics.step * pb.h0
     da_max = pb.numerics.da_max * pb.mesh.spacing
-    dd = dd_max
+    dd = None
     while m.load < protocol.preload * (1.0 - PRELOAD_RTOL):
         budget.check("the approach")
-        smallest = dd <= MIN_STEP_FRACTION * dd_max
-        solved = m.solve(m.delta + dd, dd / speed, fold=smallest,
-                         max_iter=MAX_ITER if smallest else TRIAL_ITER)
-        ok, h = solved[0], solved[1]
-        moved = abs(crossing_radius(h, pb.mesh.r, pb.hm) - m.records["a"][-1])
-        if (not ok or moved > da_max) and not smallest:
-            dd = max(0.5 * dd, MIN_STEP_FRACTION * dd_max)
-            continue
-        if not ok:
+        if dd is None:
+            dd, solved, moved = _first_step(m, speed, dd_max, da_max)
+        else:
+            smallest = dd <= MIN_STEP_FRACTION * dd_max
+            solved, moved, passed = _trial(m, dd, speed, smallest, da_max)
+            if not passed and not smallest:
+                dd = max(0.5 * dd, MIN_STEP_FRACTION * dd_max)
+                continue
+        if not solved[0]:
             raise RuntimeError(f"approach: no equilibrium at delta = {m.delta + dd:.6g}")
         if solved[3] > protocol.preload:
             dd, solved = _cut_to_preload(m, protocol, dd, speed, solved)
         m.accept(m.delta + dd, dd / speed, solved, PHASES["approach"])
         dd = min(2.0 * dd, dd_max) if moved < 0.5 * da_max else dd
+
+
+def _trial(m: _March, dd, speed, smallest, da_max):
+    """The approach's step ``dd`` tried (not accepted): (solved, the contact radius's change,
+    passed: Newton converged, within TRIAL_ITER iterations unless ``smallest``, and the
+    radius moved by at most ``da_max``). The smallest step may relax a fold
+    (:meth:`_March.solve`)."""
+    solved = m.solve(m.delta + dd, dd / speed, fold=smallest,
+                     max_iter=MAX_ITER if smallest else TRIAL_ITER)
+    moved = abs(crossing_radius(solved[1], m.pb.mesh.r, m.pb.hm) - m.records["a"][-1])
+    return solved, moved, solved[0] and moved <= da_max
+
+
+def _first_step(m: _March, speed, dd_max, da_max):
+    """The approach's first step, from the glassy contact: (dd, solved, radius change). The
+    contact relaxes fast there, so that halving from ``dd_max`` tried up to seven steps,
+    each that failed costing TRIAL_ITER Newton iterations; the step is found from below
+    instead, from MIN_STEP_FRACTION dd_max doubled while the doubled step passes
+    (:func:`_trial`). Where passing is monotone in the step, that is the step halving
+    accepts (the smallest one whether it passes or not); it is on the four scenes of
+    ``make protocol-cost``, fine and coarse meshes."""
+    dd = MIN_STEP_FRACTION * dd_max
+    best = _trial(m, dd, speed, True, da_max)
+    while best[2] and dd < dd_max:
+        trial = _trial(m, min(2.0 * dd, dd_max), speed, False, da_max)
+        if not trial[2]:
+            break
+        dd, best = min(2.0 * dd, dd_max), trial
+    return dd, best[0], best[1]
 
 
 def _cut_to_preload(m: _March, protocol: Protocol, dd, speed, solved):
