@@ -263,6 +263,7 @@ def _first_step(m: _March, speed, dd_max, da_max):
     dd = MIN_STEP_FRACTION * dd_max
     best = _trial(m, dd, speed, True, da_max)
     while best[2] and dd < dd_max:
+        budget.check("the approach")
         trial = _trial(m, min(2.0 * dd, dd_max), speed, False, da_max)
         if not trial[2]:
             break
