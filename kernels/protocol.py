@@ -1,4 +1,6 @@
-"""A time step held at a load: Newton on the gap and the indentation together (Numba kernel).
+"""The protocol march's own solves (:mod:`sweep.engine.protocol`; Numba kernels): a time step
+held at a load, Newton on the gap and the indentation together (:func:`newton_at_load`), and
+Newton's start settled at the crack tip (:func:`settle_tip`).
 
 A dwell at force (:mod:`sweep.engine.protocol`) asks, at each time step, for the indentation
 delta at which the equilibrium of the step carries the preload. Solved as one system, for the
@@ -14,6 +16,12 @@ factorization), x = -J^-1 F and y = J^-1 1, the Newton update is dh = x - y ds w
 
 (the bordered system eliminated: two solves with one factorization). One solve of the step
 instead of a secant of two or three solves on delta.
+
+The march's starts (an extrapolation of the last states) are furthest off at the crack tip,
+where the gap equation is most nonlinear: the node behind an advancing tip lands on the
+repulsive wall, and even exact Newton from there took three iterations. :func:`settle_tip`
+runs Newton on the few nodes around the tip alone, the others held, at the cost of those
+rows of A, before the solve of the whole.
 """
 from __future__ import annotations
 

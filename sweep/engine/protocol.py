@@ -69,8 +69,8 @@ MAX_ITER = 40
 HOLD_ITER = 30
 #: most Newton iterations of an approach step that may still be halved: those of the
 #: unloading kernel's solves (``sweep.engine.bem.MAX_NEWTON_ITER``); a solve that needs more
-#: is retried with half the step (the approach's first step, from the glassy contact,
-#: took 21, 21, 40, 17 and 19 iterations on trials that were all halved)
+#: is retried with half the step (halving from the largest, the approach's first step, from
+#: the glassy contact, took 21, 21, 40, 17 and 19 iterations on trials all rejected)
 TRIAL_ITER = 12
 #: the approach's smallest step, as a fraction of the largest (then the fold is relaxed) ...
 MIN_STEP_FRACTION = 1.0 / 64.0
