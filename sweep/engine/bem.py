@@ -33,7 +33,7 @@ from ..kernels.solve import (N_STATS, STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND,
                              StepControl, invalidate, unload)
 from ..errors import NUMERICAL_ERRORS, is_internal_error
 from ..kernels.interface import lj_traction
-from ..scene import Numerics, Result, Scene
+from ..scene import Numerics, Protocol, Result, Scene
 from . import budget
 from .budget import OverBudget
 from .exact import unload_exact
@@ -343,13 +343,20 @@ def no_contact_reason(scene: Scene, radius: float) -> str:
 def warm_up() -> float:
     """Compile (or load from the Numba cache) the kernels on a tiny scene; returns seconds.
 
+    The march of a test protocol (:mod:`sweep.engine.protocol`, its kernels in
+    ``kernels.protocol``) runs on the same problem, a short approach and dwell at force
+    (a scene with a protocol would fit a Prony series of its own, over a wider time window).
+
     Raises RuntimeError if the warm-up scene itself fails (a broken installation).
     """
     t0 = time.perf_counter()
     scene = Scene(n=0.8, k=0.5, mu=3.24, a0=1.5, rate=10.0)
     for mesh in ("uniform", "graded"):
-        res = simulate(scene, Numerics(mesh=mesh, nodes=80, domain=3.0, step=0.5, da_max=2.0,
-                                       prony_rtol=1e-2, tol=1e-8, pull_off_rtol=0.0))
+        numerics = Numerics(mesh=mesh, nodes=80, domain=3.0, step=0.5, da_max=2.0,
+                            prony_rtol=1e-2, tol=1e-8, pull_off_rtol=0.0)
+        res = simulate(scene, numerics)
         if not res.ok:
             raise RuntimeError(f"warm-up scene failed: {res.reason}")
+    run_phases(prepare(scene, numerics), Protocol(approach_rate=10.0, preload=1.0, dwell=0.5),
+               np.zeros(N_STATS, dtype=np.int64))
     return time.perf_counter() - t0

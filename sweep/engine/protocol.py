@@ -12,15 +12,20 @@ Then
    units, docs/design.md section 2) until the load reaches the preload; the last step is cut
    so that it ends at the preload (a secant on its length, to PRELOAD_RTOL);
 2. *dwell* for the time ``dwell`` (tau0), holding either the load at the preload (``hold``
-   "force", the indentation solved at each step by a secant on it) or the indentation
-   (``hold`` "depth"), with time steps growing by DWELL_GROWTH from the approach's last one;
+   "force", the gap and the indentation of each step solved together,
+   :func:`sweep.kernels.protocol.newton_at_load`, a secant on the indentation where that
+   fails) or the indentation (``hold`` "depth"), with time steps growing by DWELL_GROWTH
+   from the approach's last one;
 3. *retract*: the unloading kernel (:func:`sweep.kernels.solve.unload`) continues from the
    dwell's last state, its Prony modes and records, at the scene's rate, to the pull-off (or
    separation), as every scene's unloading.
 
 Phases 1 and 2 march the same hereditary integral as the kernel (the Prony recursion of
 :mod:`sweep.kernels.history`, the Newton solve of :func:`sweep.kernels.solve.newton` on the
-Lennard-Jones law), step by step from Python: a few hundred solves, each a kernel call. The
+Lennard-Jones law), step by step from Python: a few hundred solves, each a kernel call, Newton
+starting from the unloading kernel's predictors settled at the crack tip (:class:`_March`).
+Python's own share of the time is under a tenth; the rest is Newton's at the advancing crack
+tip (docs/design.md, "The test protocol", for what it costs). The
 trajectory keeps every phase (``phase``: 0 approach, 1 dwell, 2 retraction); the row adds
 the work the machine did on the sphere over the whole path, ``hysteresis_energy`` (pi dg R
 d_ref, :func:`cycle_work`).
@@ -31,7 +36,10 @@ import numpy as np
 
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
-from ..kernels.solve import invalidate, load, new_jacobian_cache, newton, predict, relax
+from ..kernels.protocol import newton_at_load, settle_tip
+from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
+                             invalidate, load, new_jacobian_cache, newton, predict,
+                             predict_lattice, relax, score_starts)
 from ..theory import jkr_contact_radius
 from ..scene import Protocol
 from . import budget
@@ -52,9 +60,18 @@ DWELL_MIN_STEP = 1e-9
 HOLD_RTOL = 1e-7
 #: ... and accepts the nearest of its iterations within this fraction where the secant stalls
 HOLD_ACCEPT = 1e-5
+#: Newton's start is settled at the crack tip first, on this many nodes either side of it,
+#: by this many Newton iterations on those nodes alone (:meth:`_March._settle`)
+TIP_NODES = 8
+TIP_ITER = 3
 #: most Newton iterations of one solve, and secant iterations of a held step
 MAX_ITER = 40
 HOLD_ITER = 30
+#: most Newton iterations of an approach step that may still be halved: those of the
+#: unloading kernel's solves (``sweep.engine.bem.MAX_NEWTON_ITER``); a solve that needs more
+#: is retried with half the step (halving from the largest, the approach's first step, from
+#: the glassy contact, took 21, 21, 40, 17 and 19 iterations on trials all rejected)
+TRIAL_ITER = 12
 #: the approach's smallest step, as a fraction of the largest (then the fold is relaxed) ...
 MIN_STEP_FRACTION = 1.0 / 64.0
 #: ... by at most this many pseudo-transient iterations before Newton takes over, where
@@ -64,7 +81,10 @@ RELAX_ITER = 300
 
 class _March:
     """The hereditary march of the approach and the dwell on one prepared problem: the state
-    (gap, Prony modes, traction), the records, and one step's solve."""
+    (gap, Prony modes, traction), the records, and one step's solve. Newton's start is the
+    unloading kernel's: the quadratic extrapolation, replaced near the crack tip by the tip
+    predictor's (:func:`sweep.kernels.solve.predict_lattice`, from a ring of the last
+    accepted states) where that has been the nearer of the two on the last steps."""
 
     def __init__(self, pb, h, delta, stats):
         self.pb, self.h, self.delta, self.t = pb, h, float(delta), 0.0
@@ -78,6 +98,8 @@ class _March:
         self.law = lennard_jones(pb.h0, pb.c, N)
         self.cache, self.stats = new_jacobian_cache(N), stats
         self.records = {k: [] for k in ("t", "delta", "P", "a", "a_inner", "phase")}
+        self.past, self.past_ta = np.empty((LATTICE_HISTORY, N)), np.empty((2, LATTICE_HISTORY))
+        self.past_count, self.tip_score = 0, 0.0
         self._record(0)
 
     def _record(self, phase):
@@ -87,33 +109,84 @@ class _March:
                            ("a", crossing_radius(self.h, r, pb.hm)),
                            ("a_inner", crossing_radius(self.h, r, pb.h0)), ("phase", phase)):
             self.records[key].append(value)
+        k = self.past_count % LATTICE_HISTORY       # the tip predictor's ring
+        self.past[k], self.past_ta[:, k] = self.h, (self.t, self.records["a"][-1])
+        self.past_count += 1
 
     @property
     def load(self) -> float:
         return self.records["P"][-1]
 
-    def solve(self, delta, dt, fold=False):
+    def solve(self, delta, dt, fold=False, start=None, max_iter=MAX_ITER):
         """The state after a step to ``delta`` over ``dt`` (not accepted): (ok, h, sigma,
-        P, e, b), Newton from the quadratic extrapolation of the last three states; where that
-        fails and ``fold``, the stable state the pseudo-transient relaxation reaches from the
-        last one (a dense factorization an iteration: for folds only)."""
+        P, e, b, starts), Newton from ``start`` (a gap) or else from the predictor
+        (:meth:`_start`; ``starts`` its two starts where the tip predictor's was made, else
+        None), at most ``max_iter`` iterations; where that fails and ``fold``, the stable
+        state the pseudo-transient relaxation reaches from the last one (a dense
+        factorization an iteration: for folds only)."""
         pb = self.pb
-        M, N = pb.prony_weights.size, self.h.size
-        e, b, H = np.empty(M), np.empty(M), np.zeros(N)
-        ceff = step_coefficients(pb.prony_weights, pb.prony_times, dt, e, b)
-        history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
-        g = -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
-        h = np.empty(N)        # the kernel's predictor: quadratic through the last three
-        predict(self.h, self.h_prev, self.h_prev2, dt, self.dt_prev, self.dt_prev2, h)
-        ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, MAX_ITER,
+        e, b, ceff, H, g = self._equation(delta, dt)
+        if start is not None:
+            h, starts = start.copy(), None
+        else:
+            h, starts = self._start(dt)
+            self._settle(h, g, ceff, H)
+        ok = newton(h, g, pb.A, ceff, H, self.law, pb.numerics.tol * pb.h0, max_iter,
                     self.cache, self.stats)
         if not ok:
             invalidate(self.cache)
         if not ok and fold:
             h, ok = self._jump(delta, g, ceff, H)
-        sig = np.empty(N)
-        lj_traction(h, pb.h0, pb.c, sig)
-        return ok, h, sig, load(sig, pb.wP), e, b
+        return self._state(ok, h, e, b, starts)
+
+    def solve_at_load(self, delta, dt, force):
+        """The state after the step ``dt`` whose load is ``force`` (to HOLD_RTOL), its
+        indentation solved with the gap from the guess ``delta``
+        (:func:`sweep.kernels.protocol.newton_at_load`): (indentation, :meth:`solve`'s
+        tuple), or None where that did not converge."""
+        pb = self.pb
+        e, b, ceff, H, g = self._equation(delta, dt)
+        h, starts = self._start(dt)
+        self._settle(h, g, ceff, H)
+        tols = np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * force])
+        ok, shift = newton_at_load(h, g, pb.A, pb.wP, ceff, H, self.law, force, tols,
+                                   MAX_ITER, self.cache, self.stats)
+        if not ok:
+            invalidate(self.cache)
+            return None
+        return delta + shift, self._state(True, h, e, b, starts)
+
+    def _settle(self, h, g, ceff, H):
+        """Newton's start ``h`` settled at the crack tip of the last state (TIP_NODES nodes
+        either side, TIP_ITER iterations: :func:`sweep.kernels.protocol.settle_tip`)."""
+        tip = int(np.searchsorted(self.pb.mesh.r, self.records["a"][-1]))
+        settle_tip(h, g, self.pb.A, ceff, H, self.law, max(tip - TIP_NODES, 0),
+                   min(tip + TIP_NODES, h.size), TIP_ITER)
+
+    def _equation(self, delta, dt):
+        """The step's Prony coefficients e, b, C_eff, history H and gap g at ``delta``."""
+        pb = self.pb
+        M, N = pb.prony_weights.size, self.h.size
+        e, b, H = np.empty(M), np.empty(M), np.zeros(N)
+        ceff = step_coefficients(pb.prony_weights, pb.prony_times, dt, e, b)
+        history_vector(pb.prony_weights, e, b, self.q, self.sigma, H)
+        return e, b, ceff, H, -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
+
+    def _state(self, ok, h, e, b, starts):
+        sig = np.empty(h.size)
+        lj_traction(h, self.pb.h0, self.pb.c, sig)
+        return ok, h, sig, load(sig, self.pb.wP), e, b, starts
+
+    def _start(self, dt):
+        """Newton's start for the step ``dt`` and the two starts, quadratic and tip
+        predictor's (None where the tip predictor made none)."""
+        starts = np.empty((2, self.h.size))
+        predict(self.h, self.h_prev, self.h_prev2, dt, self.dt_prev, self.dt_prev2, starts[0])
+        starts[1] = starts[0]
+        if not predict_lattice(self.pb.mesh.r, self.h, self.past, self.past_ta,
+                               self.past_count, dt, starts[1]):
+            return starts[0].copy(), None
+        return starts[int(self.tip_score < LATTICE_SCORE_USE)].copy(), starts
 
     def _jump(self, delta, g, ceff, H):
         """The state across a fold of the path (the crack tip snapping along the contact):
@@ -128,8 +201,12 @@ class _March:
         return h, newton(h, g, pb.A, ceff, H, self.law, tol, MAX_ITER, self.cache, self.stats)
 
     def accept(self, delta, dt, solved, phase):
-        _, h, sig, _, e, b = solved
+        _, h, sig, _, e, b, starts = solved
         update_modes(e, b, self.q, sig, self.sigma)
+        if starts is not None:
+            a = crossing_radius(h, self.pb.mesh.r, self.pb.hm)
+            self.tip_score += LATTICE_SCORE_WEIGHT * (
+                score_starts(self.pb.mesh.r, starts, h, a) - self.tip_score)
         self.h_prev2, self.h_prev, self.h, self.sigma = self.h_prev, self.h, h, sig
         self.dt_prev2, self.dt_prev = self.dt_prev, dt
         self.delta, self.t = float(delta), self.t + dt
@@ -139,27 +216,59 @@ class _March:
 def _approach(m: _March, protocol: Protocol) -> None:
     """Indentation steps of ``numerics.step`` h0 (halved where Newton fails or the contact
     radius moves by more than ``da_max`` spacings) until the load reaches the preload; the
-    step that passes it is cut to end there."""
+    step that passes it is cut to end there. The first step is the one halving would give,
+    found from below (:func:`_first_step`)."""
     pb = m.pb
     speed = protocol.approach_rate * pb.h0
     dd_max = pb.numerics.step * pb.h0
     da_max = pb.numerics.da_max * pb.mesh.spacing
-    dd = dd_max
+    dd = None
     while m.load < protocol.preload * (1.0 - PRELOAD_RTOL):
         budget.check("the approach")
-        smallest = dd <= MIN_STEP_FRACTION * dd_max
-        solved = m.solve(m.delta + dd, dd / speed, fold=smallest)
-        ok, h = solved[0], solved[1]
-        moved = abs(crossing_radius(h, pb.mesh.r, pb.hm) - m.records["a"][-1])
-        if (not ok or moved > da_max) and not smallest:
-            dd = max(0.5 * dd, MIN_STEP_FRACTION * dd_max)
-            continue
-        if not ok:
+        if dd is None:
+            dd, solved, moved = _first_step(m, speed, dd_max, da_max)
+        else:
+            smallest = dd <= MIN_STEP_FRACTION * dd_max
+            solved, moved, passed = _trial(m, dd, speed, smallest, da_max)
+            if not passed and not smallest:
+                dd = max(0.5 * dd, MIN_STEP_FRACTION * dd_max)
+                continue
+        if not solved[0]:
             raise RuntimeError(f"approach: no equilibrium at delta = {m.delta + dd:.6g}")
         if solved[3] > protocol.preload:
             dd, solved = _cut_to_preload(m, protocol, dd, speed, solved)
         m.accept(m.delta + dd, dd / speed, solved, PHASES["approach"])
         dd = min(2.0 * dd, dd_max) if moved < 0.5 * da_max else dd
+
+
+def _trial(m: _March, dd, speed, smallest, da_max):
+    """The approach's step ``dd`` tried (not accepted): (solved, the contact radius's change,
+    passed: Newton converged, within TRIAL_ITER iterations unless ``smallest``, and the
+    radius moved by at most ``da_max``). The smallest step may relax a fold
+    (:meth:`_March.solve`)."""
+    solved = m.solve(m.delta + dd, dd / speed, fold=smallest,
+                     max_iter=MAX_ITER if smallest else TRIAL_ITER)
+    moved = abs(crossing_radius(solved[1], m.pb.mesh.r, m.pb.hm) - m.records["a"][-1])
+    return solved, moved, solved[0] and moved <= da_max
+
+
+def _first_step(m: _March, speed, dd_max, da_max):
+    """The approach's first step, from the glassy contact: (dd, solved, radius change). The
+    contact relaxes fast there, so that halving from ``dd_max`` tried up to seven steps,
+    each that failed costing TRIAL_ITER Newton iterations; the step is found from below
+    instead, from MIN_STEP_FRACTION dd_max doubled while the doubled step passes
+    (:func:`_trial`). Where passing is monotone in the step, that is the step halving
+    accepts (the smallest one whether it passes or not); it is on the four scenes of
+    ``make protocol-cost``, fine and coarse meshes."""
+    dd = MIN_STEP_FRACTION * dd_max
+    best = _trial(m, dd, speed, True, da_max)
+    while best[2] and dd < dd_max:
+        budget.check("the approach")
+        trial = _trial(m, min(2.0 * dd, dd_max), speed, False, da_max)
+        if not trial[2]:
+            break
+        dd, best = min(2.0 * dd, dd_max), trial
+    return dd, best[0], best[1]
 
 
 def _cut_to_preload(m: _March, protocol: Protocol, dd, speed, solved):
@@ -213,16 +322,24 @@ def _dwell(m: _March, protocol: Protocol) -> None:
 
 
 def _held_step(m: _March, force: float, dt, fold=False):
-    """The indentation at which the step ``dt`` ends at the load ``force``: secant from the
-    last indentation, the first slope the last held step's (else from a step of 1e-3 h0;
-    ``fold``: :meth:`_March.solve`)."""
-    d0 = m.delta
+    """The indentation at which the step ``dt`` ends at the load ``force`` and its state:
+    the gap and the indentation solved together from the indentation the dwell's last steps
+    extrapolate to (:func:`_held_guess`, :meth:`_March.solve_at_load`); where that does
+    not converge, a secant of ordinary solves from there, the first slope the last held
+    step's (else from a step of 1e-3 h0), each solve after the first starting from the one
+    before (``fold``: :meth:`_March.solve`)."""
+    d0 = _held_guess(m, dt)
+    held = m.solve_at_load(d0, dt, force)
+    if held is not None:
+        return held
     s0 = m.solve(d0, dt, fold)
+    if s0[0] and abs(s0[3] - force) <= HOLD_RTOL * force:
+        return d0, s0
     if m.hold_slope is not None and s0[0]:      # the last held step's slope: one solve less
         d1 = d0 + (force - s0[3]) / m.hold_slope
     else:
         d1 = d0 + 1e-3 * m.pb.h0
-    s1 = m.solve(d1, dt, fold)
+    s1 = _solve_near(m, d1, dt, fold, s0)
     best = (abs(s0[3] - force), d0, s0)
     for _ in range(HOLD_ITER):
         if not (s0[0] and s1[0]):
@@ -237,10 +354,38 @@ def _held_step(m: _March, force: float, dt, fold=False):
             break
         d0, s0 = d1, s1
         d1 = d1 + step
-        s1 = m.solve(d1, dt, fold)
+        s1 = _solve_near(m, d1, dt, fold, s0)
     if best[0] <= HOLD_ACCEPT * force:
         return best[1], best[2]
     raise RuntimeError(f"dwell at force: the load stayed at {best[2][3]:.8g}, not {force:.8g}")
+
+
+def _solve_near(m: _March, delta, dt, fold, near):
+    """:meth:`_March.solve` from the gap of the solved state ``near`` (the same step at a
+    nearby indentation), else from the extrapolation of the last states."""
+    if near[0]:
+        solved = m.solve(delta, dt, start=near[1])
+        if solved[0]:
+            return solved
+    return m.solve(delta, dt, fold)
+
+
+def _held_guess(m: _March, dt) -> float:
+    """The indentation the dwell at force is expected at after the step ``dt``: the
+    quadratic extrapolation in time through its last three states (the dwell's start among
+    them; linear through two, the last indentation at the dwell's first step)."""
+    t, d, phase = m.records["t"], m.records["delta"], m.records["phase"]
+    k = 1
+    while k < 3 and phase[-k] == PHASES["dwell"]:
+        k += 1
+    x, guess = t[-1] + dt, 0.0
+    for j in range(1, k + 1):
+        weight = 1.0
+        for i in range(1, k + 1):
+            if i != j:
+                weight *= (x - t[-i]) / (t[-j] - t[-i])
+        guess += weight * d[-j]
+    return guess
 
 
 def first_contact(pb, stats):

@@ -155,3 +155,34 @@ def test_without_much_adhesion_a_dwell_follows_lee_and_radok(hold):
     ratio = (measured / measured[0]) / (closed / closed[0])
     assert np.max(np.abs(ratio - 1.0)) < tol
     assert closed.max() / closed.min() > 5.0               # the dwell does relax or creep
+
+
+@pytest.mark.parametrize("material", [dict(n=0.5, k=0.1), dict(material="sls", n=0.5, k=0.2)])
+def test_the_first_approach_step_is_the_one_halving_from_the_largest_accepts(material):
+    """The approach's first step is searched from below (engine.protocol._first_step: from
+    1/64 of numerics.step h0, doubled while the doubled step passes); from the glassy
+    contact, MPL k 0.1 relaxes fast (halving tries seven steps), SLS k 0.2 less. It must be
+    the step that halving from numerics.step h0 accepts, tried here on a fresh march from
+    the same contact."""
+    from sweep.engine import protocol
+    from sweep.engine.problem import prepare
+    from sweep.kernels.solve import N_STATS
+
+    scene = Scene(model="bem", mu=MU, rate=1.0, **material, **PROTOCOL)
+    pb = prepare(scene, Numerics.preset("balanced"))
+    speed = PROTOCOL["approach_rate"] * pb.h0
+    dd_max = pb.numerics.step * pb.h0
+    da_max = pb.numerics.da_max * pb.mesh.spacing
+
+    def march():
+        stats = np.zeros(N_STATS, dtype=np.int64)
+        return protocol._March(pb, *protocol.first_contact(pb, stats), stats)
+
+    found = protocol._first_step(march(), speed, dd_max, da_max)[0]
+    m, dd = march(), dd_max
+    while dd > protocol.MIN_STEP_FRACTION * dd_max:
+        if protocol._trial(m, dd, speed, False, da_max)[2]:
+            break
+        dd *= 0.5
+    assert found == dd
+    assert found < dd_max                  # the search had something to find

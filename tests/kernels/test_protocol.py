@@ -1,0 +1,85 @@
+"""The march's kernels (kernels.protocol). A step held at a load (newton_at_load): the gap and
+the indentation solved together must zero the residual numpy computes at the indentation
+found, carry the load asked for, and be the state the ordinary Newton solve finds at that
+indentation. Newton's start settled at the crack tip (settle_tip): the residual there falls,
+no other node moves."""
+import numpy as np
+import pytest
+
+from sweep.engine.initial import ElasticSolver, relaxed_state
+from sweep.engine.mesh import uniform_mesh
+from sweep.engine.problem import lj_constants
+from sweep.kernels import solve as ks
+from sweep.kernels.interface import lennard_jones, lj_traction_and_stiffness
+from sweep.kernels.protocol import newton_at_load, settle_tip
+
+N = 120
+TOL = 1e-10        # units of h0
+
+
+def _step():
+    """One unloading-like step from the relaxed elastic state at delta = 1 (C_eff < 1, a
+    history vector), as tests/kernels/test_newton.py makes it."""
+    mesh = uniform_mesh(N, 3.0)
+    A, r = np.array(mesh.influence), np.asarray(mesh.r)
+    h0, c = lj_constants(3.24)
+    el = ElasticSolver(A, r, h0, c, 1e-10)
+    h_start, _ = relaxed_state(el, delta0=1.0)
+    return A, r, h0, c, h_start, np.asarray(mesh.load_weights)
+
+
+def _load(h, h0, c, wP):
+    sig, d = np.empty(h.size), np.empty(h.size)
+    lj_traction_and_stiffness(h, h0, c, sig, d)
+    return 2.0 * np.pi * wP @ sig, sig
+
+
+@pytest.mark.parametrize("extra", [0.3, -0.2])
+def test_the_held_step_carries_the_load_at_the_indentation_it_found(extra):
+    A, r, h0, c, h_start, wP = _step()
+    ceff, H = 0.8, -0.05 * np.exp(-r)
+    delta = 1.0
+    g = -delta + h0 + 0.5 * r ** 2
+    force = _load(h_start, h0, c, wP)[0] + extra
+    h = h_start.copy()
+    cache, stats = ks.new_jacobian_cache(N), np.zeros(ks.N_STATS, np.int64)
+    law = lennard_jones(h0, c, N)
+    ok, shift = newton_at_load(h, g, A, wP, ceff, H, law, force,
+                               np.array([TOL * h0, 1e-9 * abs(force)]), 40, cache, stats)
+    assert ok
+    assert np.sign(shift) == np.sign(extra)           # more load, more indentation
+    P, sig = _load(h, h0, c, wP)
+    assert abs(P - force) <= 1e-9 * abs(force)
+    g_found = -(delta + shift) + h0 + 0.5 * r ** 2
+    assert np.max(np.abs(h - g_found - A @ (ceff * sig - H))) <= TOL * h0
+    # the ordinary solve at that indentation finds the same state
+    h_plain = h_start.copy()
+    assert ks.newton(h_plain, g_found, A, ceff, H, law, TOL * h0, 40,
+                     ks.new_jacobian_cache(N), np.zeros(ks.N_STATS, np.int64))
+    assert np.max(np.abs(h_plain - h)) <= 1e-6 * h0
+
+
+
+def test_settling_the_tip_lowers_its_residual_and_moves_no_other_node():
+    """The equilibrium at delta = 1 with the gaps of ten nodes at the crack tip off by 2 %
+    (an extrapolated start's error there): settle_tip brings the residual of those nodes down
+    by orders (numpy's residual), and leaves every other gap as it was."""
+    A, r, h0, c, h_start, _ = _step()
+    law = lennard_jones(h0, c, N)
+    g = -1.0 + h0 + 0.5 * r ** 2
+    tip = int(np.argmin(np.abs(h_start - 3.0 ** (1.0 / 6.0) * h0)))
+    lo, hi = tip - 5, tip + 5
+    h = h_start.copy()
+    h[lo:hi] *= 1.02
+
+    def tip_residual(x):
+        sig = _load(x, h0, c, np.zeros(N))[1]          # the traction (C_eff 1, H 0)
+        return np.max(np.abs((x - g - A @ sig)[lo:hi]))
+
+    before = tip_residual(h)
+    start = h.copy()
+    first, after = settle_tip(h, g, A, 1.0, np.zeros(N), law, lo, hi, 3)
+    assert first == pytest.approx(before, rel=1e-9)
+    assert tip_residual(h) == pytest.approx(after, rel=1e-6, abs=1e-14)
+    assert after < 1e-3 * before
+    assert np.array_equal(h[:lo], start[:lo]) and np.array_equal(h[hi:], start[hi:])
