@@ -30,6 +30,10 @@ PROTOCOL = dict(approach_rate=1.0, preload=2.0, dwell=5.0)
 #: tolerances below are these, with a margin.
 SAME_MESH = Numerics(mesh="uniform", nodes=800, domain=4.0, pull_off_rtol=0.0)
 LATTICE = dict(pull_off=1e-4, radius=2e-5, load_at_radius=1e-3, load_at_depth=1e-4)
+#: the crack speed at pull-off of a protocol and of the relaxed start it ends in (a fit of a(t)
+#: near the pull-off: measured 6e-7 and 1e-8 apart held at force and at depth; read over the
+#: approach's records as well, the protocol's was 10-13 % off)
+CRACK_SPEED_RTOL = 1e-3
 
 
 def run(numerics=None, **fields):
@@ -87,6 +91,10 @@ def test_a_long_dwell_ends_in_the_relaxed_state(hold):
         assert relaxed.trajectory["P"][0] == pytest.approx(
             res.trajectory["P"][res.trajectory["phase"] == 1][-1], rel=LATTICE["load_at_depth"])
     assert res.pull_off == pytest.approx(relaxed.pull_off, rel=LATTICE["pull_off"])
+    # the state at pull-off is read on the retraction, not on the approach that passed the
+    # same radii
+    assert res.crack_speed == pytest.approx(relaxed.crack_speed, rel=CRACK_SPEED_RTOL)
+    assert res.a_pulloff == pytest.approx(relaxed.a_pulloff, rel=LATTICE["radius"])
 
 
 def test_the_protocol_fields_are_checked():
