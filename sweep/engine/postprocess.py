@@ -48,7 +48,12 @@ def refine_minimum(t, P):
     """
     i = int(np.argmin(P))
     if 0 < i < len(P) - 1:
-        x = t[i - 1:i + 2]
+        # in time from the middle sample: in absolute time (t* ~ 3600 tau0 after a test
+        # protocol's dwell, steps of 1e-4) the parabola's terms cancelled to float32's
+        # precision (a pull-off quantized to 4.689464569091797 whatever the approach)
+        t0 = t[i]
+        tt = np.asarray(t, float) - t0
+        x = tt[i - 1:i + 2]
         y = P[i - 1:i + 2]
         denom = (x[0] - x[1]) * (x[0] - x[2]) * (x[1] - x[2])
         if denom != 0:
@@ -61,12 +66,12 @@ def refine_minimum(t, P):
                 miss = 0.0
                 for j in (i - 2, i + 2):
                     if 0 <= j < len(P):
-                        miss = max(miss, abs(A * t[j] ** 2 + B * t[j] + C - P[j]))
+                        miss = max(miss, abs(A * tt[j] ** 2 + B * tt[j] + C - P[j]))
                 drop = y[1] - vertex
                 smooth = (drop <= max(y[0], y[2]) - y[1]
                           and (drop <= VERTEX_RTOL * abs(y[1]) or miss <= drop))
                 if x[0] <= ts <= x[2] and smooth:
-                    return i, ts, min(vertex, y[1])
+                    return i, t0 + ts, min(vertex, y[1])
     return i, t[i], P[i]
 
 

@@ -14,6 +14,17 @@ def test_parabola_minimum_is_recovered_exactly(vertex_t):
     assert Ps == pytest.approx(-3.0, abs=1e-12)
 
 
+def test_the_minimum_is_recovered_late_in_a_long_run():
+    """Steps of 1e-4 tau0 at t ~ 3600 tau0 (a retraction after a test protocol's dwell): in
+    absolute time the parabola's terms cancelled to a relative precision of ~2e-7."""
+    t = 3598.159 + 1e-4 * np.arange(21)
+    vertex_t = t[10] + 0.3e-4
+    P = 0.5e8 * (t - vertex_t) ** 2 - 4.689463
+    _, ts, Ps = refine_minimum(t, P)
+    assert Ps == pytest.approx(-4.689463, rel=1e-12)
+    assert ts == pytest.approx(vertex_t, abs=1e-10)
+
+
 def test_a_jump_of_the_load_gives_the_sampled_minimum_not_a_wild_vertex():
     """The samples around a load jump (-3.888, -3.889, -2.770, as at a broken re-meshing)
     are no parabola; their vertex lies at -73 and must not be reported."""
