@@ -10,7 +10,7 @@ export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
-        tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem \
+        tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem pdms-protocol \
         agreement agreement-high-mu extremes tip-convergence elastic-table calibrate-demo \
         model-errors error-coverage crack-speed random-sample docs-check docs
 
@@ -27,6 +27,7 @@ help:
 	@echo "               (make threshold | vr | fig3 | figures | report; QUICK=1: thinned grids)"
 	@echo "make pdms   - PDMS pull-off vs unloading speed (results/pdms/; uses results/pdms/bem.json)"
 	@echo "make pdms-bem - the PDMS's linear BEM pull-off curve (results/pdms/bem.json, ~30 min), then make pdms"
+	@echo "make pdms-protocol - the PDMS as run (approach, 60 s dwell, retraction) vs relaxed (results/pdms/protocol.json, ~3 min), then make pdms"
 	@echo "make agreement - BEM vs crack-front model vs PB estimate (results/agreement/)"
 	@echo "make agreement-high-mu - its mu = 15 point (about 35 min), merged by make agreement"
 	@echo "make extremes [QUICK=1] [MODEL='bem auto'] - stability at the extremes of (n, k, rate, a0, mu)"
@@ -184,6 +185,12 @@ pdms: $(STAMP)
 # 30 min on a loaded 2-core machine), then the PDMS report with it
 pdms-bem: $(STAMP)
 	$(BIN)/python -m sweep.paper.pdms --out results/pdms --bem
+
+# the experiment as run against the relaxed start, by the BEM at mu 3-8 (results/pdms/
+# protocol.json, resumed; a few minutes), then the PDMS report with it
+pdms-protocol: $(STAMP)
+	$(BIN)/python -m sweep.paper.pdms_protocol --out results/pdms
+	$(BIN)/python -m sweep.paper.pdms --out results/pdms
 
 agreement: $(STAMP)
 	$(BIN)/python -m sweep.bench.agreement --out results/agreement/agreement.json

@@ -117,6 +117,9 @@ MAP: dict[tuple[str, str], tuple[str | None, str | None, str]] = {
         "30 s; its threshold and vr campaigns ran above (make threshold / vr QUICK=1)"),
     ("docs/si.md", "make pdms"): ("make -n pdms", None,
                                   "about 15 s; tests/paper/test_pdms.py covers sweep.paper.pdms"),
+    ("docs/si.md", "make pdms-protocol"): (
+        "make -n pdms-protocol", None,
+        "a few minutes; tests/paper/test_pdms_protocol.py recomputes a point of it"),
     ("docs/si.md", "make pdms-bem"): (
         "make -n pdms-bem", None,
         "about 20 s when it resumes the committed results/pdms/bem.json (30 min without it)"),
