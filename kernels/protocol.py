@@ -1,6 +1,7 @@
 """The protocol march's own solves (:mod:`sweep.engine.protocol`; Numba kernels): a time step
-held at a load, Newton on the gap and the indentation together (:func:`newton_at_load`), and
-Newton's start settled at the crack tip (:func:`settle_tip`).
+held at a load, Newton on the gap and the indentation together (:func:`newton_at_load`),
+Newton's start settled at the crack tip (:func:`settle_tip`), and the approach's kept
+factorization, its crack-tip zone ahead of an advancing tip (:func:`factorize_ahead`).
 
 A dwell at force (:mod:`sweep.engine.protocol`) asks, at each time step, for the indentation
 delta at which the equilibrium of the step carries the preload. Solved as one system, for the
@@ -29,14 +30,18 @@ import numpy as np
 from numba import njit
 
 from .blas import lu_factor, lu_solve
-from .jacobian import CACHE_STATE, STATE_VALID, apply_inverse, factorize, newton_direction
-from .interface import traction, traction_and_stiffness
+from .jacobian import (CACHE_STATE, STATE_SUBSET, STATE_VALID, STATE_ZONE_HI, apply_inverse,
+                       crack_tip_index, factorize, newton_direction)
+from .interface import TIP_GAP, traction, traction_and_stiffness
 from .solve import (STAT_FACTOR, STAT_ITER, STAT_REFACTOR_SLOW, STAT_REFACTOR_ZONE,
                     STAT_RESIDUALS, STAT_SUBSET, STAT_ZONE, positive_step, residual)
 
 #: an iteration whose residual ``max |F|`` falls by less than this factor refactorizes before
 #: the next (the unloading Newton's SLOW_CONTRACTION, :mod:`kernels.solve`)
 HELD_SLOW_CONTRACTION = 0.1
+#: :func:`factorize_ahead` closes the nodes ahead of the crack tip to this fraction below
+#: the tip gap
+CLOSED_BELOW = 1e-3
 #: an iteration whose residual grows by more than this factor ends the solve unconverged
 #: (the caller falls back to a secant of ordinary solves)
 HELD_DIVERGENCE = 10.0
@@ -125,6 +130,39 @@ def newton_at_load(h, g, A, wP, ceff, H, law, force, tols, max_iter, cache, stat
             y[0] = np.nan
         norm = new
     return False, s
+
+
+@njit(cache=True)
+def factorize_ahead(h, A, ceff, law, ahead, least, cache, stats):
+    """Factorize the Jacobian at ``h`` (Lennard-Jones law) into ``cache`` with its crack-tip
+    zone placed ``ahead`` nodes further out than :func:`kernels.jacobian.factorize` places
+    it, for a crack tip that advances (an approach: the contact grows), where the cache
+    holds no factorization or its zone ends less than ``least`` nodes outside the crack tip
+    of ``h`` (and before the factorized nodes end). Returns whether it factorized.
+
+    :func:`kernels.jacobian.factorize` places the zone about the state's crack tip, most of
+    it inside (the tip of an unloading recedes); it is given ``h`` with the ``ahead`` nodes
+    outside the tip closed to just below the tip gap, so that it finds the tip there. The
+    closed nodes lie in the zone (``ahead`` < ZONE_IN - ZONE_MARGIN, so that the tip of ``h``
+    lies inside the zone's margin too), so the factorized interior B has the stiffness of
+    ``h`` itself, and the zone's is made from the iterate at the first Newton direction
+    (:func:`kernels.jacobian.newton_direction`: a factorization leaves its Schur complement
+    stale). Counted in ``stats`` as any factorization. The march runs the Lennard-Jones law
+    alone: the tip is where the gap crosses the tip gap."""
+    N = h.size
+    sig, d, dr = np.empty(N), np.empty(N), np.empty(N)
+    traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d, dr)
+    tip = crack_tip_index(d, dr)
+    state = cache[CACHE_STATE]
+    if (state[STATE_VALID] == 1 and (state[STATE_ZONE_HI] - tip >= least
+                                     or state[STATE_ZONE_HI] >= state[STATE_SUBSET])):
+        return False
+    closed = h.copy()
+    below = TIP_GAP * law.h0 * (1.0 - CLOSED_BELOW)
+    for i in range(tip, min(tip + ahead, N)):
+        closed[i] = min(closed[i], below)
+    _factorize_counted(closed, A, ceff, law, cache, stats)
+    return True
 
 
 @njit(cache=True)

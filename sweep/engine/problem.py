@@ -23,7 +23,7 @@ from ..materials.prony_series import PronySeries
 from ..scene import Numerics, Scene, SceneTable
 from ..theory import jkr_contact_radius
 from . import diskcache, process_zone
-from .mesh import Mesh, crack_band, scene_mesh
+from .mesh import BAND_MARGIN_ZONES, Mesh, crack_band, scene_mesh
 
 #: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
 WINDOW_SAFETY = 10.0
@@ -297,6 +297,22 @@ def initial_estimates(scene: Scene, numerics: Numerics) -> tuple[float, float, f
     return s.delta0_estimate, s.a0_estimate, s.domain
 
 
+def protocol_band(scene: Scene, numerics: Numerics) -> tuple[float, float]:
+    """[lo, hi] (a_ref) of the crack band of a scene with a test protocol: every radius its
+    crack tip takes. The approach starts at first contact, the glassy JKR contact at zero
+    load, of radius k^(1/3) times the relaxed one (:func:`sweep.engine.protocol.first_contact`;
+    the scene's k, the glassy compliance, below the fitted series' 1 - sum w: a radius no
+    larger), and its contact grows to the preload's; the retraction's tip sweeps from there
+    as any scene's does. The band is the retraction's from the relaxed JKR radius at the
+    preload (:func:`sweep.engine.mesh.crack_band`; down to r = 0 where the scene follows the
+    curve to separation), reaching in to first contact less BAND_MARGIN_ZONES tip zones
+    where that lies inside it; inside the band the mesh is graded as a relaxed start's."""
+    s = derive(scene, numerics)
+    lo, hi = crack_band(s.a0_estimate, s.tip_zone, pull_off_only=scene.stop == "pulloff")
+    first = scene.k ** (1.0 / 3.0) * float(jkr_contact_radius(load=0.0))
+    return max(min(lo, first - BAND_MARGIN_ZONES * s.tip_zone), 0.0), hi
+
+
 def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Problem:
     """Derive a scene's numbers once. Raises :class:`Refused` when the mesh cannot do.
 
@@ -313,9 +329,8 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused("a protocol's approach and dwell run the hereditary BEM with the "
                       "Lennard-Jones interface: not with numerics.exact nor a process zone "
                       f"(pz_law {scene.pz_law})")
-    if protocol and band is None:           # the approach starts apart: from r = 0 out
-        band = crack_band(derive(scene, numerics).a0_estimate, tip_zone(scene.mu),
-                          pull_off_only=False)
+    if protocol and band is None:
+        band = protocol_band(scene, numerics)
     if numerics.exact and scene.pz_law != "none":
         raise Refused(f"numerics.exact: the exact hereditary reference has the Lennard-Jones "
                       f"interface only, not the process zone (pz_law {scene.pz_law}); leave "
@@ -335,7 +350,7 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
     if mesh.nodes > numerics.max_nodes:
         if protocol:
-            other = "a test protocol runs on this mesh only (its crack band starts at r = 0)"
+            other = "a test protocol runs on this mesh only"
         elif scene.pz_law != "none":
             other = "the tip-following mesh carries no process zone: use model crack"
         else:

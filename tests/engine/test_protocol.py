@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from sweep import Numerics, Scene, simulate
+from sweep.engine.problem import prepare
 from sweep.engine.protocol import HOLD_ACCEPT
 from sweep.errors import InputError
 
@@ -55,6 +56,20 @@ def test_the_phases_are_recorded_in_order_and_the_preload_is_held():
     assert np.all(np.diff(traj["delta"][approach]) > 0)
     assert traj["P"][approach][-1] == pytest.approx(PROTOCOL["preload"], rel=1e-5)
     assert math.isfinite(res.hysteresis_energy) and res.hysteresis_energy > 0
+
+
+@pytest.mark.parametrize("k, stop", [(0.1, "pulloff"), (0.3, "separation")])
+def test_the_crack_tip_stays_in_the_fine_band(k, stop):
+    # the band reaches in to first contact (a glassy contact, k^(1/3) of the relaxed one),
+    # not to r = 0 unless the scene follows the curve to separation
+    scene = Scene(model="bem", **BASE, k=k, **PROTOCOL, stop=stop)
+    numerics = Numerics.preset("balanced")
+    band = prepare(scene, numerics).mesh.band
+    assert (band[0] > 0.0) == (stop == "pulloff")
+    res = run(**BASE, k=k, **PROTOCOL, stop=stop)
+    lo, hi = prepare(scene, numerics).tip_range
+    a = res.trajectory["a"]
+    assert np.all(a[a > 0] > lo) and np.all(a < hi)
 
 
 def test_held_at_depth_the_load_relaxes():

@@ -2,7 +2,9 @@
 the indentation solved together must zero the residual numpy computes at the indentation
 found, carry the load asked for, and be the state the ordinary Newton solve finds at that
 indentation. Newton's start settled at the crack tip (settle_tip): the residual there falls,
-no other node moves."""
+no other node moves. A factorization with its crack-tip zone ahead of the tip
+(factorize_ahead): placed where asked, the rest of it the ordinary one's, kept while the tip
+lies far enough inside the zone, and Newton with it finds the ordinary solve's state."""
 import numpy as np
 import pytest
 
@@ -11,7 +13,8 @@ from sweep.engine.mesh import uniform_mesh
 from sweep.engine.problem import lj_constants
 from sweep.kernels import solve as ks
 from sweep.kernels.interface import lennard_jones, lj_traction_and_stiffness
-from sweep.kernels.protocol import newton_at_load, settle_tip
+from sweep.kernels import jacobian as jac
+from sweep.kernels.protocol import factorize_ahead, newton_at_load, settle_tip
 
 N = 120
 TOL = 1e-10        # units of h0
@@ -83,3 +86,35 @@ def test_settling_the_tip_lowers_its_residual_and_moves_no_other_node():
     assert tip_residual(h) == pytest.approx(after, rel=1e-6, abs=1e-14)
     assert after < 1e-3 * before
     assert np.array_equal(h[:lo], start[:lo]) and np.array_equal(h[hi:], start[hi:])
+
+
+def test_the_zone_ahead_of_the_tip_is_placed_there_and_newton_finds_the_same_state():
+    A, r, h0, c, h_start, _ = _step()
+    law = lennard_jones(h0, c, N)
+    ceff, H, ahead = 0.8, -0.05 * np.exp(-r), 12
+    g = -1.0 + h0 + 0.5 * r ** 2
+    sig, d = np.empty(N), np.empty(N)
+    lj_traction_and_stiffness(h_start, h0, c, sig, d)
+    tip = jac.crack_tip_index(d, np.zeros(N))
+    assert tip - jac.ZONE_IN + ahead > 0          # the zone's inner end is not cut at r = 0
+    cache, stats = ks.new_jacobian_cache(N), np.zeros(ks.N_STATS, np.int64)
+    assert factorize_ahead(h_start, A, ceff, law, ahead, 10, cache, stats)
+    state = cache[jac.CACHE_STATE]
+    lo, hi, m = state[jac.STATE_ZONE_LO], state[jac.STATE_ZONE_HI], state[jac.STATE_SUBSET]
+    assert lo == tip + ahead - jac.ZONE_IN and hi == min(tip + ahead + jac.ZONE_OUT, m)
+    assert stats[ks.STAT_FACTOR] == 1
+    # outside the zone the stiffness factorized is the state's own, as the ordinary one's
+    plain = ks.new_jacobian_cache(N)
+    jac.factorize(h_start, A, ceff, h0, c, law.h_old, law.zone, plain)
+    outside = np.r_[0:lo, hi:N]
+    assert np.array_equal(cache[jac.CACHE_E][outside], plain[jac.CACHE_E][outside])
+    # kept while the tip lies at least ``least`` nodes inside the zone's outer end
+    assert not factorize_ahead(h_start, A, ceff, law, ahead, hi - tip, cache, stats)
+    assert factorize_ahead(h_start, A, ceff, law, ahead, hi - tip + 1, cache, stats)
+    # Newton with it: the state the ordinary solve finds
+    start = h_start * (1.0 + 0.01 * np.exp(-r))
+    h, h_plain = start.copy(), start.copy()
+    assert ks.newton(h, g, A, ceff, H, law, TOL * h0, 40, cache, stats)
+    assert ks.newton(h_plain, g, A, ceff, H, law, TOL * h0, 40, ks.new_jacobian_cache(N),
+                     np.zeros(ks.N_STATS, np.int64))
+    assert np.max(np.abs(h - h_plain)) <= 1e-6 * h0
