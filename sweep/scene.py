@@ -328,6 +328,11 @@ class Scene:
         (tau0), then retracts at ``rate``. Only the BEM runs it.
     dwell_hold : {"force", "depth"}
         What the dwell holds: the load at ``preload`` (default) or the indentation.
+    machine_stiffness : float, optional
+        Stiffness K of the machine in series with the sphere (its force sensor), in pi dg R
+        per d_ref, > 0; None (default) is a rigid machine. The machine drives its own
+        displacement D at the unloading rate, dD/dt = -rate h0, and the sphere's indentation
+        is delta = D - P/K (docs/design.md, "Machine compliance"). Only the BEM runs it.
     """
 
     n: float = axis(help="MPL exponent (spectrum broadness); unused by sls", limits=(0.0, 5.0),
@@ -387,6 +392,12 @@ class Scene:
                                order=-7)
     dwell_hold: str = axis("force", help="protocol: what the dwell holds, the load (force) or "
                            "the indentation (depth)", choices=DWELL_HOLDS, order=-6)
+    machine_stiffness: float | None = axis(None, help="stiffness of the machine (force "
+                                           "sensor) in series with the sphere: the machine "
+                                           "drives D(t), the sphere's indentation is D - P/K "
+                                           "(none: a rigid machine; models bem and auto)",
+                                           unit="pi dg R/d_ref", limits=(0.0, 1e30),
+                                           lo_open=True, label=r"$\hat K$", order=-5)
 
     def __post_init__(self):
         info = _axes_of(type(self))
