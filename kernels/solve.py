@@ -525,7 +525,13 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
 
 
 @njit(cache=True, inline='always')
-def relax(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats):
+def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
+    """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success."""
+    return relax_machine(h, g, A, ceff, H, law, 0.0, np.zeros(h.size), tol, max_iter, stats)
+
+
+@njit(cache=True, inline='always')
+def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats):
     """Pseudo-transient continuation to a *stable* equilibrium, in place; True on success.
 
     Integrates the relaxation dh/dtau = -F(h) with linearly implicit Euler steps,
@@ -952,7 +958,8 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     if snap(mesh, physics, work, ceff, tol, control.max_iter, hm, cache, stats):
         return SNAPPED
     _copy(work.h, hp)
-    if relax(hp, work.g, A, ceff, work.H, law, compliance, wP, tol, RELAX_MAX_ITER, stats):
+    if relax_machine(hp, work.g, A, ceff, work.H, law, compliance, wP, tol, RELAX_MAX_ITER,
+                     stats):
         return SNAPPED
     return FAILED
 
