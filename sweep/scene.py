@@ -925,8 +925,8 @@ class Result:
     def __repr__(self) -> str:
         """A one-line summary: status (and reason), pull-off (pi dg R), crack speed
         (a_ref/tau0), model, steps, the trajectory's length (never its arrays) and the
-        scene's axes (the process zone where there is one); the full rows are
-        :meth:`to_row` and :meth:`to_dict`."""
+        scene's axes (the process zone and the machine's stiffness where given); the full
+        rows are :meth:`to_row` and :meth:`to_dict`."""
         points = len(next(iter(self.trajectory.values()), ()))
         reason = self.reason if len(self.reason) <= 80 else self.reason[:77] + "..."
         sc = self.scene
@@ -937,6 +937,8 @@ class Result:
             start = f"a0={sc.a0:g}" if sc.a0 is not None else f"delta0={sc.delta0:g}"
         pz = (f" pz_law={sc.pz_law} pz_v0={sc.pz_v0:g} pz_xi={sc.pz_xi:g}"
               if sc.pz_law != "none" else "")
+        if sc.machine_stiffness is not None:
+            pz += f" machine_stiffness={sc.machine_stiffness:g}"
         return (f"Result({self.status}{' (' + reason + ')' if reason else ''}: "
                 f"pull_off={self.pull_off:.6g} crack_speed={self.crack_speed:.6g} "
                 f"model={self.model_used or sc.model} steps={self.steps} "
