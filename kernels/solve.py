@@ -17,6 +17,18 @@ and at every iteration of the retries of a step whose solve failed. The line sea
 contraction measured before, to leave a residual below a tenth of the tolerance ends
 without evaluating it (PREDICTED_RESIDUAL).
 
+A compliant machine (a spring of stiffness K in series with the sphere, Physics.compliance
+= 1/K, 0 for a rigid one) drives its own displacement D; the sphere's indentation is
+delta = D - P(h)/K with P(h) = 2 pi wP . sigma(h), so that
+
+    F(h) = h - g(D) - P(h)/K - A [ C_eff sigma(h) - H ] = 0
+
+and the Jacobian gains the rank-one term -(1/K) 1 (dP/dh)^T, dP/dh = 2 pi wP o sigma'(h):
+Newton's direction is the kept factorization's with the Sherman-Morrison correction
+(:func:`machine_direction`, one more solve, of J^-1 1, per direction). The loop's
+indentation (RUN_DELTA) is then D; the records' delta is the sphere's, D - P/K. With
+compliance 0 no term is added: the rigid path is the one computed before.
+
 On a coarse mesh the discrete equilibrium path can fold (the crack tip snaps from node to
 node); the loop then looks for the snapped state (:func:`snap`, :func:`relax`).
 
@@ -52,8 +64,8 @@ from .interface import (TIP_GAP, ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_SMOOTH_
                         traction_and_stiffness)
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
 from .jacobian import (CACHE_CONTRACTION, CACHE_STATE, STATE_EXACT,  # noqa: F401
-                       STATE_VALID, factorize, invalidate, new_jacobian_cache,
-                       newton_direction)
+                       STATE_VALID, apply_inverse, factorize, invalidate,
+                       new_jacobian_cache, newton_direction)
 
 STATUS_DONE = 0
 STATUS_NEWTON_FAILED = 1
@@ -87,13 +99,16 @@ MeshArrays = namedtuple("MeshArrays", ["A", "r", "wP"])
 
 #: the scene's laws and loading (dimensionless, docs/design.md section 2): h0 and c of the
 #: Lennard-Jones law, the Prony modes (weights, times) of Chat (times may be inf: a lumped
-#: glassy constant), rate = r-hat (d delta/dt = -rate h0); the process zone's opening-rate
-#: scale hdot_c (d_ref / tau0; inf: none, the LJ law) and exponent xi
-#: (:func:`kernels.interface.zone_factor`)
-Physics = namedtuple("Physics", ["h0", "c", "weights", "times", "rate", "hdot_c", "xi"])
+#: glassy constant), rate = r-hat (d D/dt = -rate h0, D the machine's displacement: the
+#: indentation delta for a rigid machine); the process zone's opening-rate scale hdot_c
+#: (d_ref / tau0; inf: none, the LJ law) and exponent xi
+#: (:func:`kernels.interface.zone_factor`); compliance = 1/K, the machine's compliance in
+#: d_ref per pi dg R (0, the default: a rigid machine, delta = D; else delta = D - P/K)
+Physics = namedtuple("Physics", ["h0", "c", "weights", "times", "rate", "hdot_c", "xi",
+                                 "compliance"], defaults=(0.0,))
 
 #: the step control settings:
-#: step_max, step_min: indentation steps (units of h0);
+#: step_max, step_min: indentation steps (units of h0; of the machine's displacement D);
 #: da_max: largest contact-radius change per step (a_ref);
 #: step_tol: relative load error of the step predictor, |P(predicted) - P| / max(|P|,
 #:     LOAD_ERROR_FLOOR), below which the step may grow beyond step_max (up to
@@ -146,7 +161,7 @@ Work = namedtuple("Work", ["h", "h_prev", "h_prev2", "h_prev3", "hp", "h_pred", 
 
 # the loop's scalars: one float64 array (N_RUN), positions named RUN_*
 RUN_T = 0          # time of the last accepted state
-RUN_DELTA = 1      # its indentation (d_ref)
+RUN_DELTA = 1      # its machine displacement D (d_ref; the indentation for a rigid machine)
 RUN_A = 2          # its contact radius at h_m (a_ref)
 RUN_DD = 3         # the indentation step being tried (d_ref)
 RUN_DT = 4         # its time step
@@ -322,6 +337,44 @@ def residual(h, g, A, ceff, H, law, sig, w, F):
 
 
 @njit(cache=True, inline='always')
+def machine_residual(h, g, A, ceff, H, law, compliance, wP, sig, w, F):
+    """:func:`residual` with a compliant machine: F - compliance P(h), P = 2 pi wP . sigma
+    (the indentation is D - compliance P, ``g`` that of D); exactly :func:`residual` for
+    ``compliance`` 0. Returns max |F|."""
+    norm = residual(h, g, A, ceff, H, law, sig, w, F)
+    if compliance == 0.0:
+        return norm
+    cP = compliance * load(sig, wP)
+    norm = 0.0
+    for i in range(h.size):
+        F[i] -= cP
+        if abs(F[i]) > norm:
+            norm = abs(F[i])
+    return norm
+
+
+@njit(cache=True, inline='always')
+def machine_direction(dh, d, A, compliance, wP, cache):
+    """Newton's direction ``dh`` = -J^-1 F of the kept factorization corrected in place for a
+    compliant machine, whose Jacobian is J - compliance 1 v^T with v = dP/dh = 2 pi wP o
+    sigma'(h) (``d``): by Sherman-Morrison, dh + compliance y (v . dh) / (1 - compliance
+    v . y) with y = J^-1 1. False where the denominator vanishes (the spring's fold)."""
+    y = apply_inverse(np.ones(dh.size), A, cache)
+    vy, vdh = 0.0, 0.0
+    for i in range(dh.size):
+        v = 2.0 * np.pi * wP[i] * d[i]
+        vy += v * y[i]
+        vdh += v * dh[i]
+    den = 1.0 - compliance * vy
+    if den == 0.0 or not np.isfinite(den):
+        return False
+    f = compliance * vdh / den
+    for i in range(dh.size):
+        dh[i] += f * y[i]
+    return True
+
+
+@njit(cache=True, inline='always')
 def positive_step(h, dh):
     """Largest step length <= 1 along ``dh`` that closes no gap by more than
     MAX_GAP_CLOSURE of it."""
@@ -352,17 +405,21 @@ def _refactorize(h, A, ceff, law, cache, stats, reason):
 
 
 @njit(cache=True, inline='always')
-def _direction(h, F, A, ceff, law, sig, d, dr, cache, stats):
+def _direction(h, F, A, ceff, law, compliance, wP, sig, d, dr, cache, stats):
     """Newton's direction at ``h`` (residual ``F``) with the cached factorization, made again
-    once when it no longer fits (the crack tip left the zone). Returns (dh, ok,
-    refactorized); ok is False when even the fresh factorization gives none."""
+    once when it no longer fits (the crack tip left the zone), corrected for a compliant
+    machine (:func:`machine_direction`). Returns (dh, ok, refactorized); ok is False when
+    even the fresh factorization gives none."""
     traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d, dr)
     dh, ok = newton_direction(F, d, dr, A, ceff, cache, stats, STAT_ZONE)
-    if ok:
-        return dh, True, False
-    _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_ZONE)
-    dh, ok = newton_direction(F, d, dr, A, ceff, cache, stats, STAT_ZONE)
-    return dh, ok, True
+    refactorized = False
+    if not ok:
+        _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_ZONE)
+        dh, ok = newton_direction(F, d, dr, A, ceff, cache, stats, STAT_ZONE)
+        refactorized = True
+    if ok and compliance != 0.0:
+        ok = machine_direction(dh, d, A, compliance, wP, cache)
+    return dh, ok, refactorized
 
 
 @njit(cache=True, inline='always')
@@ -378,19 +435,27 @@ def _end_predicted(h, dh, theta, stats):
 @njit(cache=True)
 def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
     """Solve F(h) = 0 in place, starting from ``h``, with the interface law ``law``
-    (:data:`kernels.interface.Interface`). Returns True on convergence.
+    (:data:`kernels.interface.Interface`) and a rigid machine: :func:`newton_machine` with
+    compliance 0. Returns True on convergence."""
+    return newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, 0.0,
+                          np.zeros(h.size))
 
-    The Jacobian factorization in the cache (:func:`kernels.jacobian.new_jacobian_cache`)
-    is reused, its crack-tip zone kept exact (:func:`kernels.jacobian.newton_direction`); it
-    is rebuilt when the crack tip left the zone, when a stale one contracts the residual by
-    less than SLOW_CONTRACTION, when a line search fails with a stale one, and at every
-    iteration while ``state[STATE_EXACT]`` is set.
+
+@njit(cache=True)
+def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, compliance, wP):
+    """Solve F(h) = 0 in place from ``h`` with the interface law ``law``
+    (:data:`kernels.interface.Interface`) and a machine of compliance ``compliance`` (1/K;
+    0 rigid), load weights ``wP`` (:func:`machine_residual`, :func:`machine_direction`).
+    True on convergence. The Jacobian factorization in the cache is reused, its crack-tip
+    zone kept exact (:func:`kernels.jacobian.newton_direction`); it is rebuilt when the
+    crack tip left the zone, when a stale one contracts the residual by less than
+    SLOW_CONTRACTION, when a line search fails with a stale one, and at every iteration
+    while ``state[STATE_EXACT]`` is set.
 
     Converged means max |F| <= ``tol``: computed, or, after a first full update, predicted
     below PREDICTED_RESIDUAL ``tol`` as |F| times the contraction last measured (kept in
-    ``cache[CACHE_CONTRACTION]``; each solve so ended doubles it, so the residual is
-    computed again within a few solves). The prediction saves the one mat-vec of a solve
-    that a single chord update converges.
+    ``cache[CACHE_CONTRACTION]``; each solve so ended doubles it): it saves the one mat-vec
+    of a solve that a single chord update converges.
     """
     state = cache[CACHE_STATE]
     theta = cache[CACHE_CONTRACTION]
@@ -402,7 +467,7 @@ def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
     F = np.empty(N)
     Ft = np.empty(N)
     ht = np.empty(N)
-    norm = residual(h, g, A, ceff, H, law, sig, w, F)
+    norm = machine_residual(h, g, A, ceff, H, law, compliance, wP, sig, w, F)
     stats[STAT_RESIDUALS] += 1
     if norm <= tol:
         return True
@@ -415,7 +480,8 @@ def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
         if state[STATE_EXACT] == 1 and not fresh:
             _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_RETRY)
             fresh = True
-        dh, ok, refactorized = _direction(h, F, A, ceff, law, sig, d, dr, cache, stats)
+        dh, ok, refactorized = _direction(h, F, A, ceff, law, compliance, wP, sig, d, dr,
+                                          cache, stats)
         fresh = fresh or refactorized
         if not ok:       # singular even on a fresh factorization: give up
             return False
@@ -432,7 +498,7 @@ def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
         for _ls in range(LINE_SEARCH_STEPS):
             for i in range(N):
                 ht[i] = h[i] + lam * dh[i]
-            nt = residual(ht, g, A, ceff, H, law, sig, w, Ft)
+            nt = machine_residual(ht, g, A, ceff, H, law, compliance, wP, sig, w, Ft)
             stats[STAT_RESIDUALS] += 1
             nt2 = _norm2(Ft)
             if nt2 < (1.0 - ARMIJO * lam) * n2:
@@ -460,6 +526,12 @@ def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
 
 @njit(cache=True, inline='always')
 def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
+    """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success."""
+    return relax_machine(h, g, A, ceff, H, law, 0.0, np.zeros(h.size), tol, max_iter, stats)
+
+
+@njit(cache=True, inline='always')
+def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats):
     """Pseudo-transient continuation to a *stable* equilibrium, in place; True on success.
 
     Integrates the relaxation dh/dtau = -F(h) with linearly implicit Euler steps,
@@ -468,7 +540,9 @@ def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
     is Newton. J = A K (compliance times the energy Hessian), so the flow is attracted to
     stable equilibria. Used where the discrete equilibrium path folds (the crack tip
     snapping from one node to the next), as the physical system would. One dense
-    factorization per iteration: a fallback, not the main path.
+    factorization per iteration: a fallback, not the main path. A compliant machine
+    (``compliance`` = 1/K, load weights ``wP``) adds -compliance 2 pi wP_j sigma'_j to every
+    row of J (:func:`machine_residual`).
     """
     N = h.size
     sig = np.empty(N)
@@ -477,7 +551,7 @@ def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
     F = np.empty(N)
     Ft = np.empty(N)
     ht = np.empty(N)
-    norm = residual(h, g, A, ceff, H, law, sig, w, F)
+    norm = machine_residual(h, g, A, ceff, H, law, compliance, wP, sig, w, F)
     n2 = _norm2(F)
     dtau = RELAX_DTAU_START
     J = np.empty((N, N))
@@ -494,6 +568,11 @@ def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
             for j in range(N):
                 J[i, j] = -ceff * A[i, j] * d[j]
             J[i, i] += 1.0 + 1.0 / dtau
+        if compliance != 0.0:
+            for j in range(N):
+                spring = compliance * 2.0 * np.pi * wP[j] * d[j]
+                for i in range(N):
+                    J[i, j] -= spring
         # LAPACK's LU through kernels.blas (np.linalg.solve: 5 s of a cold compile)
         if lu_factor(J, piv) != 0:
             raise np.linalg.LinAlgError("relax: the Jacobian is singular")
@@ -503,7 +582,7 @@ def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
         lam = positive_step(h, dh)
         for i in range(N):
             ht[i] = h[i] + lam * dh[i]
-        nt = residual(ht, g, A, ceff, H, law, sig, w, Ft)
+        nt = machine_residual(ht, g, A, ceff, H, law, compliance, wP, sig, w, Ft)
         nt2 = _norm2(Ft)
         if not np.isfinite(nt2) or nt2 > RELAX_DIVERGENCE * n2:
             dtau *= RELAX_DTAU_CUT
@@ -541,8 +620,9 @@ def snap(mesh, physics, work, ceff, tol, max_iter, hm, cache, stats):
                 hp[i] = h[i + shift]
             else:
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
-        if newton(hp, work.g, mesh.A, ceff, work.H, Interface(physics.h0, physics.c, work.ref, work.zone),
-                  tol, max_iter, cache, stats):
+        if newton_machine(hp, work.g, mesh.A, ceff, work.H,
+                          Interface(physics.h0, physics.c, work.ref, work.zone), tol, max_iter,
+                          cache, stats, physics.compliance, mesh.wP):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -758,6 +838,8 @@ def start_run(mesh, physics, start, records, work, run, hm):
         n = start.n
     run[RUN_T] = records.t[n - 1]
     run[RUN_DELTA] = records.delta[n - 1]
+    if physics.compliance != 0.0:       # the machine's displacement D = delta + P/K
+        run[RUN_DELTA] += physics.compliance * records.P[n - 1]
     i_min = 0
     for i in range(1, n):
         if records.P[i] < records.P[i_min]:
@@ -790,7 +872,8 @@ def zone_step(physics, work, dt, dt_prev):
 
 @njit(cache=True, inline='always')
 def predict_step(mesh, physics, work, run):
-    """-- predict: the step's time step, C_eff, H and g for the step ``run[RUN_DD]``, and
+    """-- predict: the step's time step, C_eff, H and g (of the machine's displacement D, the
+    indentation of a rigid machine) for the step ``run[RUN_DD]``, and
     Newton's starting gaps: the quadratic extrapolation in ``work.h_pred`` (and ``hp``),
     the cubic one, where four states exist, in ``work.hp``, replaced near the crack tip by
     the tip predictor's (:func:`predict_lattice`) where it applies and has been the nearer
@@ -848,13 +931,16 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     max_iter = control.max_iter
     if not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0:
         max_iter *= FIRST_ZONE_ITER
-    ok = newton(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats)
+    compliance, wP = physics.compliance, mesh.wP
+    ok = newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
+                        compliance, wP)
     if not ok and cubic:
         # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
         # cubic start can overshoot: again from the quadratic one before the step halves
         stats[STAT_FAILED_SOLVES] += 1
         _copy(work.h_pred, hp)
-        ok = newton(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats)
+        ok = newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
+                            compliance, wP)
     if ok:
         return SOLVED
     stats[STAT_FAILED_SOLVES] += 1
@@ -872,7 +958,8 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     if snap(mesh, physics, work, ceff, tol, control.max_iter, hm, cache, stats):
         return SNAPPED
     _copy(work.h, hp)
-    if relax(hp, work.g, A, ceff, work.H, law, tol, RELAX_MAX_ITER, stats):
+    if relax_machine(hp, work.g, A, ceff, work.H, law, compliance, wP, tol, RELAX_MAX_ITER,
+                     stats):
         return SNAPPED
     return FAILED
 
@@ -940,8 +1027,8 @@ def step_load(mesh, physics, work, quadratic):
 def accept_step(mesh, physics, work, run, records, n, P, a_new):
     """-- accept: the Prony modes, the last four states and time steps move on by the
     solved state ``work.hp`` (also written to the tip predictor's ring, and the step's two
-    starts compared on it), and record ``n`` (load ``P``, contact radius ``a_new``) is
-    written."""
+    starts compared on it), and record ``n`` (load ``P``, contact radius ``a_new``, the
+    sphere's indentation D - P/K) is written."""
     update_modes(work.e, work.b, work.q, work.sig_new, work.sigma)
     dt = run[RUN_DT]
     _copy(work.h_prev2, work.h_prev3)
@@ -957,6 +1044,8 @@ def accept_step(mesh, physics, work, run, records, n, P, a_new):
     run[RUN_A] = a_new
     records.t[n] = run[RUN_T]
     records.delta[n] = run[RUN_DELTA]
+    if physics.compliance != 0.0:       # the sphere's indentation delta = D - P/K
+        records.delta[n] -= physics.compliance * P
     records.P[n] = P
     records.a[n] = a_new
     records.a_inner[n] = crossing_radius(work.h, mesh.r, physics.h0)
@@ -996,7 +1085,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
     h0, converted to d_ref where used)
     ----------
     mesh : MeshArrays (A, r, wP).
-    physics : Physics (h0, c, weights, times, rate, hdot_c, xi).
+    physics : Physics (h0, c, weights, times, rate, hdot_c, xi, compliance).
     control : StepControl (step_max, step_min, da_max, step_tol, tol, max_iter, max_steps,
         stop_mode, min_travel, tip_lo, tip_hi, da_max_pulloff, pulloff_zone).
     start : RunState (h, delta0, q, n, step, sigma, h_prev); q, step, sigma and h_prev are

@@ -232,7 +232,8 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "a0_si", "indentatio
 @click.option("--si", "si", is_flag=True,
               help="Give the scene in SI units: --n --R --E0 --Einf --nu --tau0 --dg --h0, one "
                    "of --preload/--a0-si/--indentation, and --speed (instead of --k --mu --a0 "
-                   "--delta0 --rate); a process zone's --pz-v0 is then in m/s.")
+                   "--delta0 --rate); a process zone's --pz-v0 is then in m/s, "
+                   "--machine-stiffness in N/m.")
 @click.option("--R", "R", type=str, default=None, help="[--si] sphere radius [m].")
 @click.option("--E0", "E0", type=str, default=None, help="[--si] relaxed Young's modulus [Pa].")
 @click.option("--Einf", "Einf", type=str, default=None, help="[--si] glassy Young's modulus [Pa].")
@@ -298,8 +299,10 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, exact, as_json, tr
                      f"dwell={sc.dwell:g} ({sc.dwell_hold})")
         else:
             start = f"a0={sc.a0:g}" if sc.a0 is not None else f"delta0={sc.delta0:g}"
+        machine = ("" if sc.machine_stiffness is None
+                   else f" machine_stiffness={sc.machine_stiffness:g}")
         click.echo(f"scene      n={sc.n:g} k={sc.k:g} mu={sc.mu:g} rate={sc.rate:g} {start}"
-                   f" material={sc.material} model={sc.model}")
+                   f" material={sc.material} model={sc.model}{machine}")
         for line in scene_text(res, preset):
             click.echo(line)
     if not res.ok:
@@ -419,6 +422,8 @@ def _scene_si(axes, as_json, values):
     if axes["dwell"] is not None:           # and the one --dwell: seconds
         kw["dwell"] = as_float("dwell", axes["dwell"])
         kw["dwell_hold"] = axes["dwell_hold"]
+    if axes["machine_stiffness"] is not None:     # and --machine-stiffness: N/m
+        kw["machine_stiffness"] = as_float("machine_stiffness", axes["machine_stiffness"])
     if "a0_si" in kw:
         kw["a0"] = kw.pop("a0_si")
     pz = {"pz_law": axes["pz_law"], **{name: as_float(name, axes[name])

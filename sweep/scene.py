@@ -328,6 +328,11 @@ class Scene:
         (tau0), then retracts at ``rate``. Only the BEM runs it.
     dwell_hold : {"force", "depth"}
         What the dwell holds: the load at ``preload`` (default) or the indentation.
+    machine_stiffness : float, optional
+        Stiffness K of the machine in series with the sphere (its force sensor), in pi dg R
+        per d_ref, > 0; None (default) is a rigid machine. The machine drives its own
+        displacement D at the unloading rate, dD/dt = -rate h0, and the sphere's indentation
+        is delta = D - P/K (docs/design.md, "Machine compliance"). Only the BEM runs it.
     """
 
     n: float = axis(help="MPL exponent (spectrum broadness); unused by sls", limits=(0.0, 5.0),
@@ -387,6 +392,12 @@ class Scene:
                                order=-7)
     dwell_hold: str = axis("force", help="protocol: what the dwell holds, the load (force) or "
                            "the indentation (depth)", choices=DWELL_HOLDS, order=-6)
+    machine_stiffness: float | None = axis(None, help="stiffness of the machine (force "
+                                           "sensor) in series with the sphere: the machine "
+                                           "drives D(t), the sphere's indentation is D - P/K "
+                                           "(none: a rigid machine; models bem and auto)",
+                                           unit="pi dg R/d_ref", limits=(0.0, 1e30),
+                                           lo_open=True, label=r"$\hat K$", order=-5)
 
     def __post_init__(self):
         info = _axes_of(type(self))
@@ -914,8 +925,8 @@ class Result:
     def __repr__(self) -> str:
         """A one-line summary: status (and reason), pull-off (pi dg R), crack speed
         (a_ref/tau0), model, steps, the trajectory's length (never its arrays) and the
-        scene's axes (the process zone where there is one); the full rows are
-        :meth:`to_row` and :meth:`to_dict`."""
+        scene's axes (the process zone and the machine's stiffness where given); the full
+        rows are :meth:`to_row` and :meth:`to_dict`."""
         points = len(next(iter(self.trajectory.values()), ()))
         reason = self.reason if len(self.reason) <= 80 else self.reason[:77] + "..."
         sc = self.scene
@@ -926,6 +937,8 @@ class Result:
             start = f"a0={sc.a0:g}" if sc.a0 is not None else f"delta0={sc.delta0:g}"
         pz = (f" pz_law={sc.pz_law} pz_v0={sc.pz_v0:g} pz_xi={sc.pz_xi:g}"
               if sc.pz_law != "none" else "")
+        if sc.machine_stiffness is not None:
+            pz += f" machine_stiffness={sc.machine_stiffness:g}"
         return (f"Result({self.status}{' (' + reason + ')' if reason else ''}: "
                 f"pull_off={self.pull_off:.6g} crack_speed={self.crack_speed:.6g} "
                 f"model={self.model_used or sc.model} steps={self.steps} "

@@ -14,7 +14,8 @@ and ``pz_xi`` (its exponent), converted to ``pz_v0`` in a_ref/tau0
 ``approach_speed`` [m/s], ``preload`` [N] (then the force at the end of the approach),
 ``dwell`` [s] and ``dwell_hold`` ("force" or "depth"), converted to the Scene's
 ``approach_rate`` (r-hat), ``preload`` (pi dg R) and ``dwell`` (tau0); ``speed`` is then the
-retraction's.
+retraction's; optionally a compliant machine, ``machine_stiffness`` [N/m] (the force
+sensor's stiffness in series with the sphere), converted to pi dg R / d_ref.
 
 Derived: ``k = E0/Einf``, ``mu`` (Tabor), ``rate = speed tau0 / h0`` (the paper's r-hat), the
 initial ``a0_hat`` (a_ref) or ``delta0_hat`` (d_ref).
@@ -38,8 +39,8 @@ from dataclasses import asdict, dataclass
 
 from .. import units
 from ..engine.crack_front import scene_law, unload
-from ..engine.models import (PROCESS_ZONE_REFUSALS, PROTOCOL_REFUSALS, choose_model,
-                             pb_estimate, simulate_model)
+from ..engine.models import (MACHINE_REFUSALS, PROCESS_ZONE_REFUSALS, PROTOCOL_REFUSALS,
+                             choose_model, pb_estimate, simulate_model)
 from ..errors import InputError, as_float, check_choice, check_positive, check_range
 from ..scene import (AXES, DWELL_HOLDS, MATERIALS, PZ_LAWS, SCENE_LIMITS, Axis, Scene,
                      SceneTable, check_process_zone, scene_table)
@@ -85,6 +86,8 @@ SI_AXES = {a.name: a for a in (
              "adhesion (with pz_law gent-schultz)", required=False, order=2),
     _si_axis("pz_xi", "", "process zone: exponent of Gamma_pz(v) (with pz_law gent-schultz)",
              hi=AXES["pz_xi"].limits[1], required=False, order=2),
+    _si_axis("machine_stiffness", "N/m", "stiffness of the machine (force sensor) in series "
+             "with the sphere (unset: a rigid machine)", required=False, order=2),
 )}
 #: The initial-state fields of an SI grid: exactly one is given.
 SI_INITIAL = ("preload", "a0", "indentation")
@@ -117,6 +120,7 @@ class SIScene:
     approach_speed: float | None = None
     dwell: float | None = None
     dwell_hold: str = "force"
+    machine_stiffness: float | None = None
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
@@ -180,6 +184,9 @@ class SIScene:
         if self.pz_xi is not None:
             set_("pz_xi", AXES["pz_xi"].check(self.pz_xi))
         check_process_zone(self.pz_law, self.pz_v0, self.pz_xi, "m/s")
+        if self.machine_stiffness is not None:
+            set_("machine_stiffness", check_positive("machine_stiffness",
+                                                     self.machine_stiffness))
 
     # ---- scales ------------------------------------------------------------------------------
     @property
@@ -216,7 +223,8 @@ class SIScene:
         """``n, k, mu, rate, material``, ``a0`` (a_ref) or ``delta0`` (d_ref), and the process
         zone ``pz_law``, ``pz_v0`` (a_ref/tau0), ``pz_xi`` (None without one); with a test
         protocol ``approach_rate`` (r-hat), ``preload`` (pi dg R), ``dwell`` (tau0) and
-        ``dwell_hold`` instead of ``a0`` and ``delta0``.
+        ``dwell_hold`` instead of ``a0`` and ``delta0``; ``machine_stiffness`` (pi dg R/d_ref,
+        None for a rigid machine).
 
         Without a protocol a preload becomes the relaxed JKR contact radius at that load.
         """
@@ -226,7 +234,9 @@ class SIScene:
              "a0": None, "delta0": None, "pz_law": self.pz_law,
              "pz_v0": (None if self.pz_v0 is None
                        else float(sc.crack_speed_hat(self.pz_v0, self.tau0))),
-             "pz_xi": self.pz_xi}
+             "pz_xi": self.pz_xi,
+             "machine_stiffness": (None if self.machine_stiffness is None
+                                   else float(sc.load_hat(self.machine_stiffness * sc.d_ref)))}
         if self.has_protocol:
             d.update(approach_rate=float(sc.rate_hat(self.approach_speed, self.tau0)),
                      preload=float(sc.load_hat(self.preload)), dwell=self.dwell / self.tau0,
@@ -249,14 +259,15 @@ class SIScene:
     def from_dimensionless(cls, *, n, k, mu, rate, R, E0, nu, tau0, dg, a0=None, delta0=None,
                            material="mpl", pz_law="none", pz_v0=None, pz_xi=None,
                            approach_rate=None, preload=None, dwell=None,
-                           dwell_hold="force") -> "SIScene":
+                           dwell_hold="force", machine_stiffness=None) -> "SIScene":
         """The SI scene of a dimensionless one for a chosen sphere and material.
 
         ``h0`` follows from ``mu`` (``mu^3 = R dg^2 / (E0*^2 h0^3)``), the speed from ``rate``,
         the initial state from ``a0`` (-> contact radius [m]) or ``delta0`` (-> indentation);
         a process zone's ``pz_v0`` (a_ref/tau0 -> m/s); a test protocol's ``approach_rate``
         (-> ``approach_speed`` [m/s]), ``preload`` (pi dg R -> N) and ``dwell`` (tau0 -> s)
-        instead of ``a0`` and ``delta0``.
+        instead of ``a0`` and ``delta0``; a compliant machine's ``machine_stiffness``
+        (pi dg R/d_ref -> N/m).
         """
         E0s = check_positive("E0", E0) / (1.0 - check_range("nu", nu, 0.0, 0.5) ** 2)
         h0 = (check_positive("R", R) * check_positive("dg", dg) ** 2 / E0s**2) ** (1.0 / 3.0) \
@@ -265,6 +276,8 @@ class SIScene:
         kw = {"pz_law": pz_law, "pz_xi": pz_xi, "dwell_hold": dwell_hold}
         if pz_v0 is not None:
             kw["pz_v0"] = float(sc.crack_speed_physical(pz_v0, tau0))
+        if machine_stiffness is not None:
+            kw["machine_stiffness"] = float(sc.load_physical(machine_stiffness)) / sc.d_ref
         if dwell is not None or approach_rate is not None:
             if a0 is not None or delta0 is not None or None in (approach_rate, preload, dwell):
                 raise InputError("approach_rate/preload/dwell: a protocol gives all three, and "
@@ -360,6 +373,9 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
     elif model in PROTOCOL_REFUSALS and si.has_protocol:
         dim = {"status": "failed", "reason": PROTOCOL_REFUSALS[model], "a0": None,
                "delta0": None}
+    elif model in MACHINE_REFUSALS and si.machine_stiffness is not None:
+        dim = {"status": "failed", "reason": MACHINE_REFUSALS[model], "a0": d["a0"],
+               "delta0": d["delta0"]}
     elif model == "pb" and d["pz_law"] != "none":
         dim = {"status": "failed", "reason": PROCESS_ZONE_REFUSALS["pb"].format(**d),
                "a0": d["a0"], "delta0": d["delta0"]}

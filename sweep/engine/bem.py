@@ -181,7 +181,7 @@ def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int
                           PULLOFF_ZONE_SPACINGS * pb.mesh.spacing)
     status, run.n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
                            Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, pb.scene.rate,
-                                   pb.hdot_c, pb.pz_xi),
+                                   pb.hdot_c, pb.pz_xi, pb.machine_compliance),
                            control, RunState(run.h, run.delta0, run.q, run.n, run.step,
                                              run.sigma, run.h_prev),
                            Records(*run.records, h_out), run.cache, run.stats)
@@ -266,7 +266,8 @@ def _finish(pb: Problem, res: Result, status: int, stats,
         return "inner" if a[-1] < pb.tip_range[0] else "outer"
     finish(res, status, res.trajectory, dr, min_travel, pb.scales,
            advice=refine_advice(pb.numerics),
-           remeshed=(retraction_from,) if retraction_from > 0 else ())
+           remeshed=(retraction_from,) if retraction_from > 0 else (),
+           machine_stiffness=pb.scene.machine_stiffness)
     return None
 
 

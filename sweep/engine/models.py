@@ -56,8 +56,8 @@ from .problem import BEM_MU_RANGE, derive
 from .resolution import refined, unresolved
 from .quasistatic import simulate_elastic
 
-__all__ = ["MODELS", "PROCESS_ZONE_REFUSALS", "PROTOCOL_REFUSALS", "simulate", "pb_estimate", "simulate_pb",
-           "simulate_model",
+__all__ = ["MODELS", "MACHINE_REFUSALS", "PROCESS_ZONE_REFUSALS", "PROTOCOL_REFUSALS",
+           "simulate", "pb_estimate", "simulate_pb", "simulate_model",
            "simulate_scene", "choose_model", "model_choice", "Choice", "measured_error",
            "bem_nodes_needed", "bem_node_budget", "wants_quasistatic", "wants_tip_following"]
 
@@ -191,7 +191,8 @@ def wants_tip_following(scene, numerics) -> bool:
     carries no opening rates) or a test protocol (the window starts at a0)."""
     if not (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact):
         return False
-    if scene.pz_law != "none" or scene.protocol() is not None:
+    if (scene.pz_law != "none" or scene.protocol() is not None
+            or scene.machine_stiffness is not None):
         return False
     graded = bem_nodes_needed(scene, numerics)
     if graded > numerics.max_nodes:
@@ -303,6 +304,9 @@ def model_choice(scene, numerics=None) -> Choice:
     if scene.protocol() is not None:
         return Choice("bem", "auto: BEM, the one model with a test protocol (approach, dwell, "
                              "retract)")
+    if scene.machine_stiffness is not None:
+        return Choice("bem", "auto: BEM, the one model with a compliant machine "
+                             "(machine_stiffness)")
     if scene.pz_law != "none":
         return Choice("crack", f"auto: crack-front model with the process zone (pz_law "
                                f"{scene.pz_law}), the BEM's local law where its error "
@@ -357,11 +361,13 @@ MODELS = {"bem": _bem, "crack": simulate_crack, "pb": simulate_pb, "elastic": si
 def wants_quasistatic(scene, numerics) -> bool:
     """Whether a "bem" or "auto" scene is elastic and quasi-static, so that the equilibrium
     branch (:mod:`sweep.engine.quasistatic`) answers it without the hereditary machinery: k = 1,
-    no process zone (a rate-dependent interface is not quasi-static), started from a0,
-    stopped at the pull-off, on the engine's own mesh (an explicit
-    ``numerics.domain`` or ``exact`` asks for the hereditary BEM on that domain)."""
+    no process zone (a rate-dependent interface is not quasi-static), a rigid machine (the
+    branch prescribes the sphere's indentation), started from a0, stopped at the pull-off, on
+    the engine's own mesh (an explicit ``numerics.domain`` or ``exact`` asks for the
+    hereditary BEM on that domain)."""
     return (scene.k == 1.0 and scene.a0 is not None and scene.stop == "pulloff"
-            and numerics.domain is None and not numerics.exact and scene.pz_law == "none")
+            and numerics.domain is None and not numerics.exact and scene.pz_law == "none"
+            and scene.machine_stiffness is None)
 
 
 #: a crack row with a process zone: its difference from the BEM's local law, measured by
@@ -405,16 +411,33 @@ PROTOCOL_REFUSALS = {
 }
 
 
+#: why each model but the BEM refuses a scene with a compliant machine (``machine_stiffness``):
+#: a failed row with this reason (not a physical refusal: the BEM answers it; auto sends it
+#: there)
+MACHINE_REFUSALS = {
+    "crack": "the crack-front model prescribes the sphere's indentation: a compliant machine "
+             "(machine_stiffness) runs with model bem or auto",
+    "elastic": "the elastic branch prescribes the sphere's indentation: a compliant machine "
+               "(machine_stiffness) runs with model bem or auto",
+    "pb": "the pb estimate's v-r fit was measured with a rigid machine: a compliant machine "
+          "(machine_stiffness) runs with model bem or auto",
+}
+
+
 def _run(model: str, scene, numerics) -> Result:
     """``MODELS[model]``; a numerical failure is a failed result, a bug raises; a scene with
-    a process zone or a protocol that the model has no law for is refused
-    (:data:`PROCESS_ZONE_REFUSALS`, :data:`PROTOCOL_REFUSALS`)."""
+    a process zone, a protocol or a compliant machine that the model has no law for is
+    refused (:data:`PROCESS_ZONE_REFUSALS`, :data:`PROTOCOL_REFUSALS`,
+    :data:`MACHINE_REFUSALS`)."""
     if scene.pz_law != "none" and model in PROCESS_ZONE_REFUSALS:
         return Result(scene=scene, numerics=numerics, status="failed",
                       reason=PROCESS_ZONE_REFUSALS[model].format(pz_law=scene.pz_law))
     if scene.protocol() is not None and model in PROTOCOL_REFUSALS:
         return Result(scene=scene, numerics=numerics, status="failed",
                       reason=PROTOCOL_REFUSALS[model])
+    if scene.machine_stiffness is not None and model in MACHINE_REFUSALS:
+        return Result(scene=scene, numerics=numerics, status="failed",
+                      reason=MACHINE_REFUSALS[model])
     try:
         budget.check(f"the {NAMES[model]}'s start")
         return MODELS[model](scene, numerics)

@@ -12,6 +12,25 @@ from ..kernels.solve import STATUS_DOMAIN, STATUS_NEWTON_FAILED, STATUS_STEP_LIM
 #: status of a run stopped by ``Numerics.time_budget_s`` (beside the kernel's STATUS_*)
 STATUS_TIME_BUDGET = -1
 
+#: a compliant machine (stiffness K) holds the sphere while dP/ddelta > -K: past the load
+#: minimum the load rises until the slope reaches -K, where the sphere jumps off (the
+#: machine's fold, no equilibrium nearby). A run whose solve fails after the minimum with
+#: the last records' slope below this fraction of -K has reached that fold: its pull-off is
+#: the minimum (measured on n 0.5, k 1, mu 3.24, a0 2: -0.06 and -0.19 at K = 0.1 and 0.3)
+MACHINE_FOLD_FRACTION = 0.5
+
+
+def machine_fold(P, delta, i_min: int, stiffness) -> float:
+    """The slope dP/ddelta (pi dg R/d_ref) of the last two records where they lie past the
+    load minimum ``i_min`` with the load risen, a compliant machine's (``stiffness`` K) run
+    ending there at its fold (:data:`MACHINE_FOLD_FRACTION`); nan otherwise (or for a rigid
+    machine, ``stiffness`` None)."""
+    n = len(P)
+    if stiffness is None or n - 1 - i_min < 2 or not P[-1] > P[i_min] or delta[-1] == delta[-2]:
+        return math.nan
+    slope = float((P[-1] - P[-2]) / (delta[-1] - delta[-2]))
+    return slope if slope <= -MACHINE_FOLD_FRACTION * stiffness else math.nan
+
 
 #: a parabola refinement lowering the sampled minimum by more than this fraction must
 #: also predict the neighbouring samples (see :func:`refine_minimum`)
@@ -141,7 +160,7 @@ def one_mesh_span(i: int, n: int, remeshed=()) -> tuple[int, int]:
 
 
 def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float, scales,
-           advice: str, remeshed=()) -> None:
+           advice: str, remeshed=(), machine_stiffness=None) -> None:
     """Fill ``res`` from a finished unloading, in place: ``ok`` with the pull-off, the state
     and crack speed at the pull-off instant, or a failure with its reason.
 
@@ -170,6 +189,9 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         on the mesh that ran).
     remeshed : indices of the first record on each new mesh (the tip-following mesh), empty
         for a run on one mesh.
+    machine_stiffness : the scene's compliant machine K (pi dg R/d_ref), None for a rigid
+        one: a solve failing at its fold after the minimum (:func:`machine_fold`) has passed
+        the pull-off.
     """
     t, delta, P, a, a_inner = (trajectory[k] for k in ("t", "delta", "P", "a", "a_inner"))
     i = int(np.argmin(P))
@@ -177,6 +199,9 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     i, t_star, P_star = refine_minimum(t[lo:hi], P[lo:hi])
     i += lo
     passed = stop_reached(P, a, len(P), i, 0, min_travel)
+    fold = machine_fold(P, delta, i, machine_stiffness) if status == STATUS_NEWTON_FAILED \
+        else math.nan
+    passed = passed or math.isfinite(fold)
     if status == STATUS_TIME_BUDGET:
         num = res.numerics
         coarser = ("fewer nodes" if num.mesh == "uniform" or num.nodes is not None
@@ -223,7 +248,10 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     if at_start:
         notes.append("load minimum at the initial state (the contact starts at or beyond its "
                      "pull-off): crack speed from the first step")
-    if status == STATUS_NEWTON_FAILED:
+    if status == STATUS_NEWTON_FAILED and math.isfinite(fold):
+        notes.append(f"stopped at the compliant machine's jump-off after pull-off (dP/ddelta "
+                     f"= {fold:.3g} against -K = {-machine_stiffness:.3g})")
+    elif status == STATUS_NEWTON_FAILED:
         notes.append("stopped at the jump-off instability after pull-off")
     edge = [m for m in (lo, hi) if 0 < m < len(P) and i in (m - 1, m)]
     if edge:

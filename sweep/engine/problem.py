@@ -209,6 +209,13 @@ class Problem:
         return 0.0 if self.scene.pz_law == "none" else float(self.scene.pz_xi)
 
     @property
+    def machine_compliance(self) -> float:
+        """1/K, the compliance of the machine in series with the sphere (d_ref per pi dg R;
+        0: a rigid machine, the default)."""
+        K = self.scene.machine_stiffness
+        return 0.0 if K is None else 1.0 / float(K)
+
+    @property
     def hm(self) -> float:
         """The gap at the crack tip, 3^(1/6) h0 (d_ref)."""
         return self.scales.tip_gap
@@ -331,6 +338,10 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"(pz_law {scene.pz_law})")
     if protocol and band is None:
         band = protocol_band(scene, numerics)
+    if scene.machine_stiffness is not None and (protocol or numerics.exact):
+        raise Refused("a compliant machine (machine_stiffness) runs on the BEM's unloading "
+                      "from a relaxed contact: not with " + ("a test protocol (approach, "
+                      "dwell, retract)" if protocol else "numerics.exact"))
     if numerics.exact and scene.pz_law != "none":
         raise Refused(f"numerics.exact: the exact hereditary reference has the Lennard-Jones "
                       f"interface only, not the process zone (pz_law {scene.pz_law}); leave "

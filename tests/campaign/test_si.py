@@ -375,3 +375,34 @@ def test_bad_table_in_an_si_config_exits_2_one_line(tmp_path, capsys):
     assert len(err) == 1 and err[0].startswith("error: ")
     assert "grid.material: " in err[0] and "times tau must be > 0" in err[0]
     assert "Traceback" not in err[0] and not (tmp_path / "b.h5").exists()
+
+
+def test_machine_stiffness_in_n_per_m():
+    """`machine_stiffness` [N/m] is K d_ref / (pi dg R) in the Scene (load over length units)
+    and back; the crack-front model refuses a compliant machine with the reason (the PDMS
+    test: mu 103, beyond the BEM)."""
+    from sweep.engine.models import MACHINE_REFUSALS
+
+    si = pdms(machine_stiffness=2.0e3)
+    d = si.dimensionless()
+    sc = si.scale
+    assert d["machine_stiffness"] == pytest.approx(2.0e3 * sc.a_ref**2 / si.R
+                                                   / (math.pi * si.dg * si.R), rel=1e-12)
+    back = SIScene.from_dimensionless(
+        n=d["n"], k=d["k"], mu=d["mu"], rate=d["rate"], a0=d["a0"], R=si.R, E0=si.E0,
+        nu=si.nu, tau0=si.tau0, dg=si.dg, machine_stiffness=d["machine_stiffness"])
+    assert back.machine_stiffness == pytest.approx(2.0e3, rel=1e-12)
+    assert pdms().dimensionless()["machine_stiffness"] is None
+    with pytest.raises(InputError, match="machine_stiffness"):
+        pdms(machine_stiffness=0.0)
+    out = run_si(si, "crack")
+    assert out["status"] == "failed" and out["reason"] == MACHINE_REFUSALS["crack"]
+
+
+def test_cli_scene_si_machine_stiffness_in_n_per_m(capsys):
+    assert main(SI_ARGS + ["--model", "crack", "--json", "--machine-stiffness", "2e3"]) == 1
+    d = json.loads(capsys.readouterr().out)
+    assert d["si"]["machine_stiffness"] == 2e3
+    assert d["scene"]["machine_stiffness"] == pytest.approx(
+        2e3 * d["d_ref_m"] / d["load_ref_N"], rel=1e-12)
+    assert d["status"] == "failed" and "machine_stiffness" in d["reason"]

@@ -73,6 +73,7 @@ def test_a_cold_warm_up_compiles_each_kernel_once(tmp_path):
             continue
         two = name in ("sweep.kernels.blas." + f for f in ("gemv_rows", "lu_factor", "lu_solve"))
         assert len(sigs) <= (2 if two else 1), (name, sigs)
-    for inlined in ("solve_step", "predict_step", "snap", "relax", "_refactorize", "_copy"):
+    for inlined in ("solve_step", "predict_step", "snap", "relax", "relax_machine",
+                    "machine_residual", "machine_direction", "_refactorize", "_copy"):
         assert "sweep.kernels.solve." + inlined not in seen
     assert "sweep.kernels.blas._gemv" not in seen and "sweep.kernels.blas._ints" not in seen

@@ -227,3 +227,36 @@ def test_relax_reaches_the_equilibrium_newton_finds():
     lj_traction_and_stiffness(hr, h0, c, sig, d)
     assert np.max(np.abs(hr - g - A @ (ceff * sig - H))) < 1e-10 * h0
     assert np.max(np.abs(hr - hn)) < 1e-8 * h0
+
+
+@pytest.mark.parametrize("stiffness", [0.3, 3.0])
+def test_newton_with_a_compliant_machine_is_the_rigid_solve_at_d_minus_p_over_k(stiffness):
+    # the machine at D, spring K: the solved gap must be the rigid machine's equilibrium at
+    # the sphere's indentation delta = D - P/K (numpy's residual there), and the iterations
+    # must converge (the Sherman-Morrison direction, checked against numpy's dense solve to
+    # 5e-5 at K = 0.3 from this start)
+    from sweep.engine.initial import ElasticSolver, relaxed_state
+    N = 120
+    A, _, h0, c, _ = _problem(N=N, seed=3)
+    r = np.arange(N) * 3.0 / (N - 1)
+    wP = np.asarray(uniform_mesh(N, 3.0).load_weights, float)
+    h_start, _ = relaxed_state(ElasticSolver(A, r, h0, c, 1e-10), delta0=1.0)
+    sig, d = np.empty(N), np.empty(N)
+    lj_traction_and_stiffness(h_start, h0, c, sig, d)
+    # the machine where the spring holds the start's load at an indentation 0.05 h0 less
+    ceff, D = 0.95, 1.0 - 0.05 * h0 + 2.0 * np.pi * wP @ sig / stiffness
+    H = -0.01 * np.exp(-r)
+    cache = ks.new_jacobian_cache(N)
+    stats = np.zeros(ks.N_STATS, np.int64)
+    hs = h_start.copy()
+    assert ks.newton_machine(hs, -D + h0 + 0.5 * r**2, A, ceff, H,
+                             lennard_jones(h0, c, N), 1e-11 * h0, 40, cache, stats,
+                             1.0 / stiffness, wP)
+    lj_traction_and_stiffness(hs, h0, c, sig, d)
+    P = 2.0 * np.pi * wP @ sig
+    delta = D - P / stiffness
+    assert abs(delta - (1.0 - 0.05 * h0)) > 1e-2 * h0         # the spring did move
+    g = -delta + h0 + 0.5 * r**2
+    assert np.max(np.abs(hs - g - A @ (ceff * sig - H))) < 1e-10 * h0
+    # measured 9 and 16 iterations at K = 3 and 0.3 (8 for a rigid machine, K = 1e6)
+    assert stats[ks.STAT_ITER] <= 20
