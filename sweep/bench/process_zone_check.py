@@ -14,7 +14,9 @@ The cost the issue bounds is measured on the bench scenes (``make bench``'s vs-n
 trade-off scenes, :func:`bench_cost`): each LJ scene, then the same scene with the
 Gent-Schultz process zone whose pz_v0 is :data:`BENCH_SPEED_MULTIPLES` times the LJ scene's
 crack speed at pull-off (1: the zone doubles the work of adhesion at the crack's own speed,
-a strong one; 10: a moderate one), timed in the same way. Written to
+a strong one; 10: a moderate one), timed in the same way, and the crack-front model's wall
+time on the same scene with the process zone (the median of :data:`REPEATS` runs after one
+untimed). Written to
 ``results/process_zone/check.json`` with a table on stdout.
 
 ``python -m sweep.bench.process_zone_check [--out PATH]``
@@ -70,16 +72,26 @@ def bench_cost() -> list[dict]:
             res, _ = _wall(scene)
             timed = [(_wall(scene)[1], _wall(plain)[1]) for _ in range(REPEATS)]
             w_pz, w = (float(np.median(x)) for x in zip(*timed))
+            crack = dataclasses.replace(scene, model="crack")
+            simulate(crack)                                     # its law's spectrum cached
+            w_crack = float(np.median([_timed_simulate(crack) for _ in range(REPEATS)]))
             row = {"scene": name, "speed_multiple": multiple, "pz_v0": scene.pz_v0,
                    "status": res.status, "amplification": res.pull_off / lj.pull_off,
                    "wall_s": w, "pz_wall_s": w_pz, "ratio": w_pz / w, "steps": lj.steps,
                    "pz_steps": res.steps, "factorizations": lj.factorizations,
-                   "pz_factorizations": res.factorizations}
+                   "pz_factorizations": res.factorizations, "crack_pz_wall_s": w_crack}
             rows.append(row)
             print(f"{name:28s} pz_v0 {multiple:g} x v: amplification {row['amplification']:.3f}"
                   f" ({res.status}), cost {row['ratio']:.2f} ({w_pz * 1e3:.0f} / {w * 1e3:.0f} ms,"
-                  f" steps {res.steps} / {lj.steps})", flush=True)
+                  f" steps {res.steps} / {lj.steps}); crack-front {w_crack * 1e3:.0f} ms",
+                  flush=True)
     return rows
+
+
+def _timed_simulate(scene: Scene) -> float:
+    t0 = time.perf_counter()
+    simulate(scene)
+    return time.perf_counter() - t0
 
 
 def _run(model: str, fields: dict, rate: float, pz: bool):
@@ -121,7 +133,13 @@ def measure() -> dict:
               for m in BENCH_SPEED_MULTIPLES}
     summary = {f"{m:g}": {"median": float(np.median(v)), "max": float(np.max(v))}
                for m, v in ratios.items()}
+    crack = [r["crack_pz_wall_s"] for r in bench]
+    summary["crack_front_wall_s"] = {"median": float(np.median(crack)), "max": float(np.max(crack))}
     for m, v in summary.items():
+        if m == "crack_front_wall_s":
+            print(f"the crack-front model with the process zone: median {v['median'] * 1e3:.0f} ms,"
+                  f" max {v['max'] * 1e3:.0f} ms a scene")
+            continue
         print(f"cost on the bench scenes, pz_v0 = {m} x the crack speed: median {v['median']:.2f},"
               f" max {v['max']:.2f}")
     return {"what": "BEM vs crack-front model with a Gent-Schultz process zone; the BEM's cost",
