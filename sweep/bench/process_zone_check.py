@@ -53,9 +53,10 @@ BENCH_SPEED_MULTIPLES = (1.0, 10.0)
 BENCH_XI = 0.5
 
 
-def _wall(scene: Scene):
+def _wall(scene: Scene, run=bem.simulate):
+    """``run(scene)`` at the balanced preset: (result, wall time in s)."""
     t0 = time.perf_counter()
-    res = bem.simulate(scene, Numerics.preset("balanced"))
+    res = run(scene, Numerics.preset("balanced"))
     return res, time.perf_counter() - t0
 
 
@@ -73,8 +74,8 @@ def bench_cost() -> list[dict]:
             timed = [(_wall(scene)[1], _wall(plain)[1]) for _ in range(REPEATS)]
             w_pz, w = (float(np.median(x)) for x in zip(*timed))
             crack = dataclasses.replace(scene, model="crack")
-            simulate(crack)                                     # its law's spectrum cached
-            w_crack = float(np.median([_timed_simulate(crack) for _ in range(REPEATS)]))
+            _wall(crack, simulate)                              # its law's spectrum cached
+            w_crack = float(np.median([_wall(crack, simulate)[1] for _ in range(REPEATS)]))
             row = {"scene": name, "speed_multiple": multiple, "pz_v0": scene.pz_v0,
                    "status": res.status, "amplification": res.pull_off / lj.pull_off,
                    "wall_s": w, "pz_wall_s": w_pz, "ratio": w_pz / w, "steps": lj.steps,
@@ -88,18 +89,11 @@ def bench_cost() -> list[dict]:
     return rows
 
 
-def _timed_simulate(scene: Scene) -> float:
-    t0 = time.perf_counter()
-    simulate(scene)
-    return time.perf_counter() - t0
-
 
 def _run(model: str, fields: dict, rate: float, pz: bool):
     extra = PZ if pz else {}
     scene = Scene(model=model, mu=MU, a0=A0, rate=rate, **fields, **extra)
-    t0 = time.perf_counter()
-    res = (bem.simulate if model == "bem" else simulate)(scene, Numerics.preset("balanced"))
-    return res, time.perf_counter() - t0
+    return _wall(scene, bem.simulate if model == "bem" else simulate)
 
 
 def measure() -> dict:

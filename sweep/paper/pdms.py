@@ -928,7 +928,8 @@ def protocol_lines(data: dict | None, crack_pb_mN: dict | None = None) -> list[s
          "and from the relaxed start at the contact radius the dwell ended with (the same "
          "geometry: what the bulk's history alone changes). `make pdms-protocol`, "
          "results/pdms/protocol.json, sweep/paper/pdms_protocol.py. A protocol's mesh is fine "
-         "from r = 0, and at the PDMS's mu the BEM would need 97,852 nodes: it runs the PDMS "
+         "from first contact out past the preload's radius, and at mu = 100 that mesh needs "
+         "161,887 nodes (balanced preset; the dense BEM takes a few thousand): it runs the PDMS "
          f"with h0 scaled to mu = {', '.join(f'{m:g}' for m in mus)} (loads in pi dg R, a_ref "
          "and d_ref unchanged).", "",
          "| r [um/s] | " + " | ".join(f"as run / relaxed at the JKR radius, mu {m:g}"

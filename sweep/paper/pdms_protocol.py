@@ -9,9 +9,10 @@ contact, approach at :data:`PROTOCOL` ``approach_speed_um_s`` to the preload, th
 force, retraction) and the relaxed start at the preload's relaxed JKR radius, at the paper's
 speeds, and reports their ratio.
 
-The BEM cannot run the PDMS's own Tabor parameter with a protocol: a protocol's approach crosses
-the whole contact, so its fine mesh band starts at r = 0, and at mu = 100 that band needs 97,852
-nodes (the engine's refusal, measured). As :func:`sweep.paper.pdms.bem_case` does for the linear
+The BEM cannot run the PDMS's own Tabor parameter with a protocol: a protocol's crack tip
+crosses the contact from first contact out to the preload's radius, all of it on the fine mesh,
+and at mu = 100 that mesh needs 161,887 nodes at the balanced preset (the engine's refusal,
+measured). As :func:`sweep.paper.pdms.bem_case` does for the linear
 BEM curve, the PDMS is run with h0 scaled to smaller Tabor parameters (:data:`MUS`; every other
 input unchanged: the loads in pi dg R, a_ref and d_ref are the PDMS's), and the ratio
 protocol/relaxed is reported at each: its spread over mu says how far it may be carried to the
@@ -101,8 +102,11 @@ def protocol_point(speed_um: float, mu: float, case=None, protocol=None,
         t0 = time.perf_counter()
         res = simulate(si.to_scene(model="bem"), _numerics())
         rows[name] = _row(res, si, time.perf_counter() - t0)
-        rows[name]["start_load_hat"] = float(res.trajectory["P"][0 if name == "relaxed" else
-                                                                 -1 - _retraction_records(res)])
+        # the load the retraction starts from: the relaxed start's first record, the
+        # protocol's last before the retraction (phase 2)
+        P = res.trajectory["P"]
+        rows[name]["start_load_hat"] = float(P[0] if name == "relaxed" else
+                                             P[res.trajectory["phase"] < 2][-1])
     # the relaxed start at the contact the dwell ended with: the same geometry, the bulk's
     # history apart (the relaxed start at the preload's JKR radius differs from it by the LJ
     # law's finite-mu correction as well)
@@ -122,13 +126,6 @@ def protocol_point(speed_um: float, mu: float, case=None, protocol=None,
             "combined_error": rows["relaxed"]["error_estimate"] + rows["protocol"]["error_estimate"],
             "combined_error_same_radius": (rows["relaxed_same_radius"]["error_estimate"]
                                            + rows["protocol"]["error_estimate"])}
-
-
-def _retraction_records(res) -> int:
-    """How many records of a protocol row's trajectory the retraction made after the dwell's
-    last (its ``phase`` 2)."""
-    phase = res.trajectory.get("phase")
-    return 0 if phase is None else int((phase == 2).sum())
 
 
 def protocol_curve(path, mus=MUS, speeds=SPEEDS_UM_S, log=print) -> dict:
