@@ -12,7 +12,7 @@ export NUMBA_NUM_THREADS ?= 1
 .PHONY: help venv demo test test-slow coverage-kernels bench bench-detail bench-reference \
         tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem pdms-protocol \
         agreement agreement-high-mu extremes tip-convergence elastic-table calibrate-demo \
-        model-errors error-coverage crack-speed random-sample docs-check docs
+        model-errors error-coverage extrapolation crack-speed random-sample docs-check docs
 
 help:
 	@echo "make demo   - create .venv, install, run a small default sweep end to end"
@@ -42,6 +42,7 @@ help:
 	@echo "make pz-map - the process zone's map from crack speed to opening rate (the table the BEM reads, ~1 min)"
 	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem (results/random/)"
 	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
+	@echo "make extrapolation - the estimate's pair as a Richardson pair, on error-coverage's references (~1 min)"
 	@echo "make crack-speed [QUICK=1] - the crack speed at pull-off per preset against a fine reference, per fit window (results/crack_speed/, ~6 min)"
 
 $(BIN)/python:
@@ -236,6 +237,11 @@ model-errors: $(STAMP)
 # per preset, on a seeded random sample (QUICK=1: 6 scenes)
 # then the accuracy asked for (Numerics.for_tolerance) at three tolerances on the same scenes
 # against the same references (issue 33 item 6)
+# the error estimate's pair as an extrapolation pair, on the scenes and references of
+# results/error_coverage/coverage.json (issue 33 item 2)
+extrapolation: $(STAMP)
+	$(BIN)/python -m sweep.bench.extrapolation
+
 error-coverage: $(STAMP)
 	$(BIN)/python -m sweep.bench.error_coverage $(if $(filter 1,$(QUICK)),--scenes 6 --out results/quick/error_coverage)
 	$(BIN)/python -m sweep.bench.error_coverage --tolerance 3e-2 --tolerance 1e-2 --tolerance 1e-3 $(if $(filter 1,$(QUICK)),--out results/quick/error_coverage)
