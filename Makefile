@@ -42,7 +42,7 @@ help:
 	@echo "make pz-map - the process zone's map from crack speed to opening rate (the table the BEM reads, ~1 min)"
 	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem (results/random/)"
 	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
-	@echo "make extrapolation - the estimate's pair as a Richardson pair, on error-coverage's references (~1 min)"
+	@echo "make extrapolation - the estimate's pair as a Richardson pair and the crossing check, on two samples' references (~1 min)"
 	@echo "make crack-speed [QUICK=1] - the crack speed at pull-off per preset against a fine reference, per fit window (results/crack_speed/, ~6 min)"
 
 $(BIN)/python:
@@ -239,8 +239,12 @@ model-errors: $(STAMP)
 # against the same references (issue 33 item 6)
 # the error estimate's pair as an extrapolation pair, on the scenes and references of
 # results/error_coverage/coverage.json (issue 33 item 2)
+# and on a second sample (seed 11), whose references are made once (about 25 min on 2 cores)
+SEED11 := results/error_coverage/references_seed11.json
 extrapolation: $(STAMP)
 	$(BIN)/python -m sweep.bench.extrapolation
+	test -f $(SEED11) || $(BIN)/python -m sweep.bench.extrapolation --references 40 --seed 11 --coverage $(SEED11)
+	$(BIN)/python -m sweep.bench.extrapolation --coverage $(SEED11) --out results/error_coverage/extrapolation_seed11.json
 
 error-coverage: $(STAMP)
 	$(BIN)/python -m sweep.bench.error_coverage $(if $(filter 1,$(QUICK)),--scenes 6 --out results/quick/error_coverage)

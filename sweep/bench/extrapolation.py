@@ -17,14 +17,24 @@ quarter of the resolution, P_4h (the same solve routine as the estimate's, its n
   with the order each scene's three solves show, p = log2((P_2h - P_4h)/(P_h - P_2h)));
 * the fraction of scenes whose P_x is nearer the reference than P_h;
 * the observed orders;
-* the coverage of the estimates: today's |P_h - P_2h|/P_h + Prony error for P_h, and the
-  size of the correction, |P_x - P_h|/P_h + Prony error, for P_x; and the three-resolution
-  estimate max(|P_h - P_2h|, |P_2h - P_4h|/4)/P_h + Prony error for P_h.
+* the coverage of the estimates: the pair's |P_h - P_2h|/P_h + Prony error for P_h, and the
+  size of the correction, |P_x - P_h|/P_h + Prony error, for P_x; the three-resolution
+  estimate max(|P_h - P_2h|, |P_2h - P_4h|/4)/P_h + Prony error for P_h, always; and the
+  row's own ``error_estimate`` (the engine's: the pair, with the third solve where the
+  pair's change is small enough to have crossed the limit,
+  :data:`sweep.engine.resolution.CROSSING_GATE`).
 
 Written to ``results/error_coverage/extrapolation.json`` (every scene's solves and the
 summary), a table on stdout.
 
+A second, independent sample (a seed other than error-coverage's, so that what was chosen
+on the first is checked on the second) gets its references with ``--references COUNT --seed
+SEED --coverage PATH`` (the sampler and the reference numerics of
+:mod:`sweep.bench.error_coverage`, the references alone, written to PATH as a coverage file)
+before the run: ``make extrapolation`` does both samples.
+
 ``python -m sweep.bench.extrapolation [--coverage PATH] [--out PATH] [-j N]``
+``python -m sweep.bench.extrapolation --references 40 --seed 11 --coverage PATH [-j N]``
 """
 from __future__ import annotations
 
@@ -84,6 +94,20 @@ def run_scene(scene: dict, reference: float, preset: str, budget_s: float = 60.0
             "coarse": got}
 
 
+def reference_row(scene: dict, budget_s: float = 30.0) -> dict:
+    """The reference run of one scene (:data:`sweep.bench.error_coverage.REFERENCE`, five
+    times ``budget_s``), as a row of a coverage file."""
+    from ..engine.models import simulate
+    from ..scene import Numerics, Scene
+    from .error_coverage import REFERENCE
+
+    ref = simulate(Scene(**scene),
+                   Numerics.preset("accurate", time_budget_s=5 * budget_s, **REFERENCE))
+    return {"scene": scene, "reference": {"status": ref.status, "reason": ref.reason,
+                                          "pull_off": ref.pull_off, "wall_s": ref.wall_s,
+                                          "nodes": ref.nodes_used}}
+
+
 def _observed_order(p_h, p_2h, p_4h) -> float:
     if p_h == p_2h or p_2h == p_4h:
         return math.nan
@@ -101,7 +125,7 @@ def summarize(rows: list[dict]) -> dict:
                and r["coarse"][0][0] != r["coarse"][1][0]]
         if not use:
             continue
-        e_h, e_x2, e_xp, est, est_x, est_3, orders = ([] for _ in range(7))
+        e_h, e_x2, e_xp, est, est_x, est_3, orders, engine = ([] for _ in range(8))
         for r in use:
             p_h, ref, prony = r["pull_off"], r["reference"], r["prony_error"]
             p_2h, p_4h = r["coarse"][0][2], r["coarse"][1][2]
@@ -116,8 +140,9 @@ def summarize(rows: list[dict]) -> dict:
             est.append(c1 + prony)
             est_x.append(c1 / 3.0 + prony)
             est_3.append(max(c1, c2 / 4.0) + prony)
-        e_h, e_x2, e_xp, est, est_x, est_3, orders = map(
-            np.asarray, (e_h, e_x2, e_xp, est, est_x, est_3, orders))
+            engine.append(r["error_estimate"])
+        e_h, e_x2, e_xp, est, est_x, est_3, orders, engine = map(
+            np.asarray, (e_h, e_x2, e_xp, est, est_x, est_3, orders, engine))
         tiny = 1e-16
 
         def cover(e, x):
@@ -139,6 +164,7 @@ def summarize(rows: list[dict]) -> dict:
             "estimate_pair": cover(e_h, est),
             "estimate_extrapolated": cover(e_x2, est_x),
             "estimate_three_resolutions": cover(e_h, est_3),
+            "estimate_engine": cover(e_h, engine),
         }
     return out
 
@@ -150,10 +176,28 @@ def _main(argv=None) -> int:
                    help="the error-coverage file whose scenes and references to use")
     p.add_argument("--out", default=str(OUT))
     p.add_argument("--jobs", "-j", type=int, default=2)
+    p.add_argument("--references", type=int, default=0, metavar="COUNT",
+                   help="draw COUNT scenes (error-coverage's sampler, --seed) and write their "
+                        "references to --coverage instead")
+    p.add_argument("--seed", type=int, default=11)
     args = p.parse_args(argv)
     from joblib import Parallel, delayed
 
     path = Path(args.coverage)
+    if args.references:
+        from .error_coverage import sample
+        t0 = time.perf_counter()
+        rows = Parallel(n_jobs=args.jobs)(delayed(reference_row)(d)
+                                          for d in sample(args.references, args.seed))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(to_jsonable(
+            {"what": "references of a seeded sample (sweep.bench.extrapolation)",
+             "seed": args.seed, "rows": rows, "wall_s": time.perf_counter() - t0,
+             "command": "python -m sweep.bench.extrapolation " + " ".join(
+                 sys.argv[1:] if argv is None else argv), **provenance()}), indent=1))
+        ok = sum(r["reference"]["status"] == "ok" for r in rows)
+        print(f"wrote {path}: {ok} of {len(rows)} references ok")
+        return 0
     if not path.exists():
         raise SystemExit(f"error: --coverage: no {path} (make error-coverage writes it)")
     t0 = time.perf_counter()
@@ -169,7 +213,8 @@ def _main(argv=None) -> int:
               f"extrapolated (p = 2) {s['median_error_extrapolated_p2']:.2g} (nearer in "
               f"{s['improved_p2']:.0%}, 2x worse in {s['worse_p2_by_2x']:.0%}), observed order "
               f"median {o['median']:.2f}, quartiles {o['quartiles'][0]:.2f}-{o['quartiles'][1]:.2f}")
-        for key in ("estimate_pair", "estimate_extrapolated", "estimate_three_resolutions"):
+        for key in ("estimate_pair", "estimate_extrapolated", "estimate_three_resolutions",
+                    "estimate_engine"):
             print(f"    {key:28s} coverage {s[key]['coverage']:.3f}, median looseness "
                   f"{s[key]['median_looseness']:.2g}")
     out = Path(args.out)

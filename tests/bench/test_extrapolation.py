@@ -1,6 +1,7 @@
 """The estimate's pair as an extrapolation pair (issue 33 item 2): the summary arithmetic on
 rows of known convergence, and the committed measurement
-(results/error_coverage/extrapolation.json, `make extrapolation`) recomputes from its rows."""
+(results/error_coverage/extrapolation.json and extrapolation_seed11.json, `make
+extrapolation`) recomputes from its rows."""
 from __future__ import annotations
 
 import json
@@ -11,14 +12,16 @@ import pytest
 from sweep.bench import extrapolation
 
 ROOT = Path(__file__).resolve().parents[2]
-COMMITTED = ROOT / "results" / "error_coverage" / "extrapolation.json"
+COMMITTED = [ROOT / "results" / "error_coverage" / name
+             for name in ("extrapolation.json", "extrapolation_seed11.json")]
 
 
 def _row(error_h, order, preset="balanced", reference=1.0, prony=0.0):
     """A scene whose pull-off converges as P(h) = ref (1 + error_h (h/h_fine)^order)."""
     p = [reference * (1.0 + error_h * 2.0 ** (order * j)) for j in range(3)]
     return {"preset": preset, "status": "ok", "reference": reference, "pull_off": p[0],
-            "prony_error": prony, "coarse": [(10.0, True, p[1]), (5.0, True, p[2])]}
+            "prony_error": prony, "error_estimate": abs(p[0] - p[1]) / p[0] + prony,
+            "coarse": [(10.0, True, p[1]), (5.0, True, p[2])]}
 
 
 def test_second_order_rows_extrapolate_exactly():
@@ -47,7 +50,8 @@ def test_a_crossing_pair_is_caught_by_the_third_solve():
     """P_h and P_2h on either side of the limit, close together: the pair's change misses the
     error, the coarser pair's (over 4) does not."""
     row = {"preset": "fast", "status": "ok", "reference": 1.0, "pull_off": 1.0 + 1e-3,
-           "prony_error": 0.0, "coarse": [(5.0, True, 1.0 + 8e-4), (2.5, True, 1.0 - 2e-2)]}
+           "prony_error": 0.0, "error_estimate": 2e-4,
+           "coarse": [(5.0, True, 1.0 + 8e-4), (2.5, True, 1.0 - 2e-2)]}
     s = extrapolation.summarize([row])["fast"]
     assert s["estimate_pair"]["coverage"] == 0.0
     assert s["estimate_three_resolutions"]["coverage"] == 1.0
@@ -59,8 +63,9 @@ def test_rows_without_a_third_solve_are_left_out():
     assert extrapolation.summarize([row, _row(1e-3, 2.0, preset="fast")]).keys() == {"fast"}
 
 
-def test_the_committed_measurement_recomputes_from_its_rows():
-    doc = json.loads(COMMITTED.read_text())
+@pytest.mark.parametrize("path", COMMITTED, ids=lambda p: p.name)
+def test_the_committed_measurement_recomputes_from_its_rows(path):
+    doc = json.loads(path.read_text())
     assert doc["command"] == "make extrapolation"
     summary = extrapolation.summarize(doc["rows"])
     for preset, s in summary.items():
