@@ -33,8 +33,15 @@ SEED --coverage PATH`` (the sampler and the reference numerics of
 :mod:`sweep.bench.error_coverage`, the references alone, written to PATH as a coverage file)
 before the run: ``make extrapolation`` does both samples.
 
+What the crossing check costs on a campaign: ``--crossing-cost CONFIG [--every K]`` runs
+every K-th scene of the config in one process, each with and without the check
+(:data:`sweep.engine.resolution.CROSSING_GATE` set to 0), alternating which goes first, and
+prints the two walls, their ratio and how many estimates the check raised
+(:func:`crossing_cost`).
+
 ``python -m sweep.bench.extrapolation [--coverage PATH] [--out PATH] [-j N]``
 ``python -m sweep.bench.extrapolation --references 40 --seed 11 --coverage PATH [-j N]``
+``python -m sweep.bench.extrapolation --crossing-cost configs/v_vs_r.yaml [--every K]``
 """
 from __future__ import annotations
 
@@ -106,6 +113,36 @@ def reference_row(scene: dict, budget_s: float = 30.0) -> dict:
     return {"scene": scene, "reference": {"status": ref.status, "reason": ref.reason,
                                           "pull_off": ref.pull_off, "wall_s": ref.wall_s,
                                           "nodes": ref.nodes_used}}
+
+
+def crossing_cost(config: str, every: int = 1) -> dict:
+    """Wall time of every ``every``-th scene of the sweep ``config`` with the crossing check
+    and without it (the gate 0), in this process, the order alternating scene by scene (the
+    first three scenes run once before, untimed), and the estimates the check raised."""
+    from ..campaign.config import load_config
+    from ..engine import resolution
+    from ..engine.models import simulate
+
+    cfg = load_config(config)
+    scenes, numerics = cfg.scenes()[::every], cfg.numerics
+    for scene in scenes[:3]:
+        simulate(scene, numerics)
+    gate = resolution.CROSSING_GATE
+    wall, raised = {gate: 0.0, 0.0: 0.0}, 0
+    try:
+        for i, scene in enumerate(scenes):
+            estimate = {}
+            for g in ((gate, 0.0) if i % 2 else (0.0, gate)):
+                resolution.CROSSING_GATE = g
+                t0 = time.perf_counter()
+                estimate[g] = simulate(scene, numerics).error_estimate
+                wall[g] += time.perf_counter() - t0
+            raised += bool(estimate[gate] > estimate[0.0] * (1.0 + 1e-9))
+    finally:
+        resolution.CROSSING_GATE = gate
+    return {"config": str(config), "every": every, "scenes": len(scenes),
+            "wall_with_s": wall[gate], "wall_without_s": wall[0.0],
+            "ratio": wall[gate] / wall[0.0], "estimates_raised": raised}
 
 
 def _observed_order(p_h, p_2h, p_4h) -> float:
@@ -180,7 +217,16 @@ def _main(argv=None) -> int:
                    help="draw COUNT scenes (error-coverage's sampler, --seed) and write their "
                         "references to --coverage instead")
     p.add_argument("--seed", type=int, default=11)
+    p.add_argument("--crossing-cost", metavar="CONFIG",
+                   help="time CONFIG's scenes with and without the crossing check instead")
+    p.add_argument("--every", type=int, default=1, help="with --crossing-cost: every K-th scene")
     args = p.parse_args(argv)
+    if args.crossing_cost:
+        c = crossing_cost(args.crossing_cost, args.every)
+        print(f"{c['config']}: {c['scenes']} scenes, with the crossing check "
+              f"{c['wall_with_s']:.1f} s, without {c['wall_without_s']:.1f} s, ratio "
+              f"{c['ratio']:.3f}; {c['estimates_raised']} estimates raised")
+        return 0
     from joblib import Parallel, delayed
 
     path = Path(args.coverage)

@@ -119,11 +119,11 @@ def refined(numerics: Numerics, res: Result) -> Numerics | None:
 COARSER_FACTORS = (2.0, math.sqrt(2.0))
 #: a pair whose change is below this fraction of (spacing / tip zone)^2 may have crossed the
 #: limit (the two pull-offs on either side of it, close together): a third solve, at a
-#: quarter of the resolution, decides (:func:`estimate_error`). Measured on the 30-32
-#: scenes of ``make error-coverage`` with a reference and 18-20 more of a second seed
-#: (``make extrapolation``, docs/numerics.md): the pair's change missed the true error in 2
-#: scenes of the fast and the accurate presets' samples, each with a change below 0.05
-#: (spacing / tip zone)^2; about a third of the rows run the third solve
+#: quarter of the resolution, decides (:func:`estimate_error`). Chosen on the 30-32 scenes
+#: of ``make error-coverage`` with a reference, where the pair's change missed the true
+#: error in 2 scenes each of the fast and the accurate presets, every one with a change
+#: below 0.05 (spacing / tip zone)^2, and checked on 21-26 scenes of a second seed
+#: (``make extrapolation``, docs/numerics.md); about a third of the rows run the third solve
 CROSSING_GATE = 0.05
 
 

@@ -73,3 +73,18 @@ def test_the_committed_measurement_recomputes_from_its_rows(path):
         assert s["scenes"] == stored["scenes"] >= 15
         for key in ("median_error", "median_error_extrapolated_p2", "improved_p2"):
             assert s[key] == pytest.approx(stored[key], rel=1e-12)
+
+
+def test_crossing_cost_runs_both_and_restores_the_gate(tmp_path):
+    """--crossing-cost times each scene with and without the check and leaves the gate as it
+    found it."""
+    from sweep.engine import resolution
+
+    config = tmp_path / "c.yaml"
+    config.write_text("name: c\ngrid: {n: 0.8, k: 0.1, mu: 3.24, a0: 1.5, rate: [1.0, 100.0]}\n"
+                      "numerics: {preset: fast}\noutput: c.h5\n")
+    gate = resolution.CROSSING_GATE
+    c = extrapolation.crossing_cost(str(config))
+    assert resolution.CROSSING_GATE == gate
+    assert c["scenes"] == 2 and c["wall_with_s"] > 0 and c["wall_without_s"] > 0
+    assert 0 <= c["estimates_raised"] <= 2
