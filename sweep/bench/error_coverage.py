@@ -60,13 +60,18 @@ def sample(count: int, seed: int = 0, bem_range: bool = True) -> list[dict]:
     return out
 
 
+def run_reference(d: dict, budget_s: float = 30.0) -> dict:
+    """The reference run of one scene (:data:`REFERENCE`, five times ``budget_s``): the
+    ``reference`` entry of a row."""
+    ref = simulate(Scene(**d), Numerics.preset("accurate", time_budget_s=5 * budget_s,
+                                                **REFERENCE))
+    return {"status": ref.status, "reason": ref.reason, "pull_off": ref.pull_off,
+            "wall_s": ref.wall_s, "nodes": ref.nodes_used}
+
+
 def run_scene(d: dict, budget_s: float = 30.0, probe: bool = False) -> dict:
     """Every preset and the reference on one scene: pull-offs, estimates, true errors."""
-    scene = Scene(**d)
-    ref = simulate(scene, Numerics.preset("accurate", time_budget_s=5 * budget_s, **REFERENCE))
-    row = {"scene": d, "reference": {"status": ref.status, "reason": ref.reason,
-                                     "pull_off": ref.pull_off, "wall_s": ref.wall_s,
-                                     "nodes": ref.nodes_used}}
+    row = {"scene": d, "reference": run_reference(d, budget_s)}
     for name in PRESET_NAMES:
         row[name] = run_preset(d, name, row["reference"], budget_s, probe)
     return row

@@ -66,7 +66,8 @@ OUT = Path("results") / "error_coverage" / "extrapolation.json"
 def _pairs(got: list):
     """While inside, every BEM error estimate appends (band resolution, ok, pull-off) of its
     coarser solve to ``got``, and of a third solve at a quarter of the resolution (the same
-    solve routine, :func:`sweep.engine.resolution.coarser` twice)."""
+    solve routine, :func:`sweep.engine.resolution.coarser` twice; the crossing check's own
+    where it ran)."""
     from ..engine import bem, resolution, tip_following
 
     original = resolution.estimate_error
@@ -77,7 +78,8 @@ def _pairs(got: list):
             got.append((numerics.band_resolution, bool(out.ok), float(out.pull_off)))
             return out
         original(res, length, recorded)
-        if res.ok and got and got[0][1] and res.numerics.pull_off_rtol > 0:
+        # the quarter-resolution solve, unless the estimate's crossing check made it
+        if res.ok and len(got) == 1 and got[0][1] and res.numerics.pull_off_rtol > 0:
             recorded(resolution.coarser(resolution.coarser(res.numerics, 2.0), 2.0))
 
     bem.estimate_error = tip_following.estimate_error = estimate
@@ -102,17 +104,11 @@ def run_scene(scene: dict, reference: float, preset: str, budget_s: float = 60.0
 
 
 def reference_row(scene: dict, budget_s: float = 30.0) -> dict:
-    """The reference run of one scene (:data:`sweep.bench.error_coverage.REFERENCE`, five
-    times ``budget_s``), as a row of a coverage file."""
-    from ..engine.models import simulate
-    from ..scene import Numerics, Scene
-    from .error_coverage import REFERENCE
+    """The reference run of one scene (:func:`sweep.bench.error_coverage.run_reference`), as
+    a row of a coverage file."""
+    from .error_coverage import run_reference
 
-    ref = simulate(Scene(**scene),
-                   Numerics.preset("accurate", time_budget_s=5 * budget_s, **REFERENCE))
-    return {"scene": scene, "reference": {"status": ref.status, "reason": ref.reason,
-                                          "pull_off": ref.pull_off, "wall_s": ref.wall_s,
-                                          "nodes": ref.nodes_used}}
+    return {"scene": scene, "reference": run_reference(scene, budget_s)}
 
 
 def crossing_cost(config: str, every: int = 1) -> dict:
