@@ -553,6 +553,12 @@ PRESETS = {
 MAX_REFINEMENTS = 6
 #: refinements of :meth:`Numerics.for_tolerance` (an accuracy asked for, not a preset)
 REFINEMENTS_ON_REQUEST = 3
+#: the node cap of an accuracy asked for (:meth:`Numerics.for_tolerance`) where the request
+#: gives none: the finest preset's, whatever preset it starts from, for its refinements reach
+#: the finer presets' resolutions (a request of 3e-2 starting from fast's max_nodes 400 could
+#: not refine a small contact whose relaxed start the fast mesh cannot hold: n 0.3724,
+#: k 0.001749, mu 9.684, a0 0.6012, rate 0.0012 needs a 523-node window at band resolution 18)
+REQUEST_MAX_NODES = max(p["max_nodes"] for p in PRESETS.values())
 #: numerics given by these keys alone, ``pull_off_rtol`` among them, ask for an accuracy:
 #: :meth:`Numerics.from_dict` resolves them with :meth:`Numerics.for_tolerance`
 TOLERANCE_REQUEST_KEYS = frozenset({"pull_off_rtol", "time_budget_s", "max_nodes", "max_steps",
@@ -715,7 +721,8 @@ class Numerics:
         row's ``error_estimate`` measures it) at the least cost: the cheapest preset whose
         own tolerance meets it (:func:`preset_for_tolerance`; the presets are the measured
         front of ``make tradeoff``), with ``pull_off_rtol`` and up to
-        :data:`REFINEMENTS_ON_REQUEST` refinements where a scene's estimate says no.
+        :data:`REFINEMENTS_ON_REQUEST` refinements where a scene's estimate says no, within
+        :data:`REQUEST_MAX_NODES` nodes unless ``max_nodes`` is given.
 
         Parameters
         ----------
@@ -725,7 +732,8 @@ class Numerics:
             Other :class:`Numerics` fields (``time_budget_s``, ``max_nodes``, ...).
         """
         rtol = check_range("pull_off_rtol", pull_off_rtol, 0.0, 1.0, lo_open=True)
-        fields = {"pull_off_rtol": rtol, "refinements": REFINEMENTS_ON_REQUEST, **overrides}
+        fields = {"pull_off_rtol": rtol, "refinements": REFINEMENTS_ON_REQUEST,
+                  "max_nodes": REQUEST_MAX_NODES, **overrides}
         return cls.preset(preset_for_tolerance(rtol), **fields)
 
     @classmethod

@@ -184,7 +184,17 @@ def test_an_unresolved_scene_is_refined_until_its_estimate_meets_the_tolerance()
 SMALL_CONTACT = Scene(n=0.3724, k=0.001749, mu=9.684, a0=0.6012, rate=0.0012)
 
 
-def test_a_relaxed_start_the_coarse_mesh_cannot_hold_is_refined():
+@pytest.fixture(scope="module")
+def small_contact_reference():
+    """SMALL_CONTACT at the accurate preset: a second resolution, its own estimate 1.4e-4."""
+    from sweep import simulate as front_door
+
+    ref = front_door(SMALL_CONTACT, Numerics.preset("accurate"))
+    assert ref.ok and ref.error_estimate < 3e-3, ref.reason
+    return ref
+
+
+def test_a_relaxed_start_the_coarse_mesh_cannot_hold_is_refined(small_contact_reference):
     """"initial state: ..." at fast is answered by one refinement: the pull-off within its
     estimate (and the tolerance) of the accurate preset's (a second resolution, its own
     estimate 1.4e-4 measured); without refinements the row stays failed."""
@@ -195,10 +205,31 @@ def test_a_relaxed_start_the_coarse_mesh_cannot_hold_is_refined():
     num = Numerics.preset("fast", max_nodes=1000, refinements=2)
     res = front_door(SMALL_CONTACT, num)
     assert res.ok and res.refinements >= 1, res.reason
-    ref = front_door(SMALL_CONTACT, Numerics.preset("accurate"))
-    assert ref.ok and ref.error_estimate < 0.1 * num.pull_off_rtol
+    ref = small_contact_reference
+    assert ref.error_estimate < 0.1 * num.pull_off_rtol
     err = abs(res.pull_off - ref.pull_off) / ref.pull_off
     assert err <= res.error_estimate + ref.error_estimate and err <= num.pull_off_rtol
+
+
+def test_a_request_refines_beyond_its_starting_presets_node_cap(small_contact_reference):
+    """An accuracy request of 3e-2 starts from fast (max_nodes 400) but refines within the
+    finest preset's node cap: SMALL_CONTACT's refinement needs a 523-node window, which
+    fast's cap refused ("mesh too large", the request undelivered, session 29). A
+    ``max_nodes`` given with the request still bounds it."""
+    from sweep import simulate as front_door
+    from sweep.scene import REQUEST_MAX_NODES
+
+    num = Numerics.for_tolerance(3e-2)
+    assert num.max_nodes == REQUEST_MAX_NODES == Numerics.preset("accurate").max_nodes
+    assert Numerics.for_tolerance(3e-2, max_nodes=400).max_nodes == 400
+    res = front_door(SMALL_CONTACT, num)
+    assert res.ok and res.refinements >= 1, res.reason
+    assert res.error_estimate <= num.pull_off_rtol
+    ref = small_contact_reference
+    err = abs(res.pull_off - ref.pull_off) / ref.pull_off
+    assert err <= res.error_estimate + ref.error_estimate and err <= num.pull_off_rtol
+    capped = front_door(SMALL_CONTACT, Numerics.for_tolerance(3e-2, max_nodes=400))
+    assert capped.status == "failed" and "max_nodes = 400" in capped.reason, capped.reason
 
 
 def test_for_tolerance_starts_from_the_cheapest_preset_that_meets_it():
