@@ -184,7 +184,9 @@ def _main(argv=None) -> int:
         old = json.loads(path.read_text())
         if args.grow and old["seed"] != args.seed:
             raise SystemExit(f"error: --grow: {path} has seed {old['seed']}, not {args.seed}")
-        rows, wall, commands = old["rows"], old["wall_s"], old["command"].split(" && ")
+        # a references file of ``make extrapolation`` (--references) records no wall time
+        rows, wall = old["rows"], old.get("wall_s", 0.0)
+        commands = old["command"].split(" && ")
     if args.rerun:
         jobs = [(i, name) for i, _ in enumerate(rows) for name in args.rerun]
         for (i, name), got in zip(jobs, Parallel(n_jobs=args.jobs)(
