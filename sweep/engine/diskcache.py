@@ -1,6 +1,7 @@
 """An on-disk cache of what a sweep derives again and again from a few numbers: the
-unit-spacing influence matrix (:func:`sweep.engine.mesh.unit_influence`) and the Prony series of a
-material on a time window (:func:`sweep.engine.problem.prony_series`).
+unit-spacing influence matrix (:func:`sweep.engine.mesh.unit_influence`), the Prony series of a
+material on a time window (:func:`sweep.engine.problem.prony_series`) and the relaxed starts
+(:func:`sweep.engine.initial.cached_state`).
 
 Both are pure functions of their key and of the source code that computes them, so each entry's
 file name carries a hash of that source (an edit there makes the old entries unused; they are

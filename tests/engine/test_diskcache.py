@@ -60,3 +60,67 @@ def test_damaged_or_switched_off_cache_falls_back_to_fitting(cache, monkeypatch)
     path.unlink()
     _same(problem.prony_series(*ARGS), fitted)
     assert not list(cache.glob("prony_*.npz"))
+
+
+# --- relaxed starts (sweep.engine.initial.cached_state) ---------------------------------
+
+RELAXED_SCENE = dict(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0)
+
+
+def _relaxed_run():
+    from sweep import Numerics, Scene
+    from sweep.engine import bem
+
+    return bem.simulate(Scene(**RELAXED_SCENE), Numerics.preset("fast"))
+
+
+def test_relaxed_start_is_kept_on_disk_and_read_back_bit_for_bit(cache, monkeypatch):
+    """A relaxed start solved once is read back by a process that has not solved it (its
+    memory cleared): the same gap, indentation and solver counters, so the row is the one
+    solved (every number; the second method: the row of a run with the disk cache off)."""
+    from sweep.engine import initial
+
+    initial.clear_relaxed_cache()
+    solved = _relaxed_run()
+    files = sorted(cache.glob("relaxed_*.npz"))
+    assert files                                        # the row's solve and its estimate's
+    initial.clear_relaxed_cache()                       # a new worker: memory empty
+    monkeypatch.setattr(initial, "_solve_relaxed",
+                        lambda *a, **kw: pytest.fail("solved again, not read from disk"))
+    read = _relaxed_run()
+    monkeypatch.undo()
+    monkeypatch.setenv(diskcache.CACHE_ENV, "off")
+    initial.clear_relaxed_cache()
+    fresh = _relaxed_run()
+    for res in (read, fresh):
+        assert res.ok and (res.pull_off, res.delta0_result, res.a0_result, res.error_estimate,
+                           res.newton_iterations, res.factorizations, res.steps) == \
+            (solved.pull_off, solved.delta0_result, solved.a0_result, solved.error_estimate,
+             solved.newton_iterations, solved.factorizations, solved.steps)
+    np.testing.assert_array_equal(read.trajectory["P"], solved.trajectory["P"])
+    np.testing.assert_array_equal(fresh.trajectory["P"], solved.trajectory["P"])
+    initial.clear_relaxed_cache()
+
+
+def test_relaxed_start_on_disk_checks_its_key_and_survives_damage(cache, monkeypatch):
+    """A file of another key under the same name, a damaged file and another version of the
+    engine's code are not read: the state is solved again (and the file rewritten)."""
+    from sweep.engine import initial
+
+    h = np.linspace(1.0, 2.0, 5)
+    initial.cached_state(("a", 1.0), lambda: (h, 0.5))
+    (path,) = cache.glob("relaxed_*.npz")
+    initial.clear_relaxed_cache()
+    assert initial._from_disk(("a", 1.0))[1] == 0.5
+    moved = initial._disk_path(("b", 2.0))
+    path.rename(moved)                                  # a digest collision, as it were
+    assert initial._from_disk(("b", 2.0)) is None
+    moved.write_bytes(b"\x00garbage")
+    assert initial._from_disk(("b", 2.0)) is None
+    calls = []
+    h2, d2 = initial.cached_state(("b", 2.0), lambda: calls.append(1) or (2.0 * h, 0.25))
+    assert calls == [1] and d2 == 0.25 and initial._from_disk(("b", 2.0))[1] == 0.25
+    initial.clear_relaxed_cache()
+    monkeypatch.setattr(initial, "_code_tag", lambda: "000000000000")
+    assert initial._from_disk(("b", 2.0)) is None       # solved by other code: not used
+    initial.clear_relaxed_cache()

@@ -308,8 +308,10 @@ def test_the_branch_start_is_solved_once_per_process_for_a_sweep_over_rates(monk
     max_nodes) depends on the window mesh, mu and a0 only: a second scene that differs in
     rate reuses it (the branch is not solved again), and a run from the cache gives the
     pull-off of a run that solved it (cleared cache: the second method)."""
+    from sweep.engine import diskcache
     from sweep.engine.initial import clear_relaxed_cache
 
+    monkeypatch.setenv(diskcache.CACHE_ENV, "off")   # the branch solved again once cleared
     num = Numerics.preset("fast", pull_off_rtol=0.0)
     slow, quick = (Scene(n=0.8, k=0.1, mu=3.24, a0=8.0, rate=r) for r in (10**0.5, 1e3))
     assert models.bem_nodes_needed(slow, num) > num.max_nodes
