@@ -16,7 +16,8 @@ The logarithmic singularity of K at s = r always sits at an end of a piece of a 
 (the r_i are nodes), so it is integrated exactly enough by Gauss-Legendre after the
 graded substitution ``s - r_i = L t^6`` on the pieces that touch r_i (error of order
 n^-12 for n points); the other pieces are smooth and use plain Gauss-Legendre (16 points
-next to the singularity, 8 points from three spacings on, where the nearest singularity
+next to the singularity, 8 points from three spacings on (6, 5 and 4 from 10, 20 and 50:
+FARTHER_PIECES), where the nearest singularity
 is far enough that the rule is exact to rounding).
 """
 from __future__ import annotations
@@ -34,11 +35,28 @@ GL16_W = 0.5 * _w16
 _x32, _w32 = np.polynomial.legendre.leggauss(32)
 GL32_X = 0.5 * (_x32 + 1.0)
 GL32_W = 0.5 * _w32
+_x6, _w6 = np.polynomial.legendre.leggauss(6)
+GL6_X = 0.5 * (_x6 + 1.0)
+GL6_W = 0.5 * _w6
+_x5, _w5 = np.polynomial.legendre.leggauss(5)
+GL5_X = 0.5 * (_x5 + 1.0)
+GL5_W = 0.5 * _w5
+_x4, _w4 = np.polynomial.legendre.leggauss(4)
+GL4_X = 0.5 * (_x4 + 1.0)
+GL4_W = 0.5 * _w4
 #: exponent of the graded substitution s - r_i = L t^GRADING on the pieces that touch r_i
 GRADING = 6.0
 #: a smooth piece whose midpoint lies more than this many piece lengths from r_i takes the
 #: 8-point rule (exact to rounding there), a nearer one the 16-point rule
 FAR_PIECES = 3.0
+#: ... and from these many piece lengths on the 6-, 5- and 4-point rules: the integrand is
+#: analytic ever further around the piece. Against the 8-point rule on the unit matrix of
+#: 600 nodes (every entry with |i - j| >= the threshold), the 6-point rule from 10 nodes
+#: differs by at most 1.3e-15 relative, the 5-point one from 20 by 1.0e-15 and the 4-point
+#: one from 50 by 2.2e-15 (rounding: the 4-point one from 20 differs by 2.1e-13, the
+#: 3-point one from 300 by 3.8e-14); most entries are that far, so a matrix assembles in
+#: about half the time (0.38 against 0.70 s for the 600 nodes)
+FARTHER_PIECES = (10.0, 20.0, 50.0)
 #: the AGM of :func:`ellipk_complement` stops when its two means agree to this relative
 #: difference (machine precision) ...
 AGM_RTOL = 1e-16
@@ -91,7 +109,14 @@ def _piece(r, sa, sb, phi_a, phi_b, singular_at, xs_smooth, ws_smooth, xs_sing, 
     L = sb - sa
     total = 0.0
     if singular_at == 0:
-        if abs(0.5 * (sa + sb) - r) > FAR_PIECES * L:
+        far = abs(0.5 * (sa + sb) - r)
+        if far > FARTHER_PIECES[2] * L:
+            xs_smooth, ws_smooth = GL4_X, GL4_W
+        elif far > FARTHER_PIECES[1] * L:
+            xs_smooth, ws_smooth = GL5_X, GL5_W
+        elif far > FARTHER_PIECES[0] * L:
+            xs_smooth, ws_smooth = GL6_X, GL6_W
+        elif far > FAR_PIECES * L:
             xs_smooth = xs_far
             ws_smooth = ws_far
         for q in range(xs_smooth.size):
