@@ -25,25 +25,20 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+
+def _gauss_legendre(n: int):
+    """The n-point Gauss-Legendre rule on [0, 1]: (nodes, weights)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
 # Gauss-Legendre rules on [0, 1]
-_x8, _w8 = np.polynomial.legendre.leggauss(8)
-GL8_X = 0.5 * (_x8 + 1.0)
-GL8_W = 0.5 * _w8
-_x16, _w16 = np.polynomial.legendre.leggauss(16)
-GL16_X = 0.5 * (_x16 + 1.0)
-GL16_W = 0.5 * _w16
-_x32, _w32 = np.polynomial.legendre.leggauss(32)
-GL32_X = 0.5 * (_x32 + 1.0)
-GL32_W = 0.5 * _w32
-_x6, _w6 = np.polynomial.legendre.leggauss(6)
-GL6_X = 0.5 * (_x6 + 1.0)
-GL6_W = 0.5 * _w6
-_x5, _w5 = np.polynomial.legendre.leggauss(5)
-GL5_X = 0.5 * (_x5 + 1.0)
-GL5_W = 0.5 * _w5
-_x4, _w4 = np.polynomial.legendre.leggauss(4)
-GL4_X = 0.5 * (_x4 + 1.0)
-GL4_W = 0.5 * _w4
+GL4_X, GL4_W = _gauss_legendre(4)
+GL5_X, GL5_W = _gauss_legendre(5)
+GL6_X, GL6_W = _gauss_legendre(6)
+GL8_X, GL8_W = _gauss_legendre(8)
+GL16_X, GL16_W = _gauss_legendre(16)
+GL32_X, GL32_W = _gauss_legendre(32)
 #: exponent of the graded substitution s - r_i = L t^GRADING on the pieces that touch r_i
 GRADING = 6.0
 #: a smooth piece whose midpoint lies more than this many piece lengths from r_i takes the
