@@ -231,8 +231,16 @@ def _solve_relaxed(el: ElasticSolver, delta0=None, a0=None):
     slope = 1.0 / max(2 * a0 - 0.5 ** 0.5 * a0 ** -0.5, MIN_JKR_DDELTA_DA)
     d2 = d1 - f1 / slope
     lo = hi = None
+    # the first step's start: the state at d1 plus the change of the JKR gap from d1 to d2
+    # (the interior stays in contact, the edge moves). The rigid shift of the whole gap by
+    # the change of indentation failed there where that step is large (mu 2.13, a0 9.58:
+    # three solves of 40 Newton iterations and a walk, 114 ms; now 6 iterations, 7.9 ms;
+    # 40 scenes of the data set's kind 0.42 s -> 0.09 s); it stays the start of the
+    # secant's later steps, whose changes of indentation are small
+    guess = np.maximum(h1 + jkr_gap_guess(el.r, d2, el.h0) - jkr_gap_guess(el.r, d1, el.h0),
+                       0.3 * h1)
     for _ in range(60):
-        ok, h2 = el.solve(d2, np.maximum(h1 + (d1 - d2), 0.3 * h1))
+        ok, h2 = el.solve(d2, guess)
         if not ok:
             h2 = _walk(el, d1, h1, d2)
             if h2 is None:
@@ -252,6 +260,7 @@ def _solve_relaxed(el: ElasticSolver, delta0=None, a0=None):
             d_new = 0.5 * (lo + hi)
         d1, h1, f1 = d2, h2, f2
         d2 = d_new
+        guess = np.maximum(h1 + (d1 - d2), 0.3 * h1)
         if lo is not None and hi is not None and hi - lo < 1e-13 * max(1.0, abs(d2)):
             return h2, float(d2)
     raise RuntimeError(f"could not reach the initial contact radius a0={a0:.6g}")
