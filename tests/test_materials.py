@@ -564,3 +564,51 @@ def test_compiled_lm_stops_where_a_weight_exceeds_1():
     b = 5.0 * np.exp(-tg / 1.0)                       # one mode of weight 5
     lt, status = lm_log_times(tg, sw, b, np.array([0.3]), -10.0, 10.0, 40)
     assert status == LM_BOUNDED and lt[0] == 0.3                 # stopped at the start
+
+
+# ============================================================ the fitter's shortcuts
+
+@pytest.mark.parametrize("n", [0.2207, 0.5, 0.9999, 1.0, 1.37, 2.0, 7.3])
+def test_mpl_series_at_a_few_times_is_the_termwise_sum(n):
+    """closed_forms._mpl_series on fewer than SERIES_TERMWISE_BELOW times (every term at once,
+    the Prony fitter's error check) against the term-at-a-time sum it replaces there: the
+    same terms added in the same order (here equal to the bit; asserted to 4 ulps), for the
+    compliance (d = 1) and its integral (d = 0), at integer and near-integer n (the paired
+    terms) as elsewhere."""
+    from sweep.materials import closed_forms as cf
+    rng = np.random.default_rng(11)
+    few = cf.SERIES_TERMWISE_BELOW - 1
+    for size in (1, 6, few):
+        T = np.exp(rng.uniform(math.log(1e-12), math.log(cf._mpl_switch(n)), size))
+        for d in (0, 1):
+            termwise = np.zeros_like(T)
+            for i in range(T.size):          # one time a call: never the few-times path ...
+                cf.SERIES_TERMWISE_BELOW, saved = 0, cf.SERIES_TERMWISE_BELOW
+                try:
+                    termwise[i] = cf._mpl_series(T[i:i + 1], n, d)[0]
+                finally:
+                    cf.SERIES_TERMWISE_BELOW = saved
+            got = cf._mpl_series(T, n, d)     # ... against it
+            np.testing.assert_allclose(got, termwise, rtol=1e-15, atol=0.0)
+
+
+def test_constant_minimax_is_the_linear_programs_optimum():
+    """fitting._constant_minimax (the closed form for a series without finite modes)
+    against the linear program it replaces (fitting._lp_weights, HiGHS): never a larger
+    maximum error, at most larger by rounding, and c >= 0; on random weights, a
+    compliance-like decreasing profile, all-equal values and values below zero."""
+    from sweep.materials.fitting import _constant_minimax, _lp_weights
+    rng = np.random.default_rng(5)
+    for trial in range(60):
+        m = int(rng.integers(2, 300))
+        y = rng.uniform(0.01, 1.0, m) if trial % 2 else np.sort(rng.uniform(0.05, 1.0, m))[::-1]
+        if trial % 7 == 0:
+            y = np.full(m, 0.3)
+        w = 1.0 / y
+        b = (1.0 - y) * w * (-1.0 if trial % 5 == 0 else 1.0)
+        c, e = _constant_minimax(w, b)
+        c_lp, _ = _lp_weights(w[:, None], b)
+        e_lp = float(np.abs(w * c_lp[0] - b).max())
+        assert c[0] >= 0.0 and e == pytest.approx(float(np.abs(w * c[0] - b).max()), rel=1e-15)
+        assert e <= e_lp * (1.0 + 1e-9)
+        assert e == pytest.approx(e_lp, rel=1e-6)

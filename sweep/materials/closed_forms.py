@@ -38,7 +38,11 @@ def _mpl_series(T: np.ndarray, n: float, d: int, J: int = 40) -> np.ndarray:
     No cancellation for small T (every term is O(T^2) or O(T^(n+1))).
     The factors that do not depend on T are computed once per (n, d, J)
     (:func:`_series_factors`; a Prony fit evaluates the series hundreds of times).
+    At most SERIES_TERMWISE_BELOW times, the terms are summed as one array
+    (:func:`_series_few`), in the same order, to the same bits.
     """
+    if T.size < SERIES_TERMWISE_BELOW:
+        return _series_few(T, n, d, J)
     lnT = np.log(T)
     out = np.zeros_like(T)
     unpaired, tail = _series_factors(n, d, J)
@@ -56,6 +60,44 @@ def _mpl_series(T: np.ndarray, n: float, d: int, J: int = 40) -> np.ndarray:
         logmag = power * lnT - lgn - lg1 - lg2
         out += scale * np.exp(logmag) * f
     return out
+
+
+#: below this many times :func:`_mpl_series` evaluates its terms as one (times x terms)
+#: array rather than a term at a time: a Prony fit's error check evaluates the compliance at
+#: a few refined times about a thousand times a fit, where the 40-80 NumPy operations of the
+#: term-wise sum on a few numbers cost 0.19 ms a call against 0.017 ms as one array (6
+#: times; 22 % of a fit's time on the data set's sample, 2026-11-26); on the fit's grids
+#: (hundreds of times) the term-wise sum is the faster, 0.33 against 1.2 ms at 900 times
+SERIES_TERMWISE_BELOW = 32
+
+
+def _series_few(T: np.ndarray, n: float, d: int, J: int) -> np.ndarray:
+    """:func:`_mpl_series` with every term evaluated at once and the terms added in the same
+    order as there (a sequential accumulation from zero: the same bits)."""
+    lnT = np.log(T)[:, None]
+    unpaired, (kind, tail) = _series_arrays(n, d, J)
+    sign_ratio, power, lg = unpaired
+    parts = [np.zeros((T.size, 1)), sign_ratio * np.exp(power * lnT - lg)]
+    if kind == "gamma":
+        g1n, power, lg1, lg2 = tail
+        parts.append(g1n * np.exp(power * lnT - lg1 - lg2))
+    else:
+        eps, (scale, dl1, dl2, power, lgn, lg1, lg2) = tail
+        D = lnT - dl1 - dl2
+        f = D if eps == 0.0 else np.expm1(eps * D) / eps
+        parts.append(scale * np.exp(power * lnT - lgn - lg1 - lg2) * f)
+    return np.add.accumulate(np.concatenate(parts, axis=1), axis=1)[:, -1].copy()
+
+
+@lru_cache(maxsize=256)
+def _series_arrays(n: float, d: int, J: int):
+    """:func:`_series_factors` as arrays, one per factor (a row of each term)."""
+    unpaired, (kind, factors) = _series_factors(n, d, J)
+    rows = (lambda terms, width: tuple(np.array(x, dtype=float) for x in zip(*terms))
+            if terms else (np.zeros(0),) * width)
+    if kind == "gamma":
+        return rows(unpaired, 3), (kind, rows(factors, 4))
+    return rows(unpaired, 3), (kind, (factors[0], rows(factors[1:], 7)))
 
 
 @lru_cache(maxsize=256)

@@ -66,6 +66,27 @@ def _nnls(M: np.ndarray, b: np.ndarray) -> np.ndarray:
     return c
 
 
+def _constant_minimax(w: np.ndarray, b: np.ndarray):
+    """min over c >= 0 of max_i |w_i c - b_i| (w > 0), in closed form: ([c], e).
+
+    With z_i = b_i / w_i the error is max_i w_i |c - z_i|, the upper envelope of lines; its
+    minimum is where a rising and a falling line cross, the largest of the crossings'
+    values over the pairs z_i < z_j: e = w_i w_j (z_j - z_i)/(w_i + w_j) at
+    c = (w_i z_i + w_j z_j)/(w_i + w_j); the error being convex, c < 0 moves to 0. It
+    replaces the fit's linear program for the constant (one per fit, about 2 ms of HiGHS
+    each, 10 % of a fit on the data set's sample)."""
+    z = b / w
+    gap = z[None, :] - z[:, None]
+    value = np.where(gap > 0.0, gap * (w[:, None] * w[None, :]) / (w[:, None] + w[None, :]),
+                     -np.inf)
+    if not np.isfinite(value).any():         # every z the same: the constant fits exactly
+        c = float(max(z[0], 0.0))
+    else:
+        i, j = np.unravel_index(int(np.argmax(value)), value.shape)
+        c = float(max((w[i] * z[i] + w[j] * z[j]) / (w[i] + w[j]), 0.0))
+    return np.array([c]), float(np.abs(w * c - b).max())
+
+
 def _local_maxima(r: np.ndarray) -> np.ndarray:
     """Indices of the local maxima of r (ends included)."""
     left = np.concatenate([[True], r[1:] >= r[:-1]])
@@ -134,7 +155,10 @@ class _Fitter:
         return _nnls(_design(self.tg, taus) * self.w[:, None], self.b)
 
     def minimax(self, taus):
-        """Minimax relative error with c >= 0 on the fit grid: LP with row exchange."""
+        """Minimax relative error with c >= 0 on the fit grid: LP with row exchange (no
+        finite mode: the constant alone, :func:`_constant_minimax`)."""
+        if taus.size == 0:
+            return _constant_minimax(self.w, self.b)
         M = _design(self.tg, taus) * self.w[:, None]
         b = self.b
         m = b.size
