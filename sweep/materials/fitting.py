@@ -25,10 +25,13 @@ def _loggrid(a: float, b: float, ppd: int) -> np.ndarray:
 
 
 def _design(t: np.ndarray, taus: np.ndarray) -> np.ndarray:
-    """Columns exp(-t/tau_i) and a final constant column."""
+    """Columns exp(-t/tau_i) and a final constant column (filled in place: a fit builds
+    about 200 of them, where np.hstack's own work was a third of the time)."""
+    A = np.empty((t.size, taus.size + 1))
     with np.errstate(under="ignore"):
-        A = np.exp(-t[:, None] / taus[None, :])
-    return np.hstack([A, np.ones((t.size, 1))])
+        A[:, :-1] = np.exp(-t[:, None] / taus[None, :])
+    A[:, -1] = 1.0
+    return A
 
 
 def _lp_weights(M: np.ndarray, b: np.ndarray):

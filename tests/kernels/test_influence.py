@@ -16,6 +16,19 @@ def test_ellipk_by_agm_matches_scipy():
     np.testing.assert_allclose(ours, ellipkm1(kc**2), rtol=1e-13)
 
 
+def test_ellipk_by_agm_is_accurate_to_rounding_over_the_whole_range():
+    """The AGM stops once its means agree to AGM_RTOL and returns pi/(a + b) (the means
+    converge quadratically): against scipy's ellipkm1 (Cephes, a second method) within a few
+    roundings on moduli from kc = 1e-300 (k -> 1, the logarithmic singularity) to 1."""
+    rng = np.random.default_rng(3)
+    kc = np.concatenate([np.logspace(-300, 0, 3000), rng.uniform(0.0, 1.0, 3000)[1:]])
+    ours = np.array([ellipk_complement(x) for x in kc])
+    wide = kc > 1e-150                      # kc^2 underflows below
+    np.testing.assert_allclose(ours[wide], ellipkm1(kc[wide] ** 2), rtol=2e-15, atol=0.0)
+    tiny = ~wide                            # K = ln(4/kc) + O(kc^2 ln kc) there
+    np.testing.assert_allclose(ours[tiny], np.log(4.0 / kc[tiny]), rtol=2e-15, atol=0.0)
+
+
 def test_matrix_matches_quadrature_of_the_elliptic_kernel():
     # independent assembly by scipy.integrate.quad (tests/naive.py); interior columns
     N = 40
