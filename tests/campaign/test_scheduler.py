@@ -197,8 +197,9 @@ def test_worker_warms_numba_cache_once(monkeypatch):
 def test_a_grid_without_bem_scenes_compiles_no_kernels_on_a_cold_cache(monkeypatch):
     """On a cold Numba cache the parent warms (compiles) the BEM kernels only where a scene
     needs them: model bem (not the elastic branch), or auto choosing the BEM; a crack-front
-    or PB grid compiles nothing, and its workers are told not to. On a warm cache it always
-    loads them (cheap)."""
+    or PB grid compiles nothing, and its workers are told not to. On a warm cache it loads
+    them where the scenes run in this process, and leaves them to the workers where they
+    run there."""
     import sweep.engine.bem as solver
     calls, cached = [], [False]
     monkeypatch.setattr(solver, "warm_up", lambda: calls.append(1) or 0.0)
@@ -215,6 +216,10 @@ def test_a_grid_without_bem_scenes_compiles_no_kernels_on_a_cold_cache(monkeypat
     assert scheduler._warm_parent(None, pb + auto_bem, num) and calls == [1, 1]
     cached[0] = True
     assert scheduler._warm_parent(None, crack, num) and calls == [1, 1, 1]
+    # a current cache, the scenes in workers: they load the kernels, the parent does not
+    assert scheduler._warm_parent(None, bem, num, in_workers=True) and calls == [1, 1, 1]
+    cached[0] = False          # a cold cache is compiled once, in the parent, all the same
+    assert scheduler._warm_parent(None, bem, num, in_workers=True) and calls == [1, 1, 1, 1]
 
 
 def test_dask_local_cluster_matches_loky(tmp_path):
