@@ -181,9 +181,10 @@ def crack_band(a0: float, l0: float, pull_off_only: bool = True) -> tuple[float,
 UNIT_BLOCK = 256
 #: a graded mesh whose lattice is wider than this many fine spacings (a fine band at large
 #: mu: 2.4e5 at mu = 100) has its influence matrix assembled on its own nodes
-#: (kernels.influence.assemble_nodes, about 1 s for 700 nodes) rather than combined from
-#: the unit-spacing matrix of the whole lattice, whose assembly costs about 3.5 us per entry
-#: (15 s at 2048, 2 min at 6000); it is assembled once per machine (see unit_influence)
+#: (kernels.influence.assemble_nodes, 0.13 s for 700 nodes) rather than combined from the
+#: unit-spacing matrix of the whole lattice, whose assembly costs about 0.28 us per entry
+#: (1.2 s at 2048; one run each, 2026-11-26; it was 3.5 us when this bound was set); it is
+#: assembled once per machine (see unit_influence)
 LATTICE_MAX_WIDTH = 2048
 _UNIT = [np.zeros((0, 0))]
 _MESH_CACHE: dict = {}
