@@ -28,7 +28,7 @@ def _same(a, b):
 
 def test_prony_fit_is_cached_on_disk_and_read_back_identical(cache, monkeypatch):
     fitted = problem.prony_series(*ARGS)
-    assert len(list(cache.glob("prony_*.npz"))) == 1
+    assert len(list(cache.glob("prony_*.rec"))) == 1
     problem.prony_series.cache_clear()                 # a new process: memory empty
     monkeypatch.setattr(problem, "material", lambda *a: pytest.fail("fitted again"))
     _same(problem.prony_series(*ARGS), fitted)
@@ -45,12 +45,12 @@ def test_prony_cache_is_not_used_after_the_fitting_code_changed(cache, monkeypat
     real = problem.material
     monkeypatch.setattr(problem, "material", lambda *a: calls.append(a) or real(*a))
     problem.prony_series(*ARGS)
-    assert len(calls) == 1 and len(list(cache.glob("prony_*.npz"))) == 2
+    assert len(calls) == 1 and len(list(cache.glob("prony_*.rec"))) == 2
 
 
 def test_damaged_or_switched_off_cache_falls_back_to_fitting(cache, monkeypatch):
     fitted = problem.prony_series(*ARGS)
-    (path,) = cache.glob("prony_*.npz")
+    (path,) = cache.glob("prony_*.rec")
     path.write_bytes(b"\x00garbage")
     problem.prony_series.cache_clear()
     _same(problem.prony_series(*ARGS), fitted)          # fitted again, file rewritten
@@ -59,7 +59,7 @@ def test_damaged_or_switched_off_cache_falls_back_to_fitting(cache, monkeypatch)
     problem.prony_series.cache_clear()
     path.unlink()
     _same(problem.prony_series(*ARGS), fitted)
-    assert not list(cache.glob("prony_*.npz"))
+    assert not list(cache.glob("prony_*.rec"))
 
 
 # --- relaxed starts (sweep.engine.initial.cached_state) ---------------------------------
@@ -82,7 +82,7 @@ def test_relaxed_start_is_kept_on_disk_and_read_back_bit_for_bit(cache, monkeypa
 
     initial.clear_relaxed_cache()
     solved = _relaxed_run()
-    files = sorted(cache.glob("relaxed_*.npz"))
+    files = sorted(cache.glob("relaxed_*.rec"))
     assert files                                        # the row's solve and its estimate's
     initial.clear_relaxed_cache()                       # a new worker: memory empty
     monkeypatch.setattr(initial, "_solve_relaxed",
@@ -109,7 +109,7 @@ def test_relaxed_start_on_disk_checks_its_key_and_survives_damage(cache, monkeyp
 
     h = np.linspace(1.0, 2.0, 5)
     initial.cached_state(("a", 1.0), lambda: (h, 0.5))
-    (path,) = cache.glob("relaxed_*.npz")
+    (path,) = cache.glob("relaxed_*.rec")
     initial.clear_relaxed_cache()
     assert initial._from_disk(("a", 1.0))[1] == 0.5
     moved = initial._disk_path(("b", 2.0))
@@ -124,3 +124,38 @@ def test_relaxed_start_on_disk_checks_its_key_and_survives_damage(cache, monkeyp
     monkeypatch.setattr(initial, "_code_tag", lambda: "000000000000")
     assert initial._from_disk(("b", 2.0)) is None       # solved by other code: not used
     initial.clear_relaxed_cache()
+
+
+def test_a_record_file_reads_back_every_array_to_the_bit(tmp_path):
+    """diskcache's record format (a .rec path): floats, integers, booleans, strings, 0-d and
+    2-d arrays come back equal to the bit, with their dtypes and shapes, and writable."""
+    arrays = {"h": np.random.default_rng(0).standard_normal(37),
+              "m": np.arange(12, dtype=np.int64).reshape(3, 4), "flag": np.array(True),
+              "key": np.array(repr(("graded", 0.1, (1, 2)))), "x": np.array(1e-300),
+              "empty": np.zeros(0)}
+    path = tmp_path / "a.rec"
+    assert diskcache.save(path, arrays)
+    got = diskcache.load(path)
+    assert list(got) == list(arrays)
+    for name, a in arrays.items():
+        assert got[name].dtype == a.dtype and got[name].shape == a.shape, name
+        np.testing.assert_array_equal(got[name], a)
+        assert got[name].flags.writeable
+    assert got["h"].tobytes() == arrays["h"].tobytes()
+
+
+@pytest.mark.parametrize("damage", ["truncate", "extend", "magic", "header"])
+def test_a_damaged_record_reads_as_missing(tmp_path, damage):
+    """A record cut short, grown, with another first line or a garbled layout reads as
+    None (the cache then computes the entry again); object arrays are never written."""
+    path = tmp_path / "a.rec"
+    assert diskcache.save(path, {"h": np.arange(5.0), "key": np.array("k")})
+    raw = path.read_bytes()
+    first = raw.index(b"\n") + 1
+    damaged = {"truncate": raw[:-3], "extend": raw + b"\x00",
+               "magic": b"x" + raw[1:],
+               "header": raw[:first] + b'[["h","<zz",[5],40]]' + raw[raw.index(b"\n", first):]}
+    path.write_bytes(damaged[damage])
+    assert diskcache.load(path) is None
+    with pytest.raises(ValueError, match="object"):
+        diskcache._record_bytes({"o": np.array([object()])})
