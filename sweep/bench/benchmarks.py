@@ -1052,7 +1052,7 @@ def _campaign_rows(df, rtol: float) -> dict:
 
 def _prony_files() -> int:
     """Prony series in the disk cache (one file per fit)."""
-    return len(list(diskcache.cache_dir().glob("prony_*.npz")))
+    return len(list(diskcache.cache_dir().glob(f"prony_*{diskcache.RECORD_SUFFIX}")))
 
 
 def bench_dataset_campaign(plan: BenchPlan) -> dict:

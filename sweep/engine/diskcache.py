@@ -53,7 +53,8 @@ def key_digest(key) -> str:
     return hashlib.sha1(repr(key).encode()).hexdigest()[:16]
 
 
-#: the first line of a record file (:func:`save` with a ``.rec`` path)
+#: the suffix of a record file (:func:`save`, :func:`load`), and its first line
+RECORD_SUFFIX = ".rec"
 RECORD_MAGIC = b"visco-sweep record 1\n"
 
 
@@ -101,7 +102,7 @@ def save(path: Path, arrays: dict) -> bool:
     for a ``.rec`` path, else .npz; False (nothing written) when the disk refuses."""
     tmp = None
     try:
-        payload = _record_bytes(arrays) if path.suffix == ".rec" else None
+        payload = _record_bytes(arrays) if path.suffix == RECORD_SUFFIX else None
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
         with os.fdopen(fd, "wb") as fh:
@@ -126,7 +127,7 @@ def load(path: Path, mmap: bool = False):
     """The array (.npy, memory-mapped read-only with ``mmap``) or dict of arrays (.rec or
     .npz) at ``path``; None when missing or unreadable."""
     try:
-        if path.suffix == ".rec":
+        if path.suffix == RECORD_SUFFIX:
             return _read_record(path)
         if path.suffix == ".npy":
             return np.load(path, mmap_mode="r" if mmap else None)

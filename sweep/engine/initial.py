@@ -71,7 +71,7 @@ def _code_tag() -> str:
 
 def _disk_path(key) -> Path | None:
     d = diskcache.cache_dir()
-    return None if d is None else d / f"relaxed_{_code_tag()}_{diskcache.key_digest(key)}.rec"
+    return None if d is None else d / f"relaxed_{_code_tag()}_{diskcache.key_digest(key)}{diskcache.RECORD_SUFFIX}"
 
 
 def _from_disk(key):

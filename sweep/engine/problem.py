@@ -130,7 +130,7 @@ def prony_series(kind: str, n: float, k: float, t_min: float, t_max: float, rtol
     d = diskcache.cache_dir()
     path = None
     if d is not None:
-        path = d / f"prony_{_materials_tag()}_{diskcache.key_digest(key)}.rec"
+        path = d / f"prony_{_materials_tag()}_{diskcache.key_digest(key)}{diskcache.RECORD_SUFFIX}"
         got = diskcache.load(path)
         if got is not None and _PRONY_FIELDS <= set(got) and tuple(got["key"]) == key[1:] \
                 and str(got["kind"]) == kind:

@@ -17,6 +17,9 @@ def cache(tmp_path, monkeypatch):
 
 
 ARGS = ("mpl", 0.8, 0.1, 1e-4, 1e2, 1e-3)
+#: the cache's files of Prony series and of relaxed starts
+PRONY = f"prony_*{diskcache.RECORD_SUFFIX}"
+RELAXED = f"relaxed_*{diskcache.RECORD_SUFFIX}"
 
 
 def _same(a, b):
@@ -28,7 +31,7 @@ def _same(a, b):
 
 def test_prony_fit_is_cached_on_disk_and_read_back_identical(cache, monkeypatch):
     fitted = problem.prony_series(*ARGS)
-    assert len(list(cache.glob("prony_*.rec"))) == 1
+    assert len(list(cache.glob(PRONY))) == 1
     problem.prony_series.cache_clear()                 # a new process: memory empty
     monkeypatch.setattr(problem, "material", lambda *a: pytest.fail("fitted again"))
     _same(problem.prony_series(*ARGS), fitted)
@@ -45,12 +48,12 @@ def test_prony_cache_is_not_used_after_the_fitting_code_changed(cache, monkeypat
     real = problem.material
     monkeypatch.setattr(problem, "material", lambda *a: calls.append(a) or real(*a))
     problem.prony_series(*ARGS)
-    assert len(calls) == 1 and len(list(cache.glob("prony_*.rec"))) == 2
+    assert len(calls) == 1 and len(list(cache.glob(PRONY))) == 2
 
 
 def test_damaged_or_switched_off_cache_falls_back_to_fitting(cache, monkeypatch):
     fitted = problem.prony_series(*ARGS)
-    (path,) = cache.glob("prony_*.rec")
+    (path,) = cache.glob(PRONY)
     path.write_bytes(b"\x00garbage")
     problem.prony_series.cache_clear()
     _same(problem.prony_series(*ARGS), fitted)          # fitted again, file rewritten
@@ -59,7 +62,7 @@ def test_damaged_or_switched_off_cache_falls_back_to_fitting(cache, monkeypatch)
     problem.prony_series.cache_clear()
     path.unlink()
     _same(problem.prony_series(*ARGS), fitted)
-    assert not list(cache.glob("prony_*.rec"))
+    assert not list(cache.glob(PRONY))
 
 
 # --- relaxed starts (sweep.engine.initial.cached_state) ---------------------------------
@@ -82,7 +85,7 @@ def test_relaxed_start_is_kept_on_disk_and_read_back_bit_for_bit(cache, monkeypa
 
     initial.clear_relaxed_cache()
     solved = _relaxed_run()
-    files = sorted(cache.glob("relaxed_*.rec"))
+    files = sorted(cache.glob(RELAXED))
     assert files                                        # the row's solve and its estimate's
     initial.clear_relaxed_cache()                       # a new worker: memory empty
     monkeypatch.setattr(initial, "_solve_relaxed",
@@ -109,7 +112,7 @@ def test_relaxed_start_on_disk_checks_its_key_and_survives_damage(cache, monkeyp
 
     h = np.linspace(1.0, 2.0, 5)
     initial.cached_state(("a", 1.0), lambda: (h, 0.5))
-    (path,) = cache.glob("relaxed_*.rec")
+    (path,) = cache.glob(RELAXED)
     initial.clear_relaxed_cache()
     assert initial._from_disk(("a", 1.0))[1] == 0.5
     moved = initial._disk_path(("b", 2.0))
@@ -133,7 +136,7 @@ def test_a_record_file_reads_back_every_array_to_the_bit(tmp_path):
               "m": np.arange(12, dtype=np.int64).reshape(3, 4), "flag": np.array(True),
               "key": np.array(repr(("graded", 0.1, (1, 2)))), "x": np.array(1e-300),
               "empty": np.zeros(0)}
-    path = tmp_path / "a.rec"
+    path = tmp_path / f"a{diskcache.RECORD_SUFFIX}"
     assert diskcache.save(path, arrays)
     got = diskcache.load(path)
     assert list(got) == list(arrays)
@@ -148,7 +151,7 @@ def test_a_record_file_reads_back_every_array_to_the_bit(tmp_path):
 def test_a_damaged_record_reads_as_missing(tmp_path, damage):
     """A record cut short, grown, with another first line or a garbled layout reads as
     None (the cache then computes the entry again); object arrays are never written."""
-    path = tmp_path / "a.rec"
+    path = tmp_path / f"a{diskcache.RECORD_SUFFIX}"
     assert diskcache.save(path, {"h": np.arange(5.0), "key": np.array("k")})
     raw = path.read_bytes()
     first = raw.index(b"\n") + 1
