@@ -62,7 +62,7 @@ def _record_bytes(arrays: dict) -> bytes:
     """A record: RECORD_MAGIC, one line of JSON listing each array's name, dtype, shape and
     byte count, then the arrays' bytes in that order. Read back by one ``read`` and one JSON
     parse (:func:`_read_record`): an .npz of the same arrays parses a zip directory and one
-    header per array (0.5-0.8 ms a file against about 0.05 ms; a warm campaign reads three
+    header per array (0.5-0.8 ms a file against about 0.1 ms; a warm campaign reads three
     files a scene). Numbers and strings only: no object arrays (no pickle)."""
     parts, layout = [], []
     for name, value in arrays.items():
