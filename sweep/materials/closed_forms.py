@@ -39,7 +39,7 @@ def _mpl_series(T: np.ndarray, n: float, d: int, J: int = 40) -> np.ndarray:
     No cancellation for small T (every term is O(T^2) or O(T^(n+1))).
     The factors that do not depend on T are computed once per (n, d, J)
     (:func:`_series_factors`; a Prony fit evaluates the series hundreds of times).
-    At most SERIES_TERMWISE_BELOW times, the terms are summed as one array
+    On fewer than SERIES_TERMWISE_BELOW times the terms are summed as one array
     (:func:`_series_few`), in the same order, to the same bits.
     """
     if T.size < SERIES_TERMWISE_BELOW:
