@@ -58,6 +58,14 @@ RECORD_SUFFIX = ".rec"
 RECORD_MAGIC = b"visco-sweep record 1\n"
 
 
+def record_path(kind: str, tag, key) -> Path | None:
+    """Where the record of ``key`` is kept: ``<kind>_<tag>_<key digest>.rec`` in the cache
+    directory, ``tag`` (a callable, called only with the cache on) naming the code that
+    computes it; None when the cache is off."""
+    d = cache_dir()
+    return None if d is None else d / f"{kind}_{tag()}_{key_digest(key)}{RECORD_SUFFIX}"
+
+
 def _record_bytes(arrays: dict) -> bytes:
     """A record: RECORD_MAGIC, one line of JSON listing each array's name, dtype, shape and
     byte count, then the arrays' bytes in that order. Read back by one ``read`` and one JSON

@@ -69,15 +69,10 @@ def _code_tag() -> str:
     return diskcache.source_tag(*sorted(str(f) for f in files))
 
 
-def _disk_path(key) -> Path | None:
-    d = diskcache.cache_dir()
-    return None if d is None else d / f"relaxed_{_code_tag()}_{diskcache.key_digest(key)}{diskcache.RECORD_SUFFIX}"
-
-
 def _from_disk(key):
     """(h, delta, spent) of ``key`` from the disk cache, or None (absent, unreadable, or
     another key under the same digest)."""
-    path = _disk_path(key)
+    path = diskcache.record_path("relaxed", _code_tag, key)
     got = None if path is None else diskcache.load(path)
     if got is None or not {"key", "h", "delta", "spent"} <= set(got):
         return None
@@ -199,7 +194,7 @@ def cached_state(key, solve, stats=None):
     h, d = solve()
     spent = np.zeros(N_STATS, dtype=np.int64) if stats is None else stats - before
     _keep(key, (h.copy(), d, spent))
-    path = _disk_path(key)
+    path = diskcache.record_path("relaxed", _code_tag, key)
     if path is not None:
         diskcache.save(path, {"key": np.array(repr(key)), "h": h, "delta": np.array(d),
                               "spent": spent})

@@ -127,10 +127,8 @@ def prony_series(kind: str, n: float, k: float, t_min: float, t_max: float, rtol
     worker or a later sweep reads it instead of fitting it again.
     """
     key = (kind, float(n), float(k), float(t_min), float(t_max), float(rtol))
-    d = diskcache.cache_dir()
-    path = None
-    if d is not None:
-        path = d / f"prony_{_materials_tag()}_{diskcache.key_digest(key)}{diskcache.RECORD_SUFFIX}"
+    path = diskcache.record_path("prony", _materials_tag, key)
+    if path is not None:
         got = diskcache.load(path)
         if got is not None and _PRONY_FIELDS <= set(got) and tuple(got["key"]) == key[1:] \
                 and str(got["kind"]) == kind:

@@ -115,7 +115,7 @@ def test_relaxed_start_on_disk_checks_its_key_and_survives_damage(cache, monkeyp
     (path,) = cache.glob(RELAXED)
     initial.clear_relaxed_cache()
     assert initial._from_disk(("a", 1.0))[1] == 0.5
-    moved = initial._disk_path(("b", 2.0))
+    moved = diskcache.record_path("relaxed", initial._code_tag, ("b", 2.0))
     path.rename(moved)                                  # a digest collision, as it were
     assert initial._from_disk(("b", 2.0)) is None
     moved.write_bytes(b"\x00garbage")
