@@ -23,6 +23,12 @@ from .problem import jkr_radius
 
 #: Newton iterations of the elastic solves of the initial state (poorer starting guesses)
 MAX_NEWTON_ITER_INITIAL = 40
+#: the elastic continuation (:func:`_walk`): the step's growth after a success and the most
+#: solves of one relaxed start's walks (the longest successful one measured: 124 solves, on a
+#: coarse graded mesh at mu 5; a relaxed start that cannot converge walked until its time
+#: budget: 3527 solves in 630 s on a 1000-node mesh at mu 10)
+WALK_GROWTH = 1.5
+WALK_MAX_SOLVES = 1000
 #: relaxed states kept per process: the initial state depends on the mesh, mu and a0 (or
 #: delta0) only, so a sweep over materials and rates solves each one once per worker
 RELAXED_CACHE_SIZE = 64
@@ -107,44 +113,61 @@ class ElasticSolver:
         return crossing_radius(h, self.r, level_factor * self.h0)
 
 
-def _walk(el: ElasticSolver, d_from: float, h_from: np.ndarray, d_to: float):
+def _walk(el: ElasticSolver, d_from: float, h_from: np.ndarray, d_to: float,
+          spent: list | None = None):
     """Elastic continuation from a converged state at ``d_from`` to ``d_to``.
 
-    Adaptive steps in delta (halved on a failed solve, grown after successes), each solve
-    warm-started from the previous gap shifted by the change of indentation.
-    Returns the gap at ``d_to`` or None.
+    Adaptive steps in delta (halved on a failed solve, grown by WALK_GROWTH after a
+    success), each solve warm-started from the secant through the last two states (the
+    first from the state shifted by the change of indentation). The secant follows the
+    contact edge as it moves, where the shift moved the whole gap: on a graded mesh at
+    mu 5 (band resolution 6, a0 2) 124 solves instead of 2280, 0.3 s instead of 6 s.
+    ``spent`` (a one-item list) counts the solves against WALK_MAX_SOLVES, shared by the
+    walks of one relaxed start. Returns the gap at ``d_to`` or None.
     """
+    spent = [0] if spent is None else spent
     d, h = d_from, h_from
+    d_prev = h_prev = None
     step = min(0.25, abs(d_to - d_from)) if d_to != d_from else 0.0
     while d != d_to:
-        if step < 1e-6:
+        if step < 1e-6 or spent[0] >= WALK_MAX_SOLVES:
             return None
         d_next = d_to if abs(d_to - d) <= step else d + math.copysign(step, d_to - d)
-        guess = np.maximum(h - (d_next - d), 0.3 * h)
+        if h_prev is None:
+            guess = np.maximum(h - (d_next - d), 0.3 * h)
+        else:
+            guess = np.maximum(h + (h - h_prev) * ((d_next - d) / (d - d_prev)), 0.3 * h)
+        spent[0] += 1
         ok, h_new = el.solve(d_next, guess)
         if ok:
-            d, h = d_next, h_new
-            step *= 1.5
+            d_prev, h_prev, d, h = d, h, d_next, h_new
+            step *= WALK_GROWTH
         else:
             step *= 0.5
     return h
 
 
-def _solve_at(el: ElasticSolver, delta: float) -> np.ndarray:
+def _solve_at(el: ElasticSolver, delta: float, spent: list | None = None) -> np.ndarray:
     """Elastic LJ solution at ``delta``: from the JKR guess, else by continuation from the
     nearest indentation that converges directly (a coarse mesh can trap Newton in a
-    non-solution minimum of |F| where the contact edge sits between nodes)."""
+    non-solution minimum of |F| where the contact edge sits between nodes), the walks'
+    solves counted in ``spent`` (:func:`_walk`)."""
+    spent = [0] if spent is None else spent
     ok, h = el.solve(delta, jkr_gap_guess(el.r, delta, el.h0))
     if ok:
         return h
     for offset in (0.5, -0.5, 1.0, -1.0, 2.0, -2.0, 4.0, 8.0):
+        if spent[0] >= WALK_MAX_SOLVES:
+            break
         d = delta + offset
         ok, h = el.solve(d, jkr_gap_guess(el.r, d, el.h0))
         if ok:
-            h = _walk(el, d, h, delta)
+            h = _walk(el, d, h, delta, spent)
             if h is not None:
                 return h
-    raise RuntimeError(f"no converged relaxed state at delta0={delta:.6g}")
+    raise RuntimeError(f"no converged relaxed state at delta0={delta:.6g}"
+                       + (f" (the continuation stopped after {spent[0]} solves)"
+                          if spent[0] >= WALK_MAX_SOLVES else ""))
 
 
 def relaxed_state(el: ElasticSolver, delta0=None, a0=None, mesh_key=None):
@@ -214,12 +237,13 @@ MIN_JKR_DDELTA_DA = 0.25
 
 def _solve_relaxed(el: ElasticSolver, delta0=None, a0=None):
     """The relaxed state of :func:`relaxed_state`, solved."""
+    spent = [0]     # the continuation's solves (WALK_MAX_SOLVES), over every walk below
     if delta0 is not None:
-        return _solve_at(el, float(delta0)), float(delta0)
+        return _solve_at(el, float(delta0), spent), float(delta0)
 
     # find delta with a(delta) = a0: secant on delta, warm-started solves
     d1 = a0 * a0 - math.sqrt(2.0 * a0)
-    h1 = _solve_at(el, d1)
+    h1 = _solve_at(el, d1, spent)
     f1 = el.radius(h1) - a0
     # JKR da/d delta, d delta/da = 2 a - (2 a)^(-1/2) kept from the fold at a = 1/2, where it
     # vanishes (a0 = 0.500-0.505 at mu = 0.03 sent the secant astray)
@@ -237,9 +261,9 @@ def _solve_relaxed(el: ElasticSolver, delta0=None, a0=None):
     for _ in range(60):
         ok, h2 = el.solve(d2, guess)
         if not ok:
-            h2 = _walk(el, d1, h1, d2)
+            h2 = _walk(el, d1, h1, d2, spent)
             if h2 is None:
-                h2 = _solve_at(el, d2)
+                h2 = _solve_at(el, d2, spent)
         f2 = el.radius(h2) - a0
         if f2 < 0:
             lo = d2 if lo is None else max(lo, d2)

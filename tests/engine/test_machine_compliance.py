@@ -11,6 +11,8 @@ builds, dd/dt = dD/dt - (dP/dt)/K).
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -54,12 +56,16 @@ def test_elastic_pull_off_is_the_rigid_machines_for_any_spring():
 
 
 def test_stiff_spring_converges_to_the_rigid_machine():
-    # viscoelastic, uniform mesh: relative differences 8.2e-4, 2.1e-4, 3.9e-5 at K = 1e2,
-    # 1e3, 1e4 (about 1/K, with the step sampling's scatter on top)
-    rigid = simulate(Scene(**VISCO), UNIFORM)
+    # viscoelastic, on a uniform mesh twice as fine as UNIFORM at step 0.1: relative
+    # differences 3.9e-4, 3.7e-5, 3.5e-6 at K = 1e2, 1e3, 1e4 (about 0.04/K). On UNIFORM
+    # itself the pull-off's scatter reached 8e-4: its relaxed start at a0 = 2 is one of
+    # several discrete equilibria of radius within a spacing of a0 (indentations 1.99, 2.07
+    # and 2.10), which one depending on the continuation that found it
+    fine = dataclasses.replace(UNIFORM, nodes=320, step=0.1)
+    rigid = simulate(Scene(**VISCO), fine)
     diff = {}
     for K in (1e2, 1e4):
-        res = simulate(Scene(**VISCO, machine_stiffness=K), UNIFORM)
+        res = simulate(Scene(**VISCO, machine_stiffness=K), fine)
         assert res.ok, res.reason
         diff[K] = abs(res.pull_off / rigid.pull_off - 1.0)
     assert diff[1e4] < 1e-4 and diff[1e4] < 0.1 * diff[1e2]

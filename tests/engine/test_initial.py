@@ -1,0 +1,65 @@
+"""The relaxed initial state's elastic continuation (sweep.engine.initial._walk): where Newton
+from the JKR guess fails (a coarse mesh traps the contact edge between nodes), the state is
+reached by a walk in the indentation, warm-started from the secant through the last two
+states, and a relaxed start that cannot converge stops after WALK_MAX_SOLVES solves."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sweep.engine import initial
+from sweep.engine.problem import prepare
+from sweep.kernels.interface import lj_traction_and_stiffness
+from sweep.scene import Numerics, Scene
+
+#: a graded mesh of band resolution 6 at mu 5 (the fast preset's pattern, no zone check):
+#: Newton from the JKR guess fails at the relaxed start of a0 = 2, which walks
+SCENE = Scene(n=0.5, k=0.5, mu=5.0, a0=2.0, rate=1.0)
+COARSE = Numerics.preset("fast", band_resolution=6.0, zone_nodes=0.0, max_nodes=2000)
+
+
+def _counted_solver(monkeypatch):
+    """(the elastic solver of SCENE on COARSE, its problem, counts of solves and walks)."""
+    pb = prepare(SCENE, COARSE)
+    el = initial.ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, COARSE.tol)
+    counts = {"solves": 0, "walks": 0}
+    solve, walk = el.solve, initial._walk
+
+    def counted_solve(delta, guess):
+        counts["solves"] += 1
+        return solve(delta, guess)
+
+    def counted_walk(*args, **kwargs):
+        counts["walks"] += 1
+        return walk(*args, **kwargs)
+
+    el.solve = counted_solve
+    monkeypatch.setattr(initial, "_walk", counted_walk)
+    return el, pb, counts
+
+
+def test_the_walk_reaches_an_equilibrium_of_radius_a0_in_few_solves(monkeypatch):
+    # measured: 124 solves in 5 walks (0.3 s); the walk warm-started from the gap shifted by
+    # the change of indentation (before 2026-11-26) took 2280 solves (6 s) to the same state
+    el, pb, counts = _counted_solver(monkeypatch)
+    h, delta = initial._solve_relaxed(el, a0=SCENE.a0)
+    assert counts["walks"] >= 1                     # the case this test is about
+    assert counts["solves"] <= 300
+    r = pb.mesh.r
+    sig, stiff = np.empty(r.size), np.empty(r.size)
+    lj_traction_and_stiffness(h, pb.h0, pb.c, sig, stiff)
+    residual = h - (-delta + pb.h0 + 0.5 * r**2) - pb.A @ sig
+    assert np.max(np.abs(residual)) <= COARSE.tol * pb.h0
+    spacing = np.diff(r)[np.searchsorted(r, SCENE.a0) - 1]
+    assert abs(el.radius(h) - SCENE.a0) <= spacing
+
+
+def test_a_relaxed_start_stops_after_walk_max_solves(monkeypatch):
+    # with too few solves allowed the same start fails, in a bounded number of solves (the
+    # direct solves of the root find and of the walks' starting points, and the walks'
+    # WALK_MAX_SOLVES), saying why
+    el, _, counts = _counted_solver(monkeypatch)
+    monkeypatch.setattr(initial, "WALK_MAX_SOLVES", 20)
+    with pytest.raises(RuntimeError, match=r"the continuation stopped after 20 solves"):
+        initial._solve_relaxed(el, a0=SCENE.a0)
+    assert counts["solves"] <= 20 + 60 + 2 * 9
