@@ -24,3 +24,13 @@ def test_outcome_classes():
     assert random_sample.outcome(row("error", "TypeError")) == "error"
     assert random_sample.outcome(row("failed", "no stable contact of radius a0 = 0.4")) == "refused"
     assert random_sample.outcome(row("failed", "time budget: 20 s")) == "failed"
+
+
+def test_the_sweep_wall_is_the_span_of_its_scenes_not_their_sum():
+    # two workers: scenes of 3, 2 and 4 s, the third started when the second ended; the
+    # wall runs from the first start (t = 10) to the last end (t = 16)
+    import pandas as pd
+
+    df = pd.DataFrame({"finished_at": [13.0, 12.0, 16.0], "task_wall_s": [3.0, 2.0, 4.0]})
+    assert random_sample.scene_span(df) == 6.0
+    assert df.task_wall_s.sum() == 9.0
