@@ -240,6 +240,33 @@ class ElasticBranch:
         return 2.0 * math.pi * (a * a * float(self.w @ sig) + tail)
 
 
+def state_at(br: ElasticBranch, a0: float):
+    """The branch's equilibrium at the radius ``a0``: (gap h, indentation delta, below),
+    ``below`` whether a0 lies below the branch's displacement-controlled fold (the
+    indentation decreases as the radius grows there: JKR's a < 0.5, where the state exists
+    but no relaxed contact can be held under fixed grips); None where it was not found. From
+    the branch's guess at a0, else along the branch from a radius where the guess is good
+    (a small a0)."""
+    h, d = br.guess(a0)
+    h, d, ok = br.solve(a0, h, d)
+    if not ok:
+        h, d = br.guess(max(1.2, 2.0 * a0))
+        for a in np.geomspace(max(1.2, 2.0 * a0), a0, 16):
+            h, d, ok = br.solve(a, h, d)
+            if not ok:
+                return None
+    _, d_up, ok_up = br.solve(1.001 * a0, h, d)
+    return h, d, bool(ok_up and d_up < d)
+
+
+def fold_refusal(mu: float, a0: float) -> str:
+    """The reason of a scene refused because its a0 lies below the fold (:func:`state_at`);
+    a physical refusal (:data:`sweep.errors.PHYSICAL_REFUSALS`)."""
+    return (f"no stable contact of radius a0 = {a0:g}: it lies below the fold of the relaxed "
+            f"elastic branch at mu = {mu:g} (the indentation decreases as the radius grows); "
+            f"give a larger a0 (JKR: a0 > 0.5) or delta0")
+
+
 def pull_off_radius_guess(mu: float) -> float:
     """Expected pull-off radius: JKR's 1.040 at high mu, the rigid DMT sphere's
     sqrt(2 (h_m - h0)) (gap h0 at the centre) at low mu; the larger of the two."""
@@ -400,10 +427,15 @@ def simulate_elastic(scene, numerics=None):
     po = elastic_pull_off(scene.mu, a_start=scene.a0)
     res.nodes_used, res.steps = po.nodes, po.solves
     res.newton_iterations = res.factorizations = po.newton_iterations
-    res.wall_s = time.perf_counter() - t0
     if not po.converged:
-        res.reason = po.reason
+        # below the fold the start exists but cannot be held: a physical refusal, as the
+        # BEM's (sweep.engine.tip_following.branch_state), not a numerical failure
+        state = state_at(ElasticBranch(scene.mu, scene.a0, 0.5 * scene.a0), scene.a0)
+        res.reason = (fold_refusal(scene.mu, scene.a0) if state is not None and state[2]
+                      else po.reason)
+        res.wall_s = time.perf_counter() - t0
         return res
+    res.wall_s = time.perf_counter() - t0
     scales = derive(scene, res.numerics)
     radii, loads, deltas = po.branch
     stop = int(np.argmin(deltas)) + 1          # the displacement-controlled fold

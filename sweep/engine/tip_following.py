@@ -51,7 +51,7 @@ from .initial import ElasticSolver, cached_state, relaxed_state
 from .mesh import WINDOW_AHEAD_ZONES, WINDOW_BEHIND_ZONES, band_nodes, tip_window
 from .postprocess import STATUS_TIME_BUDGET, finish
 from .problem import Refused, derive, jkr_radius, material_of, prepare
-from .quasistatic import ElasticBranch
+from .quasistatic import ElasticBranch, fold_refusal, state_at
 from .resolution import estimate_error
 
 #: Newton tolerance (units of h0) of a first relaxed solve where the numerics' one stalls
@@ -282,20 +282,12 @@ def branch_state(scene: Scene, band_resolution: float = 16.0, domain: float | No
     a0 = scene.a0
     br = ElasticBranch(scene.mu, a0, 0.5 * a0, zone_resolution=band_resolution, zone=8.0,
                        domain=domain)
-    h_b, d_b = br.guess(a0)
-    h_b, d, ok = br.solve(a0, h_b, d_b)
-    if not ok:      # small a0: along the branch from a radius where the guess is good
-        h_b, d = br.guess(max(1.2, 2.0 * a0))
-        for a in np.geomspace(max(1.2, 2.0 * a0), a0, 16):
-            h_b, d, ok = br.solve(a, h_b, d)
-            if not ok:
-                return None
-    _, d_up, ok_up = br.solve(1.001 * a0, h_b, d)
-    if ok_up and d_up < d:
-        raise Refused(f"no stable contact of radius a0 = {a0:g}: it lies below the fold of "
-                      f"the relaxed elastic branch at mu = {scene.mu:g} (the indentation "
-                      f"decreases as the radius grows); give a larger a0 (JKR: a0 > 0.5) or "
-                      f"delta0")
+    state = state_at(br, a0)
+    if state is None:
+        return None
+    h_b, d, below = state
+    if below:
+        raise Refused(fold_refusal(scene.mu, a0))
     return a0 * br.x, h_b, d
 
 

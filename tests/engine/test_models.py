@@ -188,13 +188,16 @@ def test_the_scene_limits_are_the_union_of_the_model_ranges():
     assert any(not r for r in models.MODEL_RANGES.values())   # one model takes every scene
 
 
-def test_an_elastic_branch_failure_is_not_the_answer_of_auto():
-    """k = 1 from a0 = 0.31 at mu = 11.8: the elastic branch's Newton fails there (a random
-    sample's scene); the crack-front model, its mu -> infinity limit, refuses the contact for
-    the physical reason (below the fixed-grip limit a0 = 0.5)."""
+def test_an_elastic_start_below_the_fold_is_refused_by_the_elastic_branch_itself():
+    """k = 1 from a0 = 0.31 at mu = 11.8 (a random sample's scene): the elastic branch's
+    Newton failed there, and auto fell back to the crack-front model, which refused the
+    contact (below its fixed-grip limit a0 = 0.5). The elastic branch now refuses it itself,
+    for the physical reason (below its displacement-controlled fold), and auto, seeing a
+    physical refusal, tries no other model."""
     res = models.simulate(Scene(n=0.779, k=1.0, mu=11.82, a0=0.31, rate=2.65e5, model="auto"))
     assert res.status == "failed" and is_physical_refusal(res.reason), res.reason
-    assert res.model_reason.startswith("auto: crack-front model: the elastic branch failed")
+    assert res.model_used == "elastic"
+    assert res.model_reason == "auto: k = 1, quasi-static: the elastic branch"
 
 
 # -- a rate-dependent process zone (issue 35): the crack-front model and the BEM have its law --

@@ -161,3 +161,23 @@ def test_viscoelastic_scenes_beyond_the_fixed_band_fail_with_the_reason():
     res = simulate(Scene(n=0.5, k=0.1, mu=50.0, a0=2.5, rate=1.0))
     assert res.status == "failed" and "max_nodes" in res.reason
     assert "tip-following" in res.reason and res.wall_s < 5.0
+
+
+@pytest.mark.parametrize("model", ["bem", "auto"])
+def test_an_elastic_start_below_the_fold_is_a_physical_refusal(model):
+    # the random sample's scene (mu 11.82, a0 0.3102, k = 1): JKR holds no relaxed contact
+    # below a = 0.5 under fixed grips, and neither does the LJ branch at this mu (its
+    # indentation falls as the radius grows there). The elastic branch failed there with
+    # "Newton did not converge", counted as a numerical failure; now it refuses for the
+    # physical reason, as the BEM's window mesh does (tip_following.branch_state), and auto
+    # does not try another model. Above the fold the same scene runs.
+    from sweep import simulate as simulate_model
+    from sweep.errors import is_physical_refusal
+    below = simulate_model(Scene(n=0.779, k=1.0, mu=11.82, a0=0.3102, rate=2.647e5,
+                                 model=model), Numerics.preset("balanced"))
+    assert below.status == "failed" and below.model_used == "elastic"
+    assert is_physical_refusal(below.reason), below.reason
+    assert below.reason.startswith("no stable contact of radius a0 = 0.3102")
+    above = simulate_model(Scene(n=0.779, k=1.0, mu=11.82, a0=0.55, rate=2.647e5,
+                                 model=model), Numerics.preset("balanced"))
+    assert above.ok, above.reason
