@@ -113,8 +113,7 @@ class ElasticSolver:
         return crossing_radius(h, self.r, level_factor * self.h0)
 
 
-def _walk(el: ElasticSolver, d_from: float, h_from: np.ndarray, d_to: float,
-          spent: list | None = None):
+def _walk(el: ElasticSolver, d_from: float, h_from: np.ndarray, d_to: float, spent: list):
     """Elastic continuation from a converged state at ``d_from`` to ``d_to``.
 
     Adaptive steps in delta (halved on a failed solve, grown by WALK_GROWTH after a
@@ -125,7 +124,6 @@ def _walk(el: ElasticSolver, d_from: float, h_from: np.ndarray, d_to: float,
     ``spent`` (a one-item list) counts the solves against WALK_MAX_SOLVES, shared by the
     walks of one relaxed start. Returns the gap at ``d_to`` or None.
     """
-    spent = [0] if spent is None else spent
     d, h = d_from, h_from
     d_prev = h_prev = None
     step = min(0.25, abs(d_to - d_from)) if d_to != d_from else 0.0
@@ -147,12 +145,11 @@ def _walk(el: ElasticSolver, d_from: float, h_from: np.ndarray, d_to: float,
     return h
 
 
-def _solve_at(el: ElasticSolver, delta: float, spent: list | None = None) -> np.ndarray:
+def _solve_at(el: ElasticSolver, delta: float, spent: list) -> np.ndarray:
     """Elastic LJ solution at ``delta``: from the JKR guess, else by continuation from the
     nearest indentation that converges directly (a coarse mesh can trap Newton in a
     non-solution minimum of |F| where the contact edge sits between nodes), the walks'
     solves counted in ``spent`` (:func:`_walk`)."""
-    spent = [0] if spent is None else spent
     ok, h = el.solve(delta, jkr_gap_guess(el.r, delta, el.h0))
     if ok:
         return h
