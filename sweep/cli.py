@@ -460,9 +460,11 @@ def plot_command(results, out):
 @cli.command("run")
 @click.argument("config")
 @click.option("-j", "--jobs", type=int, default=None,
-              help="Worker processes (loky; default: all cores) or tasks in flight (dask).")
-@click.option("--backend", type=click.Choice(["loky", "dask"]), default="loky",
-              show_default=True, help="joblib backend: local processes or a dask cluster.")
+              help="Worker processes (default: all cores) or tasks in flight (dask).")
+@click.option("--backend", type=click.Choice(["local", "loky", "dask"]), default="local",
+              show_default=True,
+              help="local: processes on this machine, forked from this one on Linux (else "
+                   "loky's); loky: always loky's new interpreters; dask: a dask cluster.")
 @click.option("--scheduler", default=None, metavar="ADDR",
               help="dask scheduler address, e.g. tcp://head:8786 (with --backend dask; "
                    "without it a local dask cluster is started).")
@@ -493,7 +495,7 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
         again = ["sweep", "run", config]
         if out is not None:
             again += ["--out", out]
-        if backend != "loky":
+        if backend != "local":
             again += ["--backend", backend] + (["--scheduler", scheduler] if scheduler else [])
         click.echo(f"\ninterrupted: {exc.kept} of {exc.total} scenes are kept in "
                    f"{exc.output}; to resume, run: {shlex.join(again)}", err=True)

@@ -203,7 +203,7 @@ def test_bad_config_exit_2_one_line(tmp_path, capsys, case):
     (["--out", "{tmp}/afile/r.h5"], "cannot create directory", 2),
     (["--out", "{tmp}"], "is a directory", 2),
     (["--scheduler", "tcp://127.0.0.1:1"], "only used with backend dask", 2),
-    (["--backend", "spark"], "'spark' is not one of 'loky', 'dask'", 2),
+    (["--backend", "spark"], "'spark' is not one of 'local', 'loky', 'dask'", 2),
     (["-j", "0"], "jobs must be an integer in [1, 4096] (got 0)", 2),
     (["-j", "two"], "'two' is not a valid integer", 2),
     (["--backend", "dask", "--scheduler", "tcp://127.0.0.1:1", "--connect-timeout", "1"],
@@ -333,7 +333,7 @@ class Sweep:
         time.sleep(0.05)
         self.drain()
         try:
-            os.killpg(self.p.pid, signal.SIGKILL)    # then its orphaned loky workers
+            os.killpg(self.p.pid, signal.SIGKILL)    # then its orphaned workers
         except ProcessLookupError:
             pass
         return self.p.returncode
@@ -534,7 +534,7 @@ def test_sigint_says_what_is_kept_and_how_to_resume(tmp_path, monkeypatch, capsy
 
 
 def test_sigint_to_the_process_group_keeps_scenes(tmp_path):
-    """Ctrl-C in a terminal signals the parent and its loky workers: one line says how many
+    """Ctrl-C in a terminal signals the parent and its workers: one line says how many
     scenes are kept (as many as the file holds) and the command that resumes."""
     cfg = write(tmp_path / "big.yaml", KILL_CFG.replace("{preset: fast, nodes: 60}",
                                                         "{preset: balanced}")

@@ -8,8 +8,9 @@ log-spaced rate axis over the same range). In one process, on one machine:
 
 1. ``bare``: ``sweep.engine.bem.simulate`` called in a plain loop (after ``warm_up``);
 2. ``j1``: ``run_sweep(jobs=1)`` (scheduler + store, in-process);
-3. ``j2``: ``run_sweep(jobs=2)`` with fresh loky workers (includes spawning them and their
-   Numba cache load), then ``j2_warm`` with the reused workers;
+3. ``j2``: ``run_sweep(jobs=2)`` with fresh workers (the local backend's: forked where it
+   forks, else loky's, their start included), then ``j2_warm`` with reused loky workers
+   (``backend="loky"``, after one loky sweep started them);
 4. optionally (``--cli``) the same with ``sweep run -j1`` / ``-j2`` subprocesses
    (each includes interpreter start-up, imports and the Numba cache load).
 
@@ -76,12 +77,15 @@ def scaled_smoke(scenes: int = 40, base: str | Path | None = None):
     return scale_grid(cfg, "rate", rates)
 
 
-def _fresh_loky_workers() -> None:
-    """Shut the reusable loky executor down, so the next sweep spawns new workers."""
+def _fresh_workers() -> None:
+    """New workers for the next sweep, with nothing in memory: the reusable loky executor shut
+    down (its threads too: beside them the local backend would not fork), and this process's
+    in-memory scene caches emptied (forked workers inherit them)."""
     try:
         get_reusable_executor().shutdown(wait=True)
     except Exception:  # pragma: no cover
         pass
+    _clear_scene_caches()
 
 
 def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool = False,
@@ -115,9 +119,10 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
 
     def sweep(j, name, fresh_workers=True):
         if fresh_workers:
-            _fresh_loky_workers()
+            _fresh_workers()
         t, c = time.perf_counter(), time.process_time()
-        rep = run_sweep(cfg, jobs=j, out=tmp / f"{name}.h5", progress="none", resume=False)
+        rep = run_sweep(cfg, jobs=j, out=tmp / f"{name}.h5", progress="none", resume=False,
+                        backend="local" if fresh_workers else "loky")
         assert rep.ran == n
         return time.perf_counter() - t, time.process_time() - c
 
@@ -131,6 +136,7 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
         samples["j1"].append(w)
         samples["j1_cpu"].append(c)
         samples["jN"].append(sweep(jobs, f"j{jobs}_{r}")[0])
+        sweep(jobs, f"j{jobs}s_{r}", fresh_workers=False)          # starts the loky workers
         samples["jN_warm"].append(sweep(jobs, f"j{jobs}w_{r}", fresh_workers=False)[0])
     best = {k: min(v) for k, v in samples.items()}
     df = load(tmp / f"j{jobs}_{repeat - 1}.h5")
@@ -158,8 +164,9 @@ def bench_scheduler(scenes: int = 40, jobs: int = 2, repeat: int = 3, cli: bool 
         f"j{jobs}_task_cpu_over_wall": float(df.task_cpu_s.sum() / df.task_wall_s.sum()),
         "definitions": {
             "parallel_efficiency": f"min t(j1) / ({jobs} * min t(j{jobs})): run_sweep walls "
-                                   f"in one process; every j{jobs} run spawns fresh loky "
-                                   f"workers (their start-up and Numba cache load included)",
+                                   f"in one process; every j{jobs} run starts fresh workers "
+                                   f"(forked, or loky's with their imports and Numba cache "
+                                   f"load; their start-up included)",
             "overhead_per_scene_s": "(min t(j1) - min sum of bare simulate walls) / scenes",
             "overhead_cpu_per_scene_s": "the same with CPU time of the process",
             "task_cpu_over_wall": "CPU/wall of the scenes in the workers: < 1 means the "
@@ -701,7 +708,7 @@ def _clear_scene_caches() -> None:
 
 class _fresh_disk_cache:
     """Within: an empty on-disk cache (:mod:`sweep.engine.diskcache`, a new temporary directory)
-    and empty in-memory scene caches, with loky workers started afresh so that they see it:
+    and empty in-memory scene caches, with workers started afresh so that they see it:
     what a first run on a new machine pays. Restores the previous cache directory."""
 
     def __enter__(self):
@@ -709,7 +716,7 @@ class _fresh_disk_cache:
         os.environ[diskcache.CACHE_ENV] = tempfile.mkdtemp(prefix="bench-cache-")
         self._unit = mesh.set_unit_influence(None)
         _clear_scene_caches()
-        _fresh_loky_workers()
+        _fresh_workers()
         return self
 
     def __exit__(self, *exc):
@@ -719,7 +726,7 @@ class _fresh_disk_cache:
             os.environ[diskcache.CACHE_ENV] = self._env
         mesh.set_unit_influence(self._unit)
         _clear_scene_caches()
-        _fresh_loky_workers()
+        _fresh_workers()
 
 
 def bench_scale(plan: "BenchPlan") -> dict:
@@ -786,7 +793,7 @@ def bench_balanced_campaign(plan: "BenchPlan") -> dict:
     cfg = load_config_path(plan.balanced_campaign)
     tmp = Path(tempfile.mkdtemp(prefix="bench-balanced-"))
     warm_up()
-    _fresh_loky_workers()
+    _fresh_workers()
     t = time.perf_counter()
     rep = run_sweep(cfg, jobs=plan.jobs, out=tmp / "runs.h5", progress="none", resume=False)
     wall = time.perf_counter() - t
@@ -811,8 +818,10 @@ def load_config_path(path: str):
 
 def bench_campaign(plan: BenchPlan) -> dict:
     """Scenes per minute of the campaign's numerics on a sample of its grid (every
-    ``campaign_stride``-th scene), at -j1 and -j{jobs} with warm workers (a first, untimed
-    sweep of the sample's first scenes starts them and loads their caches).
+    ``campaign_stride``-th scene), at -j1 and -j{jobs} with warm loky workers (a first,
+    untimed sweep of the sample's first scenes starts them and loads their caches; loky's,
+    which live from one sweep to the next, where forked workers would inherit the -j1 run's
+    in-memory caches from this process).
 
     Both timed runs start from the same state: an on-disk cache filled by a first run of
     the sample (``wall_s.first_j1``, which fits every Prony series once) and empty
@@ -839,10 +848,10 @@ def bench_campaign(plan: BenchPlan) -> dict:
             warm = config_from_dict({**data, "grid": data["grid"][:2 * plan.jobs],
                                      "name": "warm"})
             run_sweep(warm, jobs=plan.jobs, out=tmp / "warm.h5", progress="none",
-                      resume=False)
+                      resume=False, backend="loky")
         t = time.perf_counter()
         repj = run_sweep(sub_cfg, jobs=plan.jobs, out=tmp / "jN.h5", progress="none",
-                         resume=False)
+                         resume=False, backend="loky")
         walls[f"j{plan.jobs}"] = time.perf_counter() - t
         # the same again in the same processes: every per-process cache (relaxed starts,
         # meshes) now warm on both sides, the steady state of a long sweep
@@ -850,7 +859,8 @@ def bench_campaign(plan: BenchPlan) -> dict:
         run_sweep(sub_cfg, jobs=1, out=tmp / "j1b.h5", progress="none", resume=False)
         walls["j1_warm_caches"] = time.perf_counter() - t
         t = time.perf_counter()
-        run_sweep(sub_cfg, jobs=plan.jobs, out=tmp / "jNb.h5", progress="none", resume=False)
+        run_sweep(sub_cfg, jobs=plan.jobs, out=tmp / "jNb.h5", progress="none", resume=False,
+                  backend="loky")
         walls[f"j{plan.jobs}_warm_caches"] = time.perf_counter() - t
     df = load(tmp / "jN.h5")
     statuses = df.status.value_counts().to_dict()
@@ -1058,7 +1068,8 @@ def _prony_files() -> int:
 def bench_dataset_campaign(plan: BenchPlan) -> dict:
     """A campaign of the external BEM data set's kind (issue 33 item 5), as a user runs it:
     :func:`dataset_sample` of ``plan.dataset_scenes`` scenes through ``run_sweep`` at
-    -j{jobs} (fresh loky workers each time, as ``sweep run`` starts them), at
+    -j{jobs} (fresh workers each time, as ``sweep run`` starts them: forked where the local
+    backend forks; ``backend`` says which), at
     ``plan.dataset_numerics`` (the accuracy request).
 
     ``first``: an empty disk cache (``SWEEP_CACHE_DIR`` a new temporary directory: every
@@ -1078,12 +1089,13 @@ def bench_dataset_campaign(plan: BenchPlan) -> dict:
     with _fresh_disk_cache():
         fitted = 0
         for label in ("first", "warm"):
-            _fresh_loky_workers()
+            _fresh_workers()
             t = time.perf_counter()
             rep = run_sweep(cfg, jobs=plan.jobs, out=tmp / f"{label}.h5", progress="none",
                             resume=False)
             walls[label] = time.perf_counter() - t
             files = _prony_files()
+            backend = rep.backend
             rows[label] = {**_campaign_rows(load(tmp / f"{label}.h5"), rtol), "ran": rep.ran,
                            "prony_series_fitted": files - fitted}
             fitted = files
@@ -1099,7 +1111,7 @@ def bench_dataset_campaign(plan: BenchPlan) -> dict:
     return {"scenes": len(cfg.tasks()), "seed": plan.dataset_seed,
             "ranges": {k: list(v) for k, v in plan.dataset_ranges.items()},
             "numerics_request": dict(plan.dataset_numerics),
-            "numerics": cfg.numerics.to_dict(), "jobs": plan.jobs,
+            "numerics": cfg.numerics.to_dict(), "jobs": plan.jobs, "backend": backend,
             "first_s": walls["first"], "warm_s": walls["warm"],
             "first_over_warm": walls["first"] / walls["warm"], "rows": rows,
             "profile": {"scenes": len(picked), "stride": plan.dataset_profile_stride,

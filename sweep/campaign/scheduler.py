@@ -3,10 +3,11 @@
 :func:`run_sweep` is the Python entry point behind ``sweep run``::
 
     from sweep import run_sweep
-    report = run_sweep("configs/smoke.yaml", jobs=2)          # joblib/loky on this machine
+    report = run_sweep("configs/smoke.yaml", jobs=2)          # processes on this machine
     report = run_sweep(cfg, backend="dask", scheduler="tcp://head:8786")   # a cluster
 
-Scheduling. joblib ``Parallel(return_as="generator_unordered", batch_size=1)`` runs one
+Scheduling. joblib ``Parallel(return_as="generator_unordered", batch_size=1)`` (forked
+workers: a ``concurrent.futures`` process pool, the same tasks in the same order) runs one
 chunk of scenes per task (:func:`dispatch_chunks`): the scenes of a chunk share their
 relaxed start, so one worker solves it once; chunks are small (a quarter of a worker's share
 of the estimated cost at most) and dispatched the most expensive first
@@ -15,16 +16,22 @@ at the end of the grid). Results stream back to the parent as each chunk finishe
 parent, the single writer, appends them to the crash-safe store (:mod:`sweep.campaign.store`).
 Backends:
 
-* ``loky`` (default): ``jobs`` worker processes on this machine (default: all cores), each
-  with one BLAS/OpenMP/Numba thread (``inner_max_num_threads=1``). ``jobs=1`` runs in the
-  parent process.
+* ``local`` (default): ``jobs`` worker processes on this machine (default: all cores), each
+  with one BLAS/OpenMP/Numba thread. On Linux, in a process that runs no other thread, they
+  are forked from the parent once it has loaded the kernels (:mod:`sweep.campaign.forked`:
+  they start in milliseconds, where a new interpreter takes about a second); elsewhere they
+  are loky's. ``jobs=1`` runs in the parent process. The report's ``backend`` says which ran
+  (``fork`` or ``loky``).
+* ``loky``: always joblib/loky worker processes (new interpreters,
+  ``inner_max_num_threads=1``).
 * ``dask``: the same tasks through joblib's dask backend on a ``dask.distributed`` cluster at
   ``scheduler`` (``tcp://host:8786``); without an address a ``LocalCluster`` with ``jobs``
   single-threaded worker processes is started for the run.
 
 A cold Numba cache is warmed in the parent (``sweep.engine.bem.warm_up()``, which compiles and
-writes the on-disk cache) before the grid starts; every worker process warms it on its first
-task (a cache load), and a sequential run (``-j 1``) in the parent. Resume: scenes whose id is already in the results file (or
+writes the on-disk cache) before the grid starts; every loky or dask worker process warms it
+on its first task (a cache load), forked workers get it from the parent, which loads it
+before forking them, and a sequential run (``-j 1``) loads it in the parent. Resume: scenes whose id is already in the results file (or
 its journal) are skipped, so running the same command again completes an interrupted sweep.
 """
 from __future__ import annotations
@@ -51,8 +58,9 @@ from ..errors import InputError, check_int, check_range
 from ..scene import Result
 from .store import ResultStore, StoreBusyError, plain_row
 from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
+from .forked import ForkedWorkers, usable as forked_workers_usable
 
-BACKENDS = ("loky", "dask")
+BACKENDS = ("local", "loky", "dask")
 PROGRESS_MODES = ("auto", "bar", "log", "none")
 
 
@@ -110,10 +118,15 @@ class SweepReport:
 
 # ----------------------------------------------------------------------------- workers
 _WORKER_READY = False
+#: True once this process ran the kernels' warm-up (a forked worker inherits it: its
+#: parent loaded them before the fork)
+_KERNELS_LOADED = False
+
 
 def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
     """Once per process: end with the parent (:func:`exit_with_parent`), one thread for
-    BLAS/OpenMP/Numba, then warm the Numba cache."""
+    BLAS/OpenMP/Numba, then warm the Numba cache (unless the parent loaded it before forking
+    this worker)."""
     global _WORKER_READY
     if _WORKER_READY:
         return
@@ -121,7 +134,9 @@ def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
     if limit_threads:
         limit_env(THREAD_VARS)
         limit_loaded_pools()
-    if warm:
+        if "numba" in sys.modules:      # a forked worker: numba read them in the parent
+            sys.modules["numba"].config.reload_config()
+    if warm and not _KERNELS_LOADED:
         # the engine (numba) is imported here, after the thread limits above: numba reads
         # NUMBA_NUM_THREADS when it loads (the same in run_scene and _warm_parent)
         from ..engine import bem as solver
@@ -235,6 +250,13 @@ def scene_inputs(row: dict) -> str:
     return " ".join(parts)
 
 
+class _Bar(tqdm):
+    """A tqdm bar without tqdm's monitor thread (which outlives the bar by up to 10 s, and a
+    process running a second thread forks no workers: :mod:`sweep.campaign.forked`)."""
+
+    monitor_interval = 0
+
+
 class Progress:
     """Progress display: a tqdm bar on a terminal ("bar"), one line per scene ("log").
 
@@ -282,7 +304,7 @@ class Progress:
 
     def start(self) -> None:
         if self.mode == "bar":
-            self.bar = tqdm(total=self.total, initial=self.already, file=self.stream,
+            self.bar = _Bar(total=self.total, initial=self.already, file=self.stream,
                             unit="scene", dynamic_ncols=True, postfix="0 failed")
 
     def update(self, row: dict) -> None:
@@ -440,7 +462,7 @@ def _connect_dask(scheduler, jobs, timeout):
 
 
 # ----------------------------------------------------------------------------- entry point
-def run_sweep(config, jobs: int | None = None, backend: str = "loky",
+def run_sweep(config, jobs: int | None = None, backend: str = "local",
               scheduler: str | None = None, out=None, resume: bool = True,
               progress="auto", simulate: Callable | None = None,
               consolidate_every: float = 5.0, connect_timeout: float = 10.0,
@@ -451,9 +473,12 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
     ----------
     config : SweepConfig, mapping, or path of a YAML file
     jobs : int, optional
-        Worker processes (loky, default: all cores) or tasks in flight (dask, default: all
-        worker threads of the cluster).
-    backend : {"loky", "dask"}
+        Worker processes (local and loky, default: all cores) or tasks in flight (dask,
+        default: all worker threads of the cluster).
+    backend : {"local", "loky", "dask"}
+        "local" (default): worker processes on this machine, forked from this one where that
+        is safe (Linux, a single-threaded process: :mod:`sweep.campaign.forked`), else loky's;
+        "loky": always joblib's loky workers (new interpreters); "dask": a cluster.
     scheduler : str, optional
         Address of a dask.distributed scheduler (``tcp://host:8786``); dask backend only.
     out : path, optional
@@ -523,9 +548,13 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
     todo = [(sid, scene) for sid, scene in tasks if sid not in done or sid in retry]
     skipped = len(tasks) - len(todo)
     prog = Progress(progress, total=len(tasks), already=skipped, stream=stream)
-    if backend == "loky":
+    forked = False
+    if backend in ("local", "loky"):
         n_jobs = min(jobs or os.cpu_count() or 1, max(len(todo), 1))
-        where = f"{n_jobs} loky worker{'s' if n_jobs > 1 else ''}"
+        forked = backend == "local" and n_jobs > 1 and forked_workers_usable()
+        where = (f"{n_jobs} {'forked' if forked else 'loky'} worker"
+                 f"{'s' if n_jobs > 1 else ''}")
+        backend = "fork" if forked else "loky"
     else:
         n_jobs = jobs or -1
         where = f"dask cluster {scheduler or 'LocalCluster'}"
@@ -549,10 +578,12 @@ def run_sweep(config, jobs: int | None = None, backend: str = "loky",
         if todo:
             warm = simulate is None and _warm_parent(
                 prog, [scene for _, scene in todo], cfg.numerics,
-                in_workers=not (backend == "loky" and n_jobs == 1))
-            prog.start()
+                in_workers=backend != "fork" and not (backend == "loky" and n_jobs == 1))
             chunks = dispatch_chunks(todo, cfg.numerics, n_jobs)
+            # forked workers start here, before the progress bar's thread (a fork copies
+            # one thread only: sweep.campaign.forked)
             results = _results(chunks, cfg, backend, n_jobs, client, simulate, warm)
+            prog.start()
             try:
                 for row, traj in results:
                     tb = row.pop(TRACEBACK_KEY, None)
@@ -623,12 +654,14 @@ def _warm_parent(prog: Progress | None = None, scenes=(), numerics=None,
     True if the workers are to load them too (on their first task), False if the cache is
     cold and no scene of ``scenes`` runs the BEM (:func:`needs_bem_kernels`): a crack-front
     or PB grid compiles nothing. With a current cache and the scenes run in worker processes
-    (``in_workers``) the parent loads nothing: only the workers use the kernels, each
+    (``in_workers``: new interpreters) the parent loads nothing: only the workers use them, each
     loading them before its first scene's timer (the parent's load was 0.3 s of a warm
     200-scene sweep's 3.0 s on 2 cores: 2.6-2.7 s without it, three runs each, 2026-11-26).
 
     On a cold cache (the first run after an install or an edit of the kernels) the compile
-    takes tens of seconds: ``prog`` then gets a line before and one with its time after."""
+    takes tens of seconds: ``prog`` then gets a line before and one with its time after.
+    Forked workers (``in_workers`` False) inherit what the parent loaded, once for all."""
+    global _KERNELS_LOADED
     try:  # lazy: see _prepare_worker
         from ..engine import bem as solver
     except ImportError as exc:
@@ -641,6 +674,7 @@ def _warm_parent(prog: Progress | None = None, scenes=(), numerics=None,
     if cold and prog is not None:
         prog.message("compiling kernels (first run only) ...")
     seconds = solver.warm_up()
+    _KERNELS_LOADED = True
     if cold and prog is not None:
         prog.message(f"compiling kernels (first run only): done in {seconds:.1f} s")
     return True
@@ -669,9 +703,37 @@ def run_chunk(scenes, numerics, trajectories: bool = False,
     return [run_scene(scene, numerics, trajectories, simulate, warm=warm) for scene in scenes]
 
 
+class _ForkedResults:
+    """The rows of forked workers (:class:`sweep.campaign.forked.ForkedWorkers`), started on
+    creation: an iterator of ``(row, trajectory)`` with the generator's ``close``."""
+
+    def __init__(self, chunks, cfg: SweepConfig, n_jobs: int, simulate, warm: bool):
+        calls = [([scene for _, scene in chunk], cfg.numerics, cfg.trajectories, simulate, warm)
+                 for chunk in chunks]
+        self._workers = ForkedWorkers(run_chunk, calls, n_jobs)
+        self._rows = (row for rows in self._workers for row in rows)
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        return next(self._rows)
+
+    def close(self) -> None:
+        self._workers.close()
+
+
 def _results(chunks, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate,
              warm: bool = True):
-    """Yield ``(row, trajectory)`` per scene: chunk by chunk in completion order."""
+    """``(row, trajectory)`` per scene: chunk by chunk in completion order. Forked workers
+    (backend "fork") start at this call; the others at the first row asked for."""
+    if backend == "fork":
+        return _ForkedResults(chunks, cfg, n_jobs, simulate, warm)
+    return _joblib_results(chunks, cfg, backend, n_jobs, client, simulate, warm)
+
+
+def _joblib_results(chunks, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate,
+                    warm: bool = True):
     calls = (delayed(run_chunk)([scene for _, scene in chunk], cfg.numerics,
                                 cfg.trajectories, simulate, warm)
              for chunk in chunks)

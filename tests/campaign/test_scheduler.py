@@ -181,17 +181,30 @@ def test_one_thread_per_worker(tmp_path, monkeypatch):
         assert info["numba"] == 1, info
 
 
-def test_worker_warms_numba_cache_once(monkeypatch):
+def _warm_up_calls(monkeypatch, kernels_loaded: bool, scenes: int) -> list:
+    """run_scene ``scenes`` times in this process as a fresh worker would (the parent having
+    loaded the kernels before forking it, or not); the warm_up calls it made."""
     import sweep.engine.bem as solver
     calls = []
     monkeypatch.setattr(solver, "warm_up", lambda: calls.append(1) or 0.0, raising=False)
     monkeypatch.setattr(solver, "simulate", fake_simulate)
     monkeypatch.setattr(scheduler, "_WORKER_READY", False)
+    monkeypatch.setattr(scheduler, "_KERNELS_LOADED", kernels_loaded)
     for var in scheduler.THREAD_VARS:                   # run_scene sets these if unset
         monkeypatch.setenv(var, os.environ.get(var, "1"))
-    for _ in range(3):
+    for _ in range(scenes):
         row, traj = run_scene(Scene(n=0.4, rate=1, a0=2), Numerics.preset("fast"))
-    assert calls == [1] and row["status"] == "ok" and traj is None
+        assert row["status"] == "ok" and traj is None
+    return calls
+
+
+def test_worker_warms_numba_cache_once(monkeypatch):
+    assert _warm_up_calls(monkeypatch, kernels_loaded=False, scenes=3) == [1]
+
+
+def test_a_forked_worker_does_not_load_the_kernels_its_parent_loaded(monkeypatch):
+    """A worker forked after the parent's warm-up (_KERNELS_LOADED inherited) loads nothing."""
+    assert _warm_up_calls(monkeypatch, kernels_loaded=True, scenes=2) == []
 
 
 def test_a_grid_without_bem_scenes_compiles_no_kernels_on_a_cold_cache(monkeypatch):
@@ -252,7 +265,7 @@ def test_unreachable_scheduler_fails_fast_and_writes_nothing(tmp_path):
 
 
 @pytest.mark.parametrize("kw, needle", [
-    ({"backend": "spark"}, "backend must be one of loky, dask"),
+    ({"backend": "spark"}, "backend must be one of local, loky, dask"),
     ({"jobs": 0}, "jobs must be an integer in [1, 4096]"),
     ({"scheduler": "tcp://x:1"}, "only used with backend dask"),
     ({"progress": "fancy"}, "progress must be one of"),
