@@ -76,16 +76,20 @@ def _code_tag() -> str:
 
 
 def _from_disk(key):
-    """(h, delta, spent) of ``key`` from the disk cache, or None (absent, unreadable, or
-    another key under the same digest)."""
+    """(h, delta, spent) of ``key`` from the disk cache, (None, reason, spent) for a start
+    that failed, or None (absent, unreadable, or another key under the same digest)."""
     path = diskcache.record_path("relaxed", _code_tag, key)
     got = None if path is None else diskcache.load(path)
-    if got is None or not {"key", "h", "delta", "spent"} <= set(got):
+    if got is None or not {"key", "spent"} <= set(got):
         return None
     if str(got["key"]) != repr(key) or got["spent"].shape != (N_STATS,):
         return None
-    return (np.asarray(got["h"], dtype=float), float(got["delta"]),
-            np.asarray(got["spent"], dtype=np.int64))
+    spent = np.asarray(got["spent"], dtype=np.int64)
+    if "failed" in got:
+        return None, str(got["failed"]), spent
+    if not {"h", "delta"} <= set(got):
+        return None
+    return np.asarray(got["h"], dtype=float), float(got["delta"]), spent
 
 
 class ElasticSolver:
@@ -198,7 +202,15 @@ def cached_state(key, solve, stats=None):
 
     ``stats`` (the solver's counters, :data:`sweep.kernels.solve.N_STATS`) grows by what the
     solve counted, whether it ran now or when the state was kept: a row's Newton iterations
-    and factorizations do not depend on what its process solved before."""
+    and factorizations do not depend on what its process solved before.
+
+    A start that fails (``solve()`` raises RuntimeError: no converged state, the walks'
+    WALK_MAX_SOLVES spent) is kept too, with its reason, and raises again at once: it is as
+    much a function of the key as a state is. A coarse mesh that cannot hold a start (the
+    error estimate's half resolution at a0 3.5 on the threshold grid's fast numerics: 158
+    solves, 0.13 s) then costs a campaign that once, not every scene that asks for it. A
+    start stopped by the scene's time budget (:class:`sweep.engine.budget.OverBudget`) is
+    not kept: another scene's budget may let it finish."""
     hit = _RELAXED.get(key)
     if hit is not None:
         _RELAXED.move_to_end(key)
@@ -209,12 +221,24 @@ def cached_state(key, solve, stats=None):
     if hit is not None:
         if stats is not None:
             stats += hit[2]
+        if hit[0] is None:
+            raise RuntimeError(hit[1])
         return hit[0].copy(), hit[1]
     before = None if stats is None else stats.copy()
-    h, d = solve()
+    path = diskcache.record_path("relaxed", _code_tag, key)
+    try:
+        h, d = solve()
+    except budget.OverBudget:
+        raise
+    except RuntimeError as exc:
+        spent = np.zeros(N_STATS, dtype=np.int64) if stats is None else stats - before
+        _keep(key, (None, str(exc), spent))
+        if path is not None:
+            diskcache.save(path, {"key": np.array(repr(key)), "failed": np.array(str(exc)),
+                                  "spent": spent})
+        raise
     spent = np.zeros(N_STATS, dtype=np.int64) if stats is None else stats - before
     _keep(key, (h.copy(), d, spent))
-    path = diskcache.record_path("relaxed", _code_tag, key)
     if path is not None:
         diskcache.save(path, {"key": np.array(repr(key)), "h": h, "delta": np.array(d),
                               "spent": spent})

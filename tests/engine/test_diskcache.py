@@ -162,3 +162,42 @@ def test_a_damaged_record_reads_as_missing(tmp_path, damage):
     assert diskcache.load(path) is None
     with pytest.raises(ValueError, match="object"):
         diskcache._record_bytes({"o": np.array([object()])})
+
+
+def test_a_failed_relaxed_start_is_kept_and_fails_again_without_solving(cache):
+    """A start that fails is as much a function of its key as a state: kept in memory and on
+    disk with its reason and counters, it raises again at once (the solver's counters grow by
+    what the failed solve counted, as if it ran); a start stopped by the time budget is not
+    kept."""
+    from sweep.engine import budget, initial
+    from sweep.kernels.solve import N_STATS
+
+    initial.clear_relaxed_cache()
+    calls = []
+
+    def failing(stats):
+        def solve():
+            calls.append(1)
+            stats[0] += 7                               # what the solver counted
+            raise RuntimeError("no converged relaxed state at delta0=9.7")
+        return solve
+
+    for memory in (True, True, False):                  # solved, then memory, then disk
+        if not memory:
+            initial.clear_relaxed_cache()
+        stats = np.zeros(N_STATS, dtype=np.int64)
+        with pytest.raises(RuntimeError, match="no converged relaxed state at delta0=9.7"):
+            initial.cached_state(("fail", 1.0), failing(stats), stats)
+        assert stats[0] == 7
+    assert calls == [1] and len(list(cache.glob(RELAXED))) == 1
+    assert initial._from_disk(("fail", 1.0))[:2] == (None, "no converged relaxed state at "
+                                                           "delta0=9.7")
+
+    def over_budget():
+        calls.append(2)
+        raise budget.OverBudget("time budget")
+    for _ in range(2):
+        with pytest.raises(budget.OverBudget):
+            initial.cached_state(("slow", 1.0), over_budget)
+    assert calls == [1, 2, 2] and len(list(cache.glob(RELAXED))) == 1
+    initial.clear_relaxed_cache()
