@@ -68,22 +68,22 @@ class ForkedWorkers:
                 initializer=_ignore_sigint)
             # the first submit forks every worker (the fork start method starts them all at
             # once, before the executor's own threads): they inherit _CALLS as it is now
-            self._futures = [self._executor.submit(_call, i) for i in range(len(_CALLS[1]))]
+            futures = [self._executor.submit(_call, i) for i in range(len(_CALLS[1]))]
         finally:
             _CALLS = None
-        self._read = 0
+        #: the calls whose results are not read yet (a result read is dropped here, so a
+        #: long sweep's rows and trajectories are not all held until its end)
+        self.pending = set(futures)
 
     def __iter__(self):
-        for future in as_completed(self._futures):
-            result = future.result()        # BrokenProcessPool if a worker died
-            self._read += 1
-            yield result
+        for future in as_completed(list(self.pending)):
+            self.pending.discard(future)
+            yield future.result()           # BrokenProcessPool if a worker died
 
     def close(self) -> None:
         """End the workers: at once (SIGKILL) if results are still unread, else when idle."""
-        unfinished = self._read < len(self._futures)
-        if unfinished:
-            for future in self._futures:
+        if self.pending:
+            for future in self.pending:
                 future.cancel()
             for process in list((getattr(self._executor, "_processes", None) or {}).values()):
                 try:

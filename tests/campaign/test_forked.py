@@ -210,3 +210,27 @@ def test_ctrl_c_reaches_the_parent_which_keeps_the_rows_and_ends_its_workers(tmp
     left = subprocess.run(["pgrep", "-g", str(proc.pid)], capture_output=True, text=True)
     assert not left.stdout.split(), "workers outlived the interrupted sweep"
     assert 1 <= len(load(tmp_path / "r.h5")) <= 4
+
+
+def _square(x):
+    return x * x
+
+
+_POOL = """
+import gc, weakref
+from sweep.campaign.forked import ForkedWorkers
+from tests.campaign.test_forked import _square
+workers = ForkedWorkers(_square, [(i,) for i in range(40)], 2)
+got = []
+for value in workers:
+    got.append(value)
+    assert len(workers.pending) == 40 - len(got)
+workers.close()
+print(sorted(got) == [i * i for i in range(40)], len(workers.pending))
+"""
+
+
+def test_forked_workers_return_every_result_and_keep_none_read():
+    """Every call's result, in completion order; a result read is no longer held by the
+    pool (a long sweep's rows are not all kept until its end)."""
+    assert _fresh_python(_POOL).split() == ["True", "0"]
