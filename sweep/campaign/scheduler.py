@@ -548,7 +548,6 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
     todo = [(sid, scene) for sid, scene in tasks if sid not in done or sid in retry]
     skipped = len(tasks) - len(todo)
     prog = Progress(progress, total=len(tasks), already=skipped, stream=stream)
-    forked = False
     if backend in ("local", "loky"):
         n_jobs = min(jobs or os.cpu_count() or 1, max(len(todo), 1))
         forked = backend == "local" and n_jobs > 1 and forked_workers_usable()
