@@ -63,3 +63,22 @@ def test_a_relaxed_start_stops_after_walk_max_solves(monkeypatch):
     with pytest.raises(RuntimeError, match=r"the continuation stopped after 20 solves"):
         initial._solve_relaxed(el, a0=SCENE.a0)
     assert counts["solves"] <= 20 + 60 + 2 * 9
+
+
+def test_the_walk_holds_the_estimates_half_resolution_start_and_the_estimate_covers():
+    """The threshold grid's scene n 1.6, a0 3.5, rate 1e6 at its own numerics (band
+    resolution 9): the error estimate's half-resolution mesh (139 nodes) holds the relaxed
+    start only through the walk's shifted-gap start (the secant alone failed there, and the
+    estimate fell back to a pair at 1/sqrt 2 of the resolution, which missed a crossing:
+    4.2e-5 against a true error of 2.2e-4). The estimate must cover the error against the
+    accurate preset (its own estimate about 5e-5: a second, finer solve)."""
+    from sweep.engine.models import simulate
+
+    scene = Scene(n=1.6, k=0.1, mu=3.24, a0=3.5, rate=1e6)
+    numerics = Numerics.preset("fast", max_nodes=1000)      # configs/threshold.yaml's
+    res = simulate(scene, numerics)
+    ref = simulate(scene, Numerics.preset("accurate", pull_off_rtol=0.0))
+    assert res.ok and ref.ok
+    true = abs(res.pull_off / ref.pull_off - 1.0)
+    assert true > 1e-4                      # an error well above the reference's own
+    assert res.error_estimate >= true, (res.error_estimate, true)
