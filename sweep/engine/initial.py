@@ -215,8 +215,9 @@ def cached_state(key, solve, stats=None):
     A start that fails (``solve()`` raises RuntimeError: no converged state, the walks'
     WALK_MAX_SOLVES spent) is kept too, with its reason, and raises again at once: it is as
     much a function of the key as a state is. A coarse mesh that cannot hold a start (the
-    error estimate's half resolution at a0 3.5 on the threshold grid's fast numerics: 158
-    solves, 0.13 s) then costs a campaign that once, not every scene that asks for it. A
+    error estimate's half resolution at a0 3.5 on the threshold grid's fast numerics, before
+    the walk's shifted-gap retry: 158 solves, 0.13 s) then costs a campaign that once, not
+    every scene that asks for it. A
     start stopped by the scene's time budget (:class:`sweep.engine.budget.OverBudget`) is
     not kept: another scene's budget may let it finish."""
     hit = _RELAXED.get(key)
@@ -233,23 +234,24 @@ def cached_state(key, solve, stats=None):
             raise RuntimeError(hit[1])
         return hit[0].copy(), hit[1]
     before = None if stats is None else stats.copy()
-    path = diskcache.record_path("relaxed", _code_tag, key)
+
+    def kept(state: tuple, record: dict) -> None:
+        """Keep ``state`` (first two items) with the counters the solve added, in memory and
+        on disk (``record``: its arrays besides the key and the counters)."""
+        spent = np.zeros(N_STATS, dtype=np.int64) if stats is None else stats - before
+        _keep(key, (*state, spent))
+        path = diskcache.record_path("relaxed", _code_tag, key)
+        if path is not None:
+            diskcache.save(path, {"key": np.array(repr(key)), **record, "spent": spent})
+
     try:
         h, d = solve()
     except budget.OverBudget:
         raise
     except RuntimeError as exc:
-        spent = np.zeros(N_STATS, dtype=np.int64) if stats is None else stats - before
-        _keep(key, (None, str(exc), spent))
-        if path is not None:
-            diskcache.save(path, {"key": np.array(repr(key)), "failed": np.array(str(exc)),
-                                  "spent": spent})
+        kept((None, str(exc)), {"failed": np.array(str(exc))})
         raise
-    spent = np.zeros(N_STATS, dtype=np.int64) if stats is None else stats - before
-    _keep(key, (h.copy(), d, spent))
-    if path is not None:
-        diskcache.save(path, {"key": np.array(repr(key)), "h": h, "delta": np.array(d),
-                              "spent": spent})
+    kept((h.copy(), d), {"h": h, "delta": np.array(d)})
     return h, d
 
 
