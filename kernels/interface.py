@@ -90,11 +90,16 @@ def zone_factor(q, xi, qs):
     The cubic joins 1 and the power law with value and slope (m is C1 and increasing), so
     that Newton meets no infinite slope at q = 0 (the power law's for xi < 1; with it the
     solves stalled, docs/design.md "The process zone in the BEM"); below q_s it differs from
-    the power law by less than q_s^xi = ZONE_SMOOTH_TERM."""
+    the power law by less than q_s^xi = ZONE_SMOOTH_TERM.
+
+    xi = 1/2 (the paper's process-zone ratio 1 + (v/v1)^(1/2)) takes a square root for the
+    power: pow costs about 16 ns a node against 2.5, and the traction is evaluated at every
+    node several times a step (a tenth of a process-zone scene's time went to pow;
+    docs/performance.md, "The process zone's cost")."""
     if q <= 0.0:
         return 1.0, 0.0
     if q >= qs:
-        p = q ** xi
+        p = np.sqrt(q) if xi == 0.5 else q ** xi
         return 1.0 + p, xi * p / q
     x = q / qs
     a = qs ** xi

@@ -1,7 +1,8 @@
 """The protocol march's own solves (:mod:`sweep.engine.protocol`; Numba kernels): a time step
 held at a load, Newton on the gap and the indentation together (:func:`newton_at_load`),
-Newton's start settled at the crack tip (:func:`settle_tip`), and the approach's kept
-factorization, its crack-tip zone ahead of an advancing tip (:func:`factorize_ahead`).
+Newton's start settled at the crack tip (:func:`kernels.solve.settle_tip`), and the
+approach's kept factorization, its crack-tip zone ahead of an advancing tip
+(:func:`factorize_ahead`).
 
 A dwell at force (:mod:`sweep.engine.protocol`) asks, at each time step, for the indentation
 delta at which the equilibrium of the step carries the preload. Solved as one system, for the
@@ -20,19 +21,18 @@ instead of a secant of two or three solves on delta.
 
 The march's starts (an extrapolation of the last states) are furthest off at the crack tip,
 where the gap equation is most nonlinear: the node behind an advancing tip lands on the
-repulsive wall, and even exact Newton from there took three iterations. :func:`settle_tip`
-runs Newton on the few nodes around the tip alone, the others held, at the cost of those
-rows of A, before the solve of the whole.
+repulsive wall, and even exact Newton from there took three iterations.
+:func:`kernels.solve.settle_tip` runs Newton on the few nodes around the tip alone, the
+others held, at the cost of those rows of A, before the solve of the whole.
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-from .blas import lu_factor, lu_solve
 from .jacobian import (CACHE_STATE, STATE_SUBSET, STATE_VALID, STATE_ZONE_HI, apply_inverse,
                        crack_tip_index, factorize, newton_direction)
-from .interface import TIP_GAP, traction, traction_and_stiffness
+from .interface import TIP_GAP, traction_and_stiffness
 from .solve import (STAT_FACTOR, STAT_ITER, STAT_REFACTOR_SLOW, STAT_REFACTOR_ZONE,
                     STAT_RESIDUALS, STAT_SUBSET, STAT_ZONE, positive_step, residual)
 
@@ -163,47 +163,3 @@ def factorize_ahead(h, A, ceff, law, ahead, least, cache, stats):
         closed[i] = min(closed[i], below)
     _factorize_counted(closed, A, ceff, law, cache, stats)
     return True
-
-
-@njit(cache=True)
-def settle_tip(h, g, A, ceff, H, law, lo, hi, iters):
-    """Newton on the gaps of the nodes [lo, hi) alone, the others held, for ``iters``
-    iterations, in place: Newton's start settled at the crack tip, where the gap equation is
-    most nonlinear (the node behind an advancing tip lands on the repulsive wall) and an
-    extrapolated start is furthest off. Each iteration costs (hi - lo) rows of A, not all N.
-    Keeps the start where the nodes' residual did not fall. Returns that residual's max,
-    before and after."""
-    N, z = h.size, hi - lo
-    sig, d, dr, w = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
-    traction(h, law.h_old, law.zone, law.h0, law.c, sig)
-    for j in range(N):
-        w[j] = ceff * sig[j] - H[j]
-    kept = h[lo:hi].copy()
-    J, piv, dz = np.empty((z, z)), np.empty(z, np.int32), np.empty((1, z))
-    first, norm = np.inf, np.inf
-    for it in range(iters + 1):
-        traction_and_stiffness(h[lo:hi], law.h_old[lo:hi], law.zone, law.h0, law.c,
-                               sig[lo:hi], d[lo:hi], dr[lo:hi])
-        for k in range(lo, hi):
-            w[k] = ceff * sig[k] - H[k]
-        norm = 0.0
-        for k in range(z):
-            dz[0, k] = -(h[lo + k] - g[lo + k] - np.dot(A[lo + k], w))
-            norm = max(norm, abs(dz[0, k]))
-        first = norm if it == 0 else first
-        if it == iters:
-            break
-        for k in range(z):
-            for m in range(z):
-                J[k, m] = -ceff * A[lo + k, lo + m] * d[lo + m]
-            J[k, k] += 1.0
-        if lu_factor(J, piv) != 0:
-            break
-        lu_solve(J, piv, dz)
-        lam = positive_step(h[lo:hi], dz[0])
-        for k in range(z):
-            h[lo + k] += lam * dz[0, k]
-    if not norm < first:
-        for k in range(z):
-            h[lo + k] = kept[k]
-    return first, norm

@@ -254,6 +254,18 @@ SMOOTH_DA_FRACTION = 0.6
 #: crack speed; with max_iter alone that scene failed at the minimum step, and the rate-100
 #: scene of ``make pz-check`` halved its first step three times and refactorized 107 times)
 FIRST_ZONE_ITER = 4
+#: with a process zone, Newton's cubic start is settled at the crack tip first
+#: (:func:`settle_tip`): the gaps of this many nodes either side of the tip, by
+#: ZONE_SETTLE_ITER Newton iterations on those nodes alone. The rate term makes the gap
+#: equation there much stiffer than the LJ law's, and the start's residual was ten times the
+#: LJ scene's (above 1e3 tol at 370 of 485 steps, against 175 of 429), its maximum at the
+#: tip: Newton took two iterations a step where LJ takes one (n 0.4, k 0.1, mu 3.24, delta0
+#: 4.95, rate 10^0.5, pz_v0 the crack speed: 1.93 iterations a step, 1.26 settled; 6 or 12
+#: nodes, or 1 or 3 iterations, within the noise of 8 and 2; docs/performance.md, "The process
+#: zone's cost"). Not for the LJ law: there the start is near enough, and the settle's
+#: refactorizations cost more than it saves (four of six bench scenes slower)
+ZONE_SETTLE_NODES = 8
+ZONE_SETTLE_ITER = 2
 #: the predictor never puts a gap below this fraction of the last accepted one
 PREDICT_FLOOR = 0.5
 #: the tip predictor (:func:`predict_lattice`) looks this many accepted states back for the
@@ -920,9 +932,65 @@ def predict_step(mesh, physics, work, run):
 
 
 @njit(cache=True, inline='always')
+def tip_node(h, level):
+    """One past the outermost node whose gap is below ``level`` (the crack tip lies between
+    it and the node before); 0 where every gap is above it."""
+    for i in range(h.size - 1, -1, -1):
+        if h[i] < level:
+            return i + 1
+    return 0
+
+
+@njit(cache=True)
+def settle_tip(h, g, A, ceff, H, law, lo, hi, iters):
+    """Newton on the gaps of the nodes [lo, hi) alone, the others held, for ``iters``
+    iterations, in place: Newton's start settled at the crack tip, where the gap equation is
+    most nonlinear and an extrapolated start is furthest off (the node behind an advancing
+    tip lands on the repulsive wall: the protocol's approach, :mod:`kernels.protocol`; a
+    process zone's rate term, :func:`solve_step`). Each iteration costs (hi - lo) rows of A,
+    not all N. Keeps the start where the nodes' residual did not fall. Returns that
+    residual's max, before and after."""
+    N, z = h.size, hi - lo
+    sig, d, dr, w = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
+    traction(h, law.h_old, law.zone, law.h0, law.c, sig)
+    for j in range(N):
+        w[j] = ceff * sig[j] - H[j]
+    kept = h[lo:hi].copy()
+    J, piv, dz = np.empty((z, z)), np.empty(z, np.int32), np.empty((1, z))
+    first, norm = np.inf, np.inf
+    for it in range(iters + 1):
+        traction_and_stiffness(h[lo:hi], law.h_old[lo:hi], law.zone, law.h0, law.c,
+                               sig[lo:hi], d[lo:hi], dr[lo:hi])
+        for k in range(lo, hi):
+            w[k] = ceff * sig[k] - H[k]
+        norm = 0.0
+        for k in range(z):
+            dz[0, k] = -(h[lo + k] - g[lo + k] - np.dot(A[lo + k], w))
+            norm = max(norm, abs(dz[0, k]))
+        first = norm if it == 0 else first
+        if it == iters:
+            break
+        for k in range(z):
+            for m in range(z):
+                J[k, m] = -ceff * A[lo + k, lo + m] * d[lo + m]
+            J[k, k] += 1.0
+        if lu_factor(J, piv) != 0:
+            break
+        lu_solve(J, piv, dz)
+        lam = positive_step(h[lo:hi], dz[0])
+        for k in range(z):
+            h[lo + k] += lam * dz[0, k]
+    if not norm < first:
+        for k in range(z):
+            h[lo + k] = kept[k]
+    return first, norm
+
+
+@njit(cache=True, inline='always')
 def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
-    """-- solve: Newton from ``work.hp``, again from the quadratic start where the cubic one
-    failed; after a failure the step is halved, down to SNAP_STEP_FRACTION step_max, and
+    """-- solve: Newton from ``work.hp`` (with a process zone, its cubic start settled at
+    the crack tip first: ZONE_SETTLE_NODES), again from the quadratic start where the cubic
+    one failed; after a failure the step is halved, down to SNAP_STEP_FRACTION step_max, and
     the next solves are exact Newton; below it the path folds and the snapped state is
     looked for. Returns SOLVED, HALVED, SNAPPED or FAILED (the state, if any, in hp)."""
     A, h0, hp = mesh.A, physics.h0, work.hp
@@ -932,6 +1000,10 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     if not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0:
         max_iter *= FIRST_ZONE_ITER
     compliance, wP = physics.compliance, mesh.wP
+    if not np.isinf(physics.hdot_c) and cubic and cache[CACHE_STATE][STATE_EXACT] == 0:
+        tip = tip_node(hp, hm)
+        settle_tip(hp, work.g, A, ceff, work.H, law, max(tip - ZONE_SETTLE_NODES, 0),
+                   min(tip + ZONE_SETTLE_NODES, hp.size), ZONE_SETTLE_ITER)
     ok = newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
                         compliance, wP)
     if not ok and cubic:

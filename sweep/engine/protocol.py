@@ -36,7 +36,8 @@ import numpy as np
 
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
-from ..kernels.protocol import factorize_ahead, newton_at_load, settle_tip
+from ..kernels.protocol import factorize_ahead, newton_at_load
+from ..kernels.solve import settle_tip
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
                              invalidate, load, new_jacobian_cache, newton, predict,
                              predict_lattice, relax, score_starts)
@@ -181,7 +182,7 @@ class _March:
 
     def _settle(self, h, g, ceff, H):
         """Newton's start ``h`` settled at the crack tip of the last state (TIP_NODES nodes
-        either side, TIP_ITER iterations: :func:`sweep.kernels.protocol.settle_tip`)."""
+        either side, TIP_ITER iterations: :func:`sweep.kernels.solve.settle_tip`)."""
         tip = int(np.searchsorted(self.pb.mesh.r, self.records["a"][-1]))
         settle_tip(h, g, self.pb.A, ceff, H, self.law, max(tip - TIP_NODES, 0),
                    min(tip + TIP_NODES, h.size), TIP_ITER)

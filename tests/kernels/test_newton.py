@@ -260,3 +260,65 @@ def test_newton_with_a_compliant_machine_is_the_rigid_solve_at_d_minus_p_over_k(
     assert np.max(np.abs(hs - g - A @ (ceff * sig - H))) < 1e-10 * h0
     # measured 9 and 16 iterations at K = 3 and 0.3 (8 for a rigid machine, K = 1e6)
     assert stats[ks.STAT_ITER] <= 20
+
+
+def _pz_traction(h, h_old, h0, c, rate_scale, xi):
+    """The process zone's traction in numpy, from the law's definition (docs/design.md, "The
+    process zone in the BEM"): m(q) sigma_LJ on the tensile side, q = (h - h_old) rate_scale;
+    the power law itself (the nodes of this step open far beyond its smoothed range)."""
+    x3 = (h0 / h) ** 3
+    lj = -c * (x3 - x3 ** 3)
+    q = np.maximum((h - h_old) * rate_scale, 0.0)
+    return np.where(h > h0, (1.0 + q ** xi) * lj, lj)
+
+
+def test_settling_the_tip_with_a_process_zone_lowers_its_residual_and_keeps_the_solution():
+    """A process-zone step (kernels.solve.solve_step settles its cubic start at the crack tip,
+    ZONE_SETTLE_NODES): from the relaxed elastic state, an unloading step of 0.2 h0 whose
+    start misses the solution at the tip by 1e-3 h0 (a fifth of the step's opening there, as a
+    cubic extrapolation's miss can be). settle_tip lowers the residual of the
+    settled nodes (numpy's, of the law as documented) by orders and moves no other node; Newton
+    from the settled start and from the unsettled one reach the same state, within their
+    tolerance."""
+    from sweep.engine.initial import ElasticSolver, relaxed_state
+    from sweep.kernels.interface import ZONE_SMOOTH_TERM, Interface
+
+    N = 160
+    A, _, h0, c, _ = _problem(N=N)
+    r = np.arange(N) * 3.0 / (N - 1)
+    el = ElasticSolver(A, r, h0, c, 1e-10)
+    h_start, _ = relaxed_state(el, delta0=1.0)
+    xi, rate_scale = 0.5, 50.0 / h0                  # m - 1 = 1 at an opening of h0 / 50
+    law = Interface(h0, c, h_start.copy(), np.array([rate_scale, xi, ZONE_SMOOTH_TERM ** (1 / xi)]))
+    g = -(1.0 - 0.2 * h0) + h0 + 0.5 * r ** 2
+    ceff, H, tol = 0.8, -0.05 * np.exp(-r), 1e-10 * h0
+
+    def newton(h):
+        ok = ks.newton(h, g, A, ceff, H, law, tol, 40, ks.new_jacobian_cache(N),
+                       np.zeros(ks.N_STATS, np.int64))
+        return ok, h
+
+    ok, solution = newton(h_start.copy())
+    assert ok
+    F = solution - g - A @ (ceff * _pz_traction(solution, h_start, h0, c, rate_scale, xi) - H)
+    assert np.max(np.abs(F)) <= tol                  # the kernel's law is the documented one
+    tip = ks.tip_node(solution, 3.0 ** (1.0 / 6.0) * h0)
+    lo, hi = tip - ks.ZONE_SETTLE_NODES, tip + ks.ZONE_SETTLE_NODES
+    zone_term = np.maximum((solution - h_start) * rate_scale, 0.0) ** xi
+    assert 0 < lo and hi < N and zone_term[lo:hi].max() > 0.3      # the zone acts at the tip
+    start = solution.copy()
+    start[lo:hi] += 1e-3 * h0 * np.sin(np.pi * (np.arange(hi - lo) + 0.5) / (hi - lo))
+
+    def tip_residual(h):
+        F = h - g - A @ (ceff * _pz_traction(h, h_start, h0, c, rate_scale, xi) - H)
+        return np.max(np.abs(F[lo:hi]))
+
+    settled = start.copy()
+    first, after = ks.settle_tip(settled, g, A, ceff, H, law, lo, hi, ks.ZONE_SETTLE_ITER)
+    assert first == pytest.approx(tip_residual(start), rel=1e-9)
+    assert tip_residual(settled) == pytest.approx(after, rel=1e-6, abs=1e-14)
+    assert after < 1e-2 * first
+    assert np.array_equal(settled[:lo], start[:lo]) and np.array_equal(settled[hi:], start[hi:])
+    for h in (start, settled):
+        ok, found = newton(h.copy())
+        assert ok and np.max(np.abs(found - solution)) <= 1e-8 * h0

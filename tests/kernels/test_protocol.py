@@ -14,7 +14,8 @@ from sweep.engine.problem import lj_constants
 from sweep.kernels import solve as ks
 from sweep.kernels.interface import lennard_jones, lj_traction_and_stiffness
 from sweep.kernels import jacobian as jac
-from sweep.kernels.protocol import factorize_ahead, newton_at_load, settle_tip
+from sweep.kernels.protocol import factorize_ahead, newton_at_load
+from sweep.kernels.solve import settle_tip
 
 N = 120
 TOL = 1e-10        # units of h0
