@@ -174,8 +174,8 @@ def _refinable(res) -> bool:
 
 def _bem_once(scene, numerics):
     """One BEM solve with its error estimate, on the mesh that fits ``numerics`` (a scene
-    with a process zone or a test protocol on the graded or uniform mesh: the tip-following
-    mesh's re-meshing carries no opening rates, and its window starts at a0)."""
+    with a test protocol on the graded or uniform mesh: the tip-following mesh's window
+    starts at a0)."""
     if wants_tip_following(scene, numerics):
         from .tip_following import simulate_tip_following  # lazy: scipy.interpolate, optimize
 
@@ -199,12 +199,12 @@ def wants_tip_following(scene, numerics) -> bool:
     a graded mesh sized from the band resolution (``nodes`` unset, not ``exact``) whose
     fixed crack band would need more than ``numerics.max_nodes`` nodes (large mu or a0), or
     :data:`TIP_FOLLOWING_NODE_RATIO` times the nodes of the window that follows the tip (the
-    cheaper mesh at equal resolution). Never a scene with a process zone (the re-meshing
-    carries no opening rates) or a test protocol (the window starts at a0)."""
+    cheaper mesh at equal resolution). Never a scene with a test protocol (the window starts
+    at a0) or a compliant machine; a process zone is carried across the re-meshings
+    (:func:`sweep.engine.tip_following.transfer`)."""
     if not (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact):
         return False
-    if (scene.pz_law != "none" or scene.protocol() is not None
-            or scene.machine_stiffness is not None):
+    if scene.protocol() is not None or scene.machine_stiffness is not None:
         return False
     graded = bem_nodes_needed(scene, numerics)
     if graded > numerics.max_nodes:

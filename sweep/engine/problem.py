@@ -360,8 +360,6 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
     if mesh.nodes > numerics.max_nodes:
         if protocol:
             other = "a test protocol runs on this mesh only"
-        elif scene.pz_law != "none":
-            other = "the tip-following mesh carries no process zone: use model crack"
         else:
             other = ("or run it on the tip-following mesh (sweep.engine.tip_following; model "
                      "bem does so)")

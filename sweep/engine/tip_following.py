@@ -17,7 +17,8 @@ mesh is rebuilt when the tip leaves the window:
    the fine spacing, so nodes common to both meshes keep their values exactly), the Prony
    modal state ``q`` as displacements (A (sigma - q_i), smooth, interpolated and mapped
    back through the new influence matrix), then the gap is re-equilibrated on the new
-   mesh at frozen time; the records continue and the kernel resumes
+   mesh at frozen time (with a process zone, under the last step's law, the state before it
+   carried too); the records continue and the kernel resumes
    (:func:`sweep.engine.bem.unload_chunk`). Each re-meshing up to the pull-off must leave the
    load continuous (:func:`remesh_jump`), else the run ends failed with the reason.
 
@@ -41,7 +42,7 @@ from scipy.optimize import brentq
 from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
                            STATUS_LEFT_BAND, STATUS_STEP_LIMIT, invalidate, new_jacobian_cache,
                            newton)
-from ..kernels.interface import lennard_jones, lj_traction
+from ..kernels.interface import ZONE_SMOOTH_TERM, Interface, lennard_jones, lj_traction, traction
 
 from ..scene import Numerics, Result, Scene
 from . import budget
@@ -191,7 +192,11 @@ def transfer(run, old, new, form: str = "auto") -> None:
        jumped by 29 % at mu = 15 and 124 % at mu = 30 at the first re-meshing).
     3. The gap is re-equilibrated on the new mesh at frozen time; without it the kernel
        takes the change from the interpolated to the equilibrium traction for the
-       traction increment of its first step (measured: a load jump of 2.3 %).
+       traction increment of its first step (measured: a load jump of 2.3 %). With a
+       process zone the state before the last step (``run.h_prev``) is carried as the gap
+       is, the equilibrium is that of the last step's law (its opening rate by backward
+       Euler over ``run.step[1]``), and the run resumes from the traction under that law
+       (``run.sigma``) and the carried ``h_prev``.
 
     ``form`` says which part of the state is carried and how the traction adjusts:
 
@@ -210,20 +215,36 @@ def transfer(run, old, new, form: str = "auto") -> None:
     the caller's load continuity check judges the result.
     """
     old_r, new_r = old.mesh.r, new.mesh.r
-    run.sigma = None        # the LJ law's traction on the new mesh (bem.unload_chunk)
-    h = CubicSpline(old_r, run.h)(new_r)
     # the spline passes through its knots only to rounding (which depends on the BLAS
     # kernels of the CPU): the common nodes take their old gap exactly
     _, i_old, i_new = np.intersect1d(old.mesh.lattice, new.mesh.lattice, return_indices=True)
-    h[i_new] = run.h[i_old]
-    h = np.maximum(h, 0.5 * float(np.min(run.h)))
+
+    def gap(h_old):
+        h = CubicSpline(old_r, h_old)(new_r)
+        h[i_new] = h_old[i_old]
+        return np.maximum(h, 0.5 * float(np.min(h_old)))
+
+    zone = _last_step_law(run, old)
+    h = gap(run.h)
     run.cache = new_jacobian_cache(new_r.size)
+    if zone is None:
+        run.sigma = None    # the LJ law's traction on the new mesh (bem.unload_chunk)
+        law = lennard_jones(new.h0, new.c, new_r.size)
+        sigma_old = np.empty(old_r.size)
+        lj_traction(run.h, old.h0, old.c, sigma_old)
+    else:
+        # the process zone's traction depends on the step that made the state: the state
+        # before it is carried too, and the new mesh's state is solved with the last step's
+        # law (the opening rate over it, backward Euler: re-equilibrated at frozen time)
+        run.h_prev = gap(run.h_prev)
+        law = Interface(new.h0, new.c, run.h_prev, zone)
+        sigma_old = run.sigma
+    sigma = np.empty(new_r.size)
+    traction(h, law.h_old, law.zone, law.h0, law.c, sigma)
     if run.q.shape[0] == 0:
         run.h, run.q = h, np.zeros((0, new_r.size))
+        _carried_traction(run, law)
         return
-    sigma_old, sigma = np.empty(old_r.size), np.empty(new_r.size)
-    lj_traction(run.h, old.h0, old.c, sigma_old)
-    lj_traction(h, new.h0, new.c, sigma)
     lu = scipy.linalg.lu_factor(new.A)
 
     def carried(history):       # (M, N_old) tractions -> the same displacements, new mesh
@@ -245,24 +266,47 @@ def transfer(run, old, new, form: str = "auto") -> None:
         else:
             ceff = 1.0 - float(np.sum(new.prony_weights))           # Chat(0)
             H = new.prony_weights @ q - np.sum(new.prony_weights) * sigma
-        h_eq = _reequilibrate(run, new, h, ceff, np.ascontiguousarray(H))
+        h_eq = _reequilibrate(run, new, h, ceff, np.ascontiguousarray(H), law)
         if h_eq is not None:
             if name == "glassy":            # every mode takes the change of traction
                 sigma_eq = np.empty(new_r.size)
-                lj_traction(h_eq, new.h0, new.c, sigma_eq)
+                traction(h_eq, law.h_old, law.zone, law.h0, law.c, sigma_eq)
                 q += (sigma_eq - sigma)[None, :]
             run.h, run.q = h_eq, q
+            _carried_traction(run, law)
             return
     run.h, run.q = h, q_first
+    _carried_traction(run, law)
 
 
-def _reequilibrate(run, new, h, ceff, H):
+def _last_step_law(run, pb):
+    """The process zone's state (:data:`sweep.kernels.interface.Interface`'s ``zone``) over
+    the run's last step on ``pb``'s mesh, its opening rate by backward Euler from the carried
+    state before it (``run.h_prev``) over that step (``run.step[1]``); None without a process
+    zone, or before a step was taken (the LJ law at rest)."""
+    if math.isinf(pb.hdot_c) or not run.step[1] > 0.0:
+        return None
+    xi = pb.pz_xi
+    return np.array([1.0 / (pb.hdot_c * float(run.step[1])), xi, ZONE_SMOOTH_TERM ** (1.0 / xi)])
+
+
+def _carried_traction(run, law) -> None:
+    """With a process zone, the traction of the carried state under ``law`` (the last step's):
+    the kernel resumes from it and from ``run.h_prev`` (:func:`sweep.engine.bem.unload_chunk`)."""
+    if run.sigma is not None:
+        run.sigma = np.empty(run.h.size)
+        traction(run.h, law.h_old, law.zone, law.h0, law.c, run.sigma)
+
+
+def _reequilibrate(run, new, h, ceff, H, law=None):
     """The gap on the mesh of ``new`` in equilibrium with u = A (ceff sigma - H) at the
-    indentation of the last record (Newton from ``h``), or None if it does not converge."""
+    indentation of the last record (Newton from ``h``; the interface ``law``, default the
+    Lennard-Jones law), or None if it does not converge."""
     g = -float(run.records[1][run.n - 1]) + new.h0 + 0.5 * new.mesh.r**2
     h_eq = h.copy()
     stats = run.stats if run.stats is not None else np.zeros(N_STATS, dtype=np.int64)
-    ok = newton(h_eq, g, new.A, ceff, H, lennard_jones(new.h0, new.c, h.size),
+    law = lennard_jones(new.h0, new.c, h.size) if law is None else law
+    ok = newton(h_eq, g, new.A, ceff, H, law,
                 new.numerics.tol * new.h0, REEQUILIBRATE_ITER, new_jacobian_cache(h.size), stats)
     return h_eq if ok else None
 

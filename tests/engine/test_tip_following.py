@@ -104,6 +104,47 @@ def test_tip_following_matches_the_fixed_band_where_both_run():
     assert moving.a_pulloff == pytest.approx(fixed.a_pulloff, abs=2 * fixed.spacing)
 
 
+#: a process zone the tip-following mesh carries (pz_v0 in a_ref/tau0; the scene's crack speed
+#: is of that order, so the zone doubles the work of adhesion where it runs)
+PZ = dict(pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5)
+
+
+def _meshes(res):
+    return int(res.reason.split(" meshes")[0].split()[-1])
+
+
+def test_a_process_zone_is_carried_across_remeshings_and_matches_the_fixed_band():
+    """mu 7, a0 3: the band needs 1252 nodes, the window 479, rebuilt three times. With the
+    process zone's state carried (the state before the last step, the last step's law), the
+    pull-off is the fixed band's within the two rows' error estimates (measured 7e-5 against
+    1.6e-3 and 1.7e-3), and the zone acts (the pull-off a third above the LJ scene's)."""
+    scene = Scene(n=0.8, k=0.1, mu=7.0, a0=3.0, rate=10.0, model="bem", **PZ)
+    num = Numerics.preset("balanced")
+    assert models.wants_tip_following(scene, num)
+    moving = tf.simulate_tip_following(scene, num)
+    fixed = simulate(scene, Numerics.preset("balanced", max_nodes=1500))
+    assert moving.ok and fixed.ok, (moving.reason, fixed.reason)
+    assert _meshes(moving) >= 3 and moving.nodes_used < fixed.nodes_used
+    bound = max(moving.error_estimate, fixed.error_estimate)
+    assert abs(moving.pull_off / fixed.pull_off - 1.0) <= bound
+    plain = tf.simulate_tip_following(Scene(n=0.8, k=0.1, mu=7.0, a0=3.0, rate=10.0), num)
+    assert moving.pull_off > 1.2 * plain.pull_off
+
+
+def test_a_vanishing_process_zone_on_the_tip_following_mesh_is_the_lj_scene():
+    """pz_v0 1e12: the law's factor differs from 1 by less than 1e-5 at every node, so the
+    process zone's path through the re-meshings (its carried state and law) gives the LJ
+    scene's run: the same meshes and steps, the pull-off to 1e-6 (measured 7e-8)."""
+    lj = Scene(n=0.8, k=0.1, mu=7.0, a0=3.0, rate=10.0, model="bem")
+    num = Numerics.preset("balanced", pull_off_rtol=0.0)
+    plain = tf.simulate_tip_following(lj, num)
+    faint = tf.simulate_tip_following(Scene(**{**lj.to_dict(), **PZ, "pz_v0": 1e12}), num)
+    assert plain.ok and faint.ok, (plain.reason, faint.reason)
+    assert _meshes(plain) >= 3 and _meshes(faint) == _meshes(plain)
+    assert faint.steps == plain.steps
+    assert faint.pull_off == pytest.approx(plain.pull_off, rel=1e-6)
+
+
 def test_large_mu_bem_scenes_route_to_the_tip_following_mesh():
     num = Numerics.preset("balanced")
     assert models.wants_tip_following(Scene(n=0.8, k=0.5, mu=30.0, a0=1.5, rate=1.0), num)
