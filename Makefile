@@ -255,11 +255,13 @@ crack-speed: $(STAMP)
 	$(BIN)/python -m sweep.bench.crack_speed $(if $(filter 1,$(QUICK)),--quick --out results/quick/crack_speed)
 
 # issue 21: a random sample across the declared ranges through `sweep run`, model auto and the
-# default bem (configs/random/, written by `python -m sweep.bench.random_sample configs`);
+# default bem (configs/random/, written by `python -m sweep.bench.random_sample configs`), and
+# 24 process-zone scenes on the BEM (configs/random/process_zone.yaml, issue 35);
 # the summary counts ok / physically refused / failed / internal errors and draws the map
 random-sample: $(STAMP)
 	-$(BIN)/sweep run configs/random/auto.yaml -j 2
 	-$(BIN)/sweep run configs/random/bem.yaml -j 2
+	-$(BIN)/sweep run configs/random/process_zone.yaml -j 2
 	$(BIN)/python -m sweep.bench.random_sample summary
 
 clean:
