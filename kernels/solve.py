@@ -255,7 +255,7 @@ SMOOTH_DA_FRACTION = 0.6
 #: scene of ``make pz-check`` halved its first step three times and refactorized 107 times)
 FIRST_ZONE_ITER = 4
 #: with a process zone, Newton's cubic start is settled at the crack tip first
-#: (:func:`settle_tip`): the gaps of this many nodes either side of the tip, by
+#: (:func:`settle_tip`): the gaps of this many nodes either side of the last state's tip, by
 #: ZONE_SETTLE_ITER Newton iterations on those nodes alone. The rate term makes the gap
 #: equation there much stiffer than the LJ law's, and the start's residual was ten times the
 #: LJ scene's (above 1e3 tol at 370 of 485 steps, against 175 of 429), its maximum at the
@@ -931,16 +931,6 @@ def predict_step(mesh, physics, work, run):
     return quadratic, cubic
 
 
-@njit(cache=True, inline='always')
-def tip_node(h, level):
-    """One past the outermost node whose gap is below ``level`` (the crack tip lies between
-    it and the node before); 0 where every gap is above it."""
-    for i in range(h.size - 1, -1, -1):
-        if h[i] < level:
-            return i + 1
-    return 0
-
-
 @njit(cache=True)
 def settle_tip(h, g, A, ceff, H, law, lo, hi, iters):
     """Newton on the gaps of the nodes [lo, hi) alone, the others held, for ``iters``
@@ -1001,7 +991,7 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
         max_iter *= FIRST_ZONE_ITER
     compliance, wP = physics.compliance, mesh.wP
     if not np.isinf(physics.hdot_c) and cubic and cache[CACHE_STATE][STATE_EXACT] == 0:
-        tip = tip_node(hp, hm)
+        tip = np.searchsorted(mesh.r, run[RUN_A])      # the last state's crack tip
         settle_tip(hp, work.g, A, ceff, work.H, law, max(tip - ZONE_SETTLE_NODES, 0),
                    min(tip + ZONE_SETTLE_NODES, hp.size), ZONE_SETTLE_ITER)
     ok = newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
