@@ -80,6 +80,13 @@ ZONE_SMOOTH_TERM = 3e-2
 
 
 @njit(cache=True)
+def smoothing_rate(xi):
+    """q_s = ZONE_SMOOTH_TERM^(1/xi), the opening rate below which the process zone's law is
+    smoothed (:func:`zone_factor`; zone[ZONE_SMOOTH] of a law of exponent ``xi``)."""
+    return ZONE_SMOOTH_TERM ** (1.0 / xi)
+
+
+@njit(cache=True)
 def zone_factor(q, xi, qs):
     """m(q) and dm/dq of the process zone at the normalized opening rate q = hdot/hdot_c:
 

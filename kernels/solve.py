@@ -59,8 +59,8 @@ from numba import njit
 
 from .blas import lu_factor, lu_solve
 from .history import history_vector, step_coefficients, update_modes
-from .interface import (TIP_GAP, ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_SMOOTH_TERM, ZONE_XI,
-                        Interface, crossing_radius, lj_traction, traction,
+from .interface import (TIP_GAP, ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Interface,
+                        crossing_radius, lj_traction, smoothing_rate, traction,
                         traction_and_stiffness)
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
 from .jacobian import (CACHE_CONTRACTION, CACHE_STATE, STATE_EXACT,  # noqa: F401
@@ -879,7 +879,7 @@ def zone_step(physics, work, dt, dt_prev):
         _copy(work.h, work.ref)
     work.zone[ZONE_RATE] = a0 / (physics.hdot_c * dt)
     work.zone[ZONE_XI] = physics.xi
-    work.zone[ZONE_SMOOTH] = ZONE_SMOOTH_TERM ** (1.0 / physics.xi)
+    work.zone[ZONE_SMOOTH] = smoothing_rate(physics.xi)
 
 
 @njit(cache=True, inline='always')

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import units
-from ..kernels.interface import ZONE_SMOOTH_TERM, zone_factor
+from ..kernels.interface import smoothing_rate, zone_factor
 
 __all__ = ["MAP", "slope_scale", "opening_rate_scale", "hdot_c", "work_of_separation"]
 
@@ -42,7 +42,7 @@ def work_of_separation(q, xi, dg=1.0 / math.pi) -> float:
     """The work of separation of the BEM's law opened at the constant rate q hdot_c:
     ``dg m(q)`` (dimensionless, dg = 1/pi in the units of docs/design.md section 2), with
     m = 1 + q^xi above the smoothing rate q_s (:func:`sweep.kernels.interface.zone_factor`)."""
-    m, _ = zone_factor(float(q), float(xi), ZONE_SMOOTH_TERM ** (1.0 / xi))
+    m, _ = zone_factor(float(q), float(xi), smoothing_rate(float(xi)))
     return dg * m
 
 

@@ -42,7 +42,8 @@ from scipy.optimize import brentq
 from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
                            STATUS_LEFT_BAND, STATUS_STEP_LIMIT, invalidate, new_jacobian_cache,
                            newton)
-from ..kernels.interface import ZONE_SMOOTH_TERM, Interface, lennard_jones, lj_traction, traction
+from ..kernels.interface import (ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Interface,
+                                 lennard_jones, lj_traction, smoothing_rate, traction)
 
 from ..scene import Numerics, Result, Scene
 from . import budget
@@ -241,9 +242,15 @@ def transfer(run, old, new, form: str = "auto") -> None:
         sigma_old = run.sigma
     sigma = np.empty(new_r.size)
     traction(h, law.h_old, law.zone, law.h0, law.c, sigma)
+
+    def carry(h, q):            # the new mesh's state; with a process zone, its traction
+        run.h, run.q = h, q     # under the last step's law, which the kernel resumes from
+        if zone is not None:
+            run.sigma = np.empty(new_r.size)
+            traction(h, law.h_old, law.zone, law.h0, law.c, run.sigma)
+
     if run.q.shape[0] == 0:
-        run.h, run.q = h, np.zeros((0, new_r.size))
-        _carried_traction(run, law)
+        carry(h, np.zeros((0, new_r.size)))
         return
     lu = scipy.linalg.lu_factor(new.A)
 
@@ -272,11 +279,9 @@ def transfer(run, old, new, form: str = "auto") -> None:
                 sigma_eq = np.empty(new_r.size)
                 traction(h_eq, law.h_old, law.zone, law.h0, law.c, sigma_eq)
                 q += (sigma_eq - sigma)[None, :]
-            run.h, run.q = h_eq, q
-            _carried_traction(run, law)
+            carry(h_eq, q)
             return
-    run.h, run.q = h, q_first
-    _carried_traction(run, law)
+    carry(h, q_first)
 
 
 def _last_step_law(run, pb):
@@ -286,26 +291,20 @@ def _last_step_law(run, pb):
     zone, or before a step was taken (the LJ law at rest)."""
     if math.isinf(pb.hdot_c) or not run.step[1] > 0.0:
         return None
-    xi = pb.pz_xi
-    return np.array([1.0 / (pb.hdot_c * float(run.step[1])), xi, ZONE_SMOOTH_TERM ** (1.0 / xi)])
+    zone = np.zeros(ZONE_SIZE)
+    zone[ZONE_RATE] = 1.0 / (pb.hdot_c * float(run.step[1]))
+    zone[ZONE_XI] = pb.pz_xi
+    zone[ZONE_SMOOTH] = smoothing_rate(pb.pz_xi)
+    return zone
 
 
-def _carried_traction(run, law) -> None:
-    """With a process zone, the traction of the carried state under ``law`` (the last step's):
-    the kernel resumes from it and from ``run.h_prev`` (:func:`sweep.engine.bem.unload_chunk`)."""
-    if run.sigma is not None:
-        run.sigma = np.empty(run.h.size)
-        traction(run.h, law.h_old, law.zone, law.h0, law.c, run.sigma)
-
-
-def _reequilibrate(run, new, h, ceff, H, law=None):
+def _reequilibrate(run, new, h, ceff, H, law):
     """The gap on the mesh of ``new`` in equilibrium with u = A (ceff sigma - H) at the
-    indentation of the last record (Newton from ``h``; the interface ``law``, default the
-    Lennard-Jones law), or None if it does not converge."""
+    indentation of the last record under the interface ``law`` (Newton from ``h``), or None
+    if it does not converge."""
     g = -float(run.records[1][run.n - 1]) + new.h0 + 0.5 * new.mesh.r**2
     h_eq = h.copy()
     stats = run.stats if run.stats is not None else np.zeros(N_STATS, dtype=np.int64)
-    law = lennard_jones(new.h0, new.c, h.size) if law is None else law
     ok = newton(h_eq, g, new.A, ceff, H, law,
                 new.numerics.tol * new.h0, REEQUILIBRATE_ITER, new_jacobian_cache(h.size), stats)
     return h_eq if ok else None

@@ -282,7 +282,7 @@ def test_settling_the_tip_with_a_process_zone_lowers_its_residual_and_keeps_the_
     from the settled start and from the unsettled one reach the same state, within their
     tolerance."""
     from sweep.engine.initial import ElasticSolver, relaxed_state
-    from sweep.kernels.interface import ZONE_SMOOTH_TERM, Interface
+    from sweep.kernels.interface import Interface, smoothing_rate
 
     N = 160
     A, _, h0, c, _ = _problem(N=N)
@@ -290,7 +290,7 @@ def test_settling_the_tip_with_a_process_zone_lowers_its_residual_and_keeps_the_
     el = ElasticSolver(A, r, h0, c, 1e-10)
     h_start, _ = relaxed_state(el, delta0=1.0)
     xi, rate_scale = 0.5, 50.0 / h0                  # m - 1 = 1 at an opening of h0 / 50
-    law = Interface(h0, c, h_start.copy(), np.array([rate_scale, xi, ZONE_SMOOTH_TERM ** (1 / xi)]))
+    law = Interface(h0, c, h_start.copy(), np.array([rate_scale, xi, smoothing_rate(xi)]))
     g = -(1.0 - 0.2 * h0) + h0 + 0.5 * r ** 2
     ceff, H, tol = 0.8, -0.05 * np.exp(-r), 1e-10 * h0
 
