@@ -330,10 +330,9 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
                       f"elastic or auto, large contacts the crack-front model (model crack)")
     protocol = scene.protocol()
-    if protocol and (numerics.exact or scene.pz_law != "none"):
-        raise Refused("a protocol's approach and dwell run the hereditary BEM with the "
-                      "Lennard-Jones interface: not with numerics.exact nor a process zone "
-                      f"(pz_law {scene.pz_law})")
+    if protocol and numerics.exact:
+        raise Refused("a protocol's approach and dwell run the hereditary BEM's time march: "
+                      "not with numerics.exact")
     if protocol and band is None:
         band = protocol_band(scene, numerics)
     if scene.machine_stiffness is not None and (protocol or numerics.exact):

@@ -25,7 +25,11 @@ Phases 1 and 2 march the same hereditary integral as the kernel (the Prony recur
 Lennard-Jones law), step by step from Python: a few hundred solves, each a kernel call, Newton
 starting from the unloading kernel's predictors settled at the crack tip (:class:`_March`).
 Python's own share of the time is under a tenth; the rest is Newton's at the advancing crack
-tip (docs/design.md, "The test protocol", for what it costs). The
+tip (docs/design.md, "The test protocol", for what it costs). A scene with a process zone
+(``pz_law``) runs it too: the approach and the dwell grow the contact, closing its crack, and
+on a closing gap the process zone's law is the Lennard-Jones law, so they march that; a step
+that opens a node fast enough for the process zone to matter (ZONE_IN_MARCH_RTOL) ends the
+scene with the reason; the retraction runs the process zone's law (the unloading kernel). The
 trajectory keeps every phase (``phase``: 0 approach, 1 dwell, 2 retraction); the row adds
 the work the machine did on the sphere over the whole path, ``hysteresis_energy`` (pi dg R
 d_ref, :func:`cycle_work`).
@@ -35,12 +39,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.history import history_vector, step_coefficients, update_modes
-from ..kernels.interface import crossing_radius, lennard_jones, lj_traction
+from ..kernels.interface import (crossing_radius, lennard_jones, lj_traction, smoothing_rate,
+                                 zone_factor)
 from ..kernels.protocol import factorize_ahead, newton_at_load
-from ..kernels.solve import settle_tip
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
                              invalidate, load, new_jacobian_cache, newton, predict,
-                             predict_lattice, relax, score_starts)
+                             predict_lattice, relax, score_starts, settle_tip)
 from ..theory import jkr_contact_radius
 from ..scene import Protocol
 from . import budget
@@ -98,6 +102,14 @@ MIN_STEP_FRACTION = 1.0 / 64.0
 #: ... by at most this many pseudo-transient iterations before Newton takes over, where
 #: Newton from the JKR contact failed (:meth:`_March._jump`)
 RELAX_ITER = 300
+#: a scene with a process zone: the approach and the dwell march the Lennard-Jones law, which
+#: is the process zone's on a closing or compressed gap (a growing contact closes its crack);
+#: each accepted step's opening nodes are checked, and where the traction the process zone
+#: would have added exceeds this fraction of the peak LJ tension at a node the scene is refused
+#: with the reason. Measured on the four scenes of ``make protocol-cost`` with pz_v0 1, xi 0.5:
+#: at most 2.2e-4 (one node of the SLS dwell), none at all in two; the SLS scene's approach
+#: opened a node enough to add 1.2e-3 at pz_v0 1e-2 and 2.1e-2 at pz_v0 1e-6
+ZONE_IN_MARCH_RTOL = 1e-2
 
 
 class _March:
@@ -234,6 +246,7 @@ class _March:
 
     def accept(self, delta, dt, solved, phase):
         _, h, sig, _, e, b, starts = solved
+        self._check_closing(h, dt, phase)
         update_modes(e, b, self.q, sig, self.sigma)
         if starts is not None:
             a = crossing_radius(h, self.pb.mesh.r, self.pb.hm)
@@ -243,6 +256,32 @@ class _March:
         self.dt_prev2, self.dt_prev = self.dt_prev, dt
         self.delta, self.t = float(delta), self.t + dt
         self._record(phase)
+
+
+    def _check_closing(self, h, dt, phase):
+        """With a process zone, raise where the step to ``h`` opened a node in tension fast
+        enough that the process zone would have added more than ZONE_IN_MARCH_RTOL of the peak
+        LJ tension (its opening rate by backward Euler over ``dt``): the march's law, the
+        Lennard-Jones law, is the scene's only where the gaps close."""
+        pb = self.pb
+        if np.isinf(pb.hdot_c):
+            return
+        q = (h - self.h) / (dt * pb.hdot_c)
+        sig = np.empty(h.size)
+        lj_traction(h, pb.h0, pb.c, sig)
+        qs, worst, where = smoothing_rate(pb.pz_xi), 0.0, 0
+        for i in np.flatnonzero((h > pb.h0) & (q > 0.0)):
+            added = (zone_factor(q[i], pb.pz_xi, qs)[0] - 1.0) * -sig[i]
+            if added > worst:
+                worst, where = added, i
+        peak = pb.c * (3.0 ** -0.5 - 3.0 ** -1.5)   # the LJ law's most tensile traction
+        if worst > ZONE_IN_MARCH_RTOL * peak:
+            name = next(k for k, v in PHASES.items() if v == phase)
+            raise RuntimeError(
+                f"the {name} opened the gap at r = {pb.mesh.r[where]:.4g} (t = {self.t + dt:.4g}"
+                f" tau0): the process zone would add {worst / peak:.2g} of the peak tension "
+                f"there (> {ZONE_IN_MARCH_RTOL:g}), which the approach and dwell, marched with "
+                f"the Lennard-Jones law, do not carry")
 
 
 def _approach(m: _March, protocol: Protocol) -> None:

@@ -130,8 +130,36 @@ def test_only_the_bem_runs_a_protocol_and_auto_sends_it_there():
     for model in ("crack", "pb", "elastic"):
         r = simulate(Scene(**sc, model=model))
         assert r.status == "failed" and "runs with model bem or auto" in r.reason
-    pz = simulate(Scene(**sc, pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5))
-    assert pz.status == "failed" and "Lennard-Jones interface" in pz.reason
+    # with a process zone too: the retraction runs its law, which raises the pull-off
+    pz = simulate(Scene(**sc, **PZ))
+    assert pz.ok and pz.model_used == "bem" and pz.pull_off > 1.05 * res.pull_off
+
+
+#: a process zone of pz_v0 1 a_ref/tau0 (the scenes' crack speeds are of that order)
+PZ = dict(pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5)
+
+
+def test_an_elastic_bulk_with_a_process_zone_retracts_as_from_its_relaxed_start():
+    """k = 1 has no memory: the approach and dwell end in the equilibrium at the preload,
+    and the retraction from it (the process zone's law, from rest) is the relaxed start's
+    at that contact radius, to the lattice. The process zone acts (the pull-off rises)."""
+    res = run(SAME_MESH, **BASE, k=1.0, **PROTOCOL, **PZ)
+    relaxed = run(SAME_MESH, **BASE, k=1.0, a0=res.a0_result, **PZ)
+    plain = run(SAME_MESH, **BASE, k=1.0, a0=res.a0_result)
+    assert res.pull_off == pytest.approx(relaxed.pull_off, rel=LATTICE["pull_off"])
+    assert res.pull_off > 1.1 * plain.pull_off
+
+
+def test_a_march_that_opens_a_gap_under_a_strong_process_zone_is_refused():
+    """The approach and the dwell march the LJ law, the process zone's on closing gaps;
+    where a step opens a node enough that the process zone would add more than
+    ZONE_IN_MARCH_RTOL of the peak tension there (pz_v0 1e-6 on an SLS approach: 2e-2), the
+    scene ends with the reason."""
+    sls = dict(BASE, material="sls", k=0.2, approach_rate=1.0, preload=4.0, dwell=100.0)
+    res = simulate(Scene(model="bem", **sls, **dict(PZ, pz_v0=1e-6)), Numerics.preset("balanced"))
+    assert res.status == "failed"
+    assert "protocol: the approach opened the gap" in res.reason
+    assert "Lennard-Jones law, do not carry" in res.reason
 
 
 def test_the_effective_adhesion_is_bell_shaped_without_a_dwell_and_monotone_after_one():
