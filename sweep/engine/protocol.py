@@ -45,6 +45,7 @@ from ..kernels.protocol import factorize_ahead, newton_at_load
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
                              invalidate, load, new_jacobian_cache, newton, predict,
                              predict_lattice, relax, score_starts, settle_tip)
+from .. import units
 from ..theory import jkr_contact_radius
 from ..scene import Protocol
 from . import budget
@@ -246,7 +247,7 @@ class _March:
 
     def accept(self, delta, dt, solved, phase):
         _, h, sig, _, e, b, starts = solved
-        self._check_closing(h, dt, phase)
+        self._check_closing(h, sig, dt, phase)
         update_modes(e, b, self.q, sig, self.sigma)
         if starts is not None:
             a = crossing_radius(h, self.pb.mesh.r, self.pb.hm)
@@ -258,23 +259,22 @@ class _March:
         self._record(phase)
 
 
-    def _check_closing(self, h, dt, phase):
-        """With a process zone, raise where the step to ``h`` opened a node in tension fast
-        enough that the process zone would have added more than ZONE_IN_MARCH_RTOL of the peak
-        LJ tension (its opening rate by backward Euler over ``dt``): the march's law, the
-        Lennard-Jones law, is the scene's only where the gaps close."""
+    def _check_closing(self, h, sig, dt, phase):
+        """With a process zone, raise where the step to ``h`` (LJ traction ``sig``) opened a
+        node in tension fast enough that the process zone would have added more than
+        ZONE_IN_MARCH_RTOL of the peak LJ tension (its opening rate by backward Euler over
+        ``dt``): the march's law, the Lennard-Jones law, is the scene's only where the gaps
+        close."""
         pb = self.pb
         if np.isinf(pb.hdot_c):
             return
         q = (h - self.h) / (dt * pb.hdot_c)
-        sig = np.empty(h.size)
-        lj_traction(h, pb.h0, pb.c, sig)
         qs, worst, where = smoothing_rate(pb.pz_xi), 0.0, 0
         for i in np.flatnonzero((h > pb.h0) & (q > 0.0)):
             added = (zone_factor(q[i], pb.pz_xi, qs)[0] - 1.0) * -sig[i]
             if added > worst:
                 worst, where = added, i
-        peak = pb.c * (3.0 ** -0.5 - 3.0 ** -1.5)   # the LJ law's most tensile traction
+        peak = units.sigma0_hat(pb.scene.mu)         # the LJ law's most tensile traction
         if worst > ZONE_IN_MARCH_RTOL * peak:
             name = next(k for k, v in PHASES.items() if v == phase)
             raise RuntimeError(
