@@ -134,14 +134,16 @@ def test_a_process_zone_is_carried_across_remeshings_and_matches_the_fixed_band(
 def test_a_vanishing_process_zone_on_the_tip_following_mesh_is_the_lj_scene():
     """pz_v0 1e12: the law's factor differs from 1 by less than 1e-5 at every node, so the
     process zone's path through the re-meshings (its carried state and law) gives the LJ
-    scene's run: the same meshes and steps, the pull-off to 1e-6 (measured 7e-8)."""
+    scene's run: the same meshes, the same steps to 1 % (equal here; the process zone's
+    settled Newton start may tip one step decision on another processor's rounding), the
+    pull-off to 1e-6 (measured 7e-8)."""
     lj = Scene(n=0.8, k=0.1, mu=7.0, a0=3.0, rate=10.0, model="bem")
     num = Numerics.preset("balanced", pull_off_rtol=0.0)
     plain = tf.simulate_tip_following(lj, num)
     faint = tf.simulate_tip_following(Scene(**{**lj.to_dict(), **PZ, "pz_v0": 1e12}), num)
     assert plain.ok and faint.ok, (plain.reason, faint.reason)
     assert _meshes(plain) >= 3 and _meshes(faint) == _meshes(plain)
-    assert faint.steps == plain.steps
+    assert abs(faint.steps - plain.steps) <= 0.01 * plain.steps
     assert faint.pull_off == pytest.approx(plain.pull_off, rel=1e-6)
 
 
