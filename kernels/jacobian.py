@@ -44,7 +44,10 @@ diverge (it dominates the opening nodes' stiffness). Block elimination of B:
             x_F = v_F + A_FS diag(E) x_S
 
 The zone follows the crack tip exactly at the cost of a z x z factorization; the drift of
-the interior makes Newton a chord iteration there, contracting by about that drift. The
+the interior makes Newton a chord iteration there, contracting by about that drift. Where the
+contact is pressed (the protocol's approach and dwell) the interior stiffens fast; there the
+drift is taken out of the direction as a column scaling (STATE_SCALED,
+:func:`scale_for_drift`). The
 factorization of K is made again when the crack tip leaves the zone's inner part (it
 recedes through ZONE_IN - ZONE_MARGIN nodes between two factorizations), when a node of F
 becomes stiff, or when the caller finds the iteration contracting poorly
@@ -114,7 +117,12 @@ STATE_SCHUR_VALID = 5
 #: state[STATE_EXACT]: 1 to refactorize at every Newton iteration (exact Newton: set by the
 #: time stepper for the retries of a step whose solve failed, near a fold of the path)
 STATE_EXACT = 6
-N_STATE = 7
+#: state[STATE_SCALED]: 1 for the drift-scaled chord (:func:`newton_direction`; set by the
+#: protocol's march, whose pressed contact stiffens at every step): the direction corrected for
+#: the interior's drift since the factorization, and the factorization kept where an
+#: iteration contracts slowly (:func:`kernels.solve.newton`)
+STATE_SCALED = 7
+N_STATE = 8
 
 
 def new_jacobian_cache(N):
@@ -134,6 +142,12 @@ def new_jacobian_cache(N):
 def invalidate(cache):
     """Mark the factorization in ``cache`` stale: the next solve refactorizes."""
     cache[CACHE_STATE][STATE_VALID] = 0
+
+
+def use_drift_scaled(cache, on: bool):
+    """Switch the drift-scaled chord (STATE_SCALED) of the solves that use ``cache`` on or
+    off (off in a new cache)."""
+    cache[CACHE_STATE][STATE_SCALED] = int(on)
 
 
 @njit(cache=True)
@@ -267,11 +281,35 @@ def apply_inverse(v, A, cache):
     return x
 
 
+@njit(cache=True, inline='always')
+def scale_for_drift(x, d, A, ceff, cache):
+    """The drift-scaled chord: x = J_b^-1 v (the kept factorization, interior stiffness E_b)
+    turned, in place, into an approximation of J^-1 v for the interior's stiffness now,
+    ``ceff d``. The drift is taken as a scaling of B's columns, J ~ J_b diag(c) with c_i =
+    (1 - A_ii E_i) / (1 - A_ii E_b,i), exact on the diagonal; hence x_i /= c_i on B. Where the
+    contact is pressed (A_ii |E| of 10 and more) the columns of J are nearly -A diag(E), which
+    the scaling follows. Measured: the direction's error a third of the chord's on a pressed
+    contact pressed 6-28 % stiffer (tests/kernels/test_newton.py); on the approach of ``make
+    protocol-cost``'s rate-100 scene the chord's contraction (spectral radius) at most 0.037
+    against 0.076. Nodes where either diagonal is not positive (the cohesive zone's unstable
+    branch) keep x_i."""
+    E, base_nodes, state = cache[CACHE_E], cache[CACHE_BASE_NODES], cache[CACHE_STATE]
+    for p in range(state[STATE_BASE]):
+        i = base_nodes[p]
+        then = 1.0 - A[i, i] * E[i]
+        now = 1.0 - A[i, i] * ceff * d[i]
+        if then > 0.0 and now > 0.0:
+            x[i] *= then / now
+
+
 @njit(cache=True)
 def newton_direction(F, d, drate, A, ceff, cache, stats, stat_zone):
     """Newton step dh = -J^-1 F with the interior's stiffness as factorized and the crack-tip
     zone's as it is now (its Schur complement refactorized when it moved by more than
     ZONE_ETA; ``stats[stat_zone]`` counts those).
+
+    With ``state[STATE_SCALED]`` set, the direction is corrected for the interior's drift
+    (:func:`scale_for_drift`).
 
     Returns (dh, ok); ok is False when the factorization no longer fits the state (the crack
     tip left the zone's inner part, a far-field node became stiff, or Sigma is singular):
@@ -306,6 +344,8 @@ def newton_direction(F, d, drate, A, ceff, cache, stats, stat_zone):
         state[STATE_SCHUR_VALID] = 1
         stats[stat_zone] += 1
     x = apply_inverse(F, A, cache)
+    if state[STATE_SCALED] == 1:
+        scale_for_drift(x, d, A, ceff, cache)
     for i in range(N):
         x[i] = -x[i]
     return x, True

@@ -30,8 +30,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .jacobian import (CACHE_STATE, STATE_SUBSET, STATE_VALID, STATE_ZONE_HI, apply_inverse,
-                       crack_tip_index, factorize, newton_direction)
+from .jacobian import (CACHE_STATE, STATE_SCALED, STATE_SUBSET, STATE_VALID, STATE_ZONE_HI,
+                       apply_inverse, crack_tip_index, factorize, newton_direction)
 from .interface import TIP_GAP, traction_and_stiffness
 from .solve import (STAT_FACTOR, STAT_ITER, STAT_REFACTOR_SLOW, STAT_REFACTOR_ZONE,
                     STAT_RESIDUALS, STAT_SUBSET, STAT_ZONE, positive_step, residual)
@@ -96,9 +96,10 @@ def newton_at_load(h, g, A, wP, ceff, H, law, force, tols, max_iter, cache, stat
     """Solve F(h, s) = 0 and G(h) = 0 (module docstring) in place of ``h`` from ``h`` and
     s = 0, the gap g of the guessed indentation; ``tols`` = (``max |F|`` in units of d_ref,
     ``|G|`` in units of pi dg R). Returns (converged, s): the step's indentation is the
-    guess plus s. The cache's factorization is kept and made again where its iteration contracts the
-    residual by less than HELD_SLOW_CONTRACTION; a residual growing by HELD_DIVERGENCE ends
-    the solve unconverged."""
+    guess plus s. The cache's factorization is kept and made again where its iteration
+    contracts the residual by less than HELD_SLOW_CONTRACTION (not with the drift-scaled chord,
+    ``state[STATE_SCALED]``: :func:`kernels.solve.newton`); a residual growing by
+    HELD_DIVERGENCE ends the solve unconverged."""
     N = h.size
     sig, w, F, dh, y = np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.full(N, np.nan)
     gs = g.copy()
@@ -124,7 +125,8 @@ def newton_at_load(h, g, A, wP, ceff, H, law, force, tols, max_iter, cache, stat
         stats[STAT_RESIDUALS] += 1
         if not new < HELD_DIVERGENCE * norm:
             return False, s
-        if new > tols[0] and new > HELD_SLOW_CONTRACTION * norm:
+        if (new > tols[0] and new > HELD_SLOW_CONTRACTION * norm
+                and cache[CACHE_STATE][STATE_SCALED] == 0):
             _factorize_counted(h, A, ceff, law, cache, stats)
             stats[STAT_REFACTOR_SLOW] += 1
             y[0] = np.nan

@@ -63,7 +63,7 @@ from .interface import (TIP_GAP, ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Int
                         crossing_radius, lj_traction, smoothing_rate, traction,
                         traction_and_stiffness)
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
-from .jacobian import (CACHE_CONTRACTION, CACHE_STATE, STATE_EXACT,  # noqa: F401
+from .jacobian import (CACHE_CONTRACTION, CACHE_STATE, STATE_EXACT, STATE_SCALED,  # noqa: F401
                        STATE_VALID, apply_inverse, factorize, invalidate,
                        new_jacobian_cache, newton_direction)
 
@@ -186,7 +186,10 @@ FAILED = 3         # no equilibrium at the smallest step
 #: an iteration with a stale factorization that reduces |F|_2 by less than this factor
 #: refactorizes before the next one (fresh, the chord iteration contracts by 1e-4 to 1e-3 on
 #: the reference scenes; 0.5 let it crawl at 0.46 for ten iterations; 0.1 and 0.03 cost
-#: the same on the vs-numpy scenes, 0.03 refactorizes 5x more on the fast n = 0.4 one)
+#: the same on the vs-numpy scenes, 0.03 refactorizes 5x more on the fast n = 0.4 one).
+#: Not with the drift-scaled chord (state[STATE_SCALED], the protocol's march): its linear
+#: contraction stays at 0.002-0.04 there, so a slow iteration is the start's nonlinearity at
+#: the advancing crack tip, which a new factorization does not speed
 SLOW_CONTRACTION = 0.1
 
 #: a solve ends after its first update without the residual at the new point when the
@@ -530,7 +533,7 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
         norm = nt
         if norm <= tol:
             return True
-        fresh = not fresh and nt2 > SLOW_CONTRACTION * n2
+        fresh = not fresh and nt2 > SLOW_CONTRACTION * n2 and state[STATE_SCALED] == 0
         if fresh:
             _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_SLOW)
     return False

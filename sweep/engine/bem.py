@@ -33,6 +33,7 @@ from ..kernels.solve import (N_STATS, STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND,
                              StepControl, invalidate, unload)
 from ..errors import NUMERICAL_ERRORS, is_internal_error
 from ..kernels.interface import lj_traction
+from ..kernels.jacobian import use_drift_scaled
 from ..scene import Numerics, Protocol, Result, Scene
 from . import budget
 from .budget import OverBudget
@@ -296,6 +297,7 @@ def _simulate_protocol(pb: Problem, res: Result, deadline: float):
     pb = dataclasses.replace(pb, numerics=dataclasses.replace(
         pb.numerics, max_steps=pb.numerics.max_steps + n0))
     invalidate(march.cache)
+    use_drift_scaled(march.cache, False)    # the retraction: the unloading kernel's Newton
     run = UnloadingState.start(pb, march.h, march.delta, march.cache, stats)
     for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):
         run.records[i][:n0] = rec[key]

@@ -41,6 +41,7 @@ import numpy as np
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import (crossing_radius, lennard_jones, lj_traction, smoothing_rate,
                                  zone_factor)
+from ..kernels.jacobian import use_drift_scaled
 from ..kernels.protocol import factorize_ahead, newton_at_load
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
                              invalidate, load, new_jacobian_cache, newton, predict,
@@ -132,6 +133,7 @@ class _March:
         self.advancing = False      # the crack tip advances: the approach
         self.law = lennard_jones(pb.h0, pb.c, N)
         self.cache, self.stats = new_jacobian_cache(N), stats
+        use_drift_scaled(self.cache, True)      # the pressed contact stiffens every step
         self.records = {k: [] for k in ("t", "delta", "P", "a", "a_inner", "phase")}
         self.past, self.past_ta = np.empty((LATTICE_HISTORY, N)), np.empty((2, LATTICE_HISTORY))
         self.past_count, self.tip_score = 0, 0.0
