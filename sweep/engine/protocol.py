@@ -119,7 +119,9 @@ class _March:
     (gap, Prony modes, traction), the records, and one step's solve. Newton's start is the
     unloading kernel's: the quadratic extrapolation, replaced near the crack tip by the tip
     predictor's (:func:`sweep.kernels.solve.predict_lattice`, from a ring of the last
-    accepted states) where that has been the nearer of the two on the last steps."""
+    accepted states) where that has been the nearer of the two on the last steps. Newton runs
+    the drift-scaled chord (:func:`sweep.kernels.jacobian.scale_for_drift`): the pressed
+    contact's interior stiffens at every step (docs/performance.md, "The protocol's march")."""
 
     def __init__(self, pb, h, delta, stats):
         self.pb, self.h, self.delta, self.t = pb, h, float(delta), 0.0
