@@ -602,7 +602,7 @@ class Numerics:
         Tolerance of the error estimate ``Result.error_estimate``: the pull-off change
         against a solve at half the resolution in space and time (half the band resolution
         or nodes, twice the step; sqrt 2 where that mesh cannot hold the initial contact)
-        over (factor - 1), plus the Prony fit's error (:mod:`sweep.engine.resolution`). A
+        over (factor^0.65 - 1), plus the Prony fit's error (:mod:`sweep.engine.resolution`). A
         result whose estimate exceeds the tolerance is not ``ok`` (``failed``, reason
         "unresolved: ..."); "auto" also runs a cheaper model where its measured error meets
         it. 0 skips the estimate and its second solve (then ``error_estimate`` is NaN).
@@ -861,8 +861,9 @@ class Result:
         Number of mesh nodes.
     error_estimate : float
         Estimated relative pull-off error: for the BEM the change against a solve at half
-        the resolution in space and time over (factor - 1) plus the Prony fit's error (about
-        three times the error of a second-order discretization; :mod:`sweep.engine.resolution`),
+        the resolution in space and time over (factor^0.65 - 1) plus the Prony fit's error
+        (about five times the error of a second-order discretization, 1.76 times a first-order
+        one's; :mod:`sweep.engine.resolution`),
         for the crack-front model and the PB estimate their measured difference from the BEM
         at the scene's mu (:func:`sweep.engine.models.measured_error`). NaN when not estimated.
     wall_s : float
