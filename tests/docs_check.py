@@ -186,7 +186,9 @@ YAML_CHECKS = {
 INLINE_RUN: dict[tuple[str, str], tuple[tuple[str, ...], int]] = {
     ("docs/numerics.md",
      "sweep scene --n 0.4 --k 0.1 --mu 3.24 --a0 2 --rate 1 --preset fast --nodes 60"):
-        (("failed (unresolved: the pull-off moves by 0.67",), 1),
+        # the change itself (0.68 here, 0.67 on 2026-11-25) is left out: its second digit
+        # moves with the numerics and the processor
+        (("failed (unresolved: the pull-off moves by ",), 1),
 }
 
 # what a command must print where the page says what it prints; for a transcript, in place of
