@@ -1,7 +1,8 @@
 """What the test as run costs: a protocol scene against its relaxed start, and a Prony-table
 material against the MPL whose series it holds (``make protocol-cost``; issue 36 item 5).
 
-For each scene of :data:`SCENES` (mu 5 on the BEM's graded mesh, balanced preset) the wall
+For each scene of :data:`SCENES` (mu 5 on the BEM's graded mesh, balanced preset), and of
+:func:`bench_scenes` (the three vs-numpy scenes of ``make bench`` with a protocol), the wall
 time of the protocol (approach to the preload, dwell, retraction) against
 
 * ``ratio``: its relaxed-start scene, the same scene without the protocol: the relaxed start
@@ -12,6 +13,13 @@ time of the protocol (approach to the preload, dwell, retraction) against
 * ``ratio_two_relaxed``: the sum of two relaxed starts at the preload, one retracted at the
   approach's rate, one at the retraction's (the cost model: an approach costs about what a
   march over the same contacts at its speed costs);
+* ``travel_ratio``: the crack tip's travel over the protocol (the contact radius's path, sum
+  of |da| over the fine solve's records, by phase in ``travel``) over the relaxed start's, and
+  ``cost_per_travel_ratio`` = ``ratio`` / ``travel_ratio``: what the protocol costs per unit
+  of crack travel against the relaxed start's unloading (1: the march as efficient as the
+  unloading kernel). A march's cost is set by how far the tip moves across the fine band
+  (every step moves it at most ``da_max`` spacings), and an approach to the preload, or a
+  dwell at force whose contact creeps, moves it about as far as the retraction does;
 
 in one process, the kernels compiled first, each scene run once untimed, then
 :data:`REPEATS` alternating timed runs each, the median. Written to
@@ -33,8 +41,9 @@ from ..engine.problem import prepare
 from ..scene import Numerics, Scene
 from ..theory import jkr_contact_radius
 from . import measurement_main
+from .tradeoff import VS_NUMPY_SCENES
 
-#: (name, scene fields) of the protocol scenes
+#: (name, scene fields) of the protocol scenes (mu :data:`MU`)
 SCENES = (
     ("MPL k 0.1, rate 1, dwell 10 at force", dict(n=0.5, k=0.1, rate=1.0, approach_rate=1.0,
                                                   preload=2.0, dwell=10.0)),
@@ -46,6 +55,24 @@ SCENES = (
     ("SLS k 0.2, rate 1, dwell 100 at force", dict(material="sls", n=0.5, k=0.2, rate=1.0,
                                                    approach_rate=1.0, preload=4.0, dwell=100.0)),
 )
+#: the bench scenes' protocol (issue 36 item 5 asks for the ratio "on the bench scenes"): each
+#: scene of ``make bench``'s vs-numpy comparison (issue 9, mu 3.24) without its delta0,
+#: approached at its retraction's rate to this preload, held there for BENCH_DWELL tau0
+BENCH_PRELOAD = 2.0
+BENCH_DWELL = 10.0
+
+
+def bench_scenes() -> list[tuple[str, dict]]:
+    """(name, scene fields with mu) of the bench scenes' protocol (:data:`BENCH_PRELOAD`)."""
+    out = []
+    for name, fields in VS_NUMPY_SCENES.items():
+        base = {k: v for k, v in fields.items() if k not in ("delta0", "a0")}
+        out.append((f"bench {name}, dwell {BENCH_DWELL:g} at force",
+                    dict(base, approach_rate=base["rate"], preload=BENCH_PRELOAD,
+                         dwell=BENCH_DWELL)))
+    return out
+
+
 #: (name, MPL scene fields) of the table-material comparison (mu 5, a0 1.5)
 TABLE_SCENES = (("MPL n 0.8 k 0.1, rate 1", dict(n=0.8, k=0.1, rate=1.0)),
                 ("MPL n 0.8 k 0.1, rate 100", dict(n=0.8, k=0.1, rate=100.0)),
@@ -62,18 +89,32 @@ def _timed(scene: Scene):
     return res, time.perf_counter() - t0
 
 
+PHASE_NAMES = ("approach", "dwell", "retract")
+
+
+def crack_travel(res) -> dict:
+    """The crack tip's travel (a_ref) over a result's records: the sum of |da| of the contact
+    radius between consecutive records, by phase (a relaxed start's records are all
+    ``retract``)."""
+    a = np.asarray(res.trajectory["a"], float)
+    phase = np.asarray(res.trajectory.get("phase", np.full(a.size, 2)))
+    moved = np.abs(np.diff(a))
+    return {name: float(moved[phase[1:] == code].sum()) for code, name in enumerate(PHASE_NAMES)}
+
+
 def measure() -> dict:
     rows = []
-    for name, fields in SCENES:
-        protocol_scene = Scene(mu=MU, **fields)
+    for name, fields in [(n, dict(f, mu=MU)) for n, f in SCENES] + bench_scenes():
+        mu = fields.pop("mu")
+        protocol_scene = Scene(mu=mu, **fields)
         res, _ = _timed(protocol_scene)
         relaxed_fields = {k: v for k, v in fields.items()
                           if k not in ("approach_rate", "preload", "dwell", "dwell_hold")}
         at_preload = float(jkr_contact_radius(load=fields["preload"]))
         comparators = {     # what the protocol's wall time is set against
-            "relaxed": Scene(mu=MU, a0=at_preload, **relaxed_fields),
-            "same_contact": Scene(mu=MU, a0=res.a0_result, **relaxed_fields),
-            "approach": Scene(mu=MU, a0=at_preload,
+            "relaxed": Scene(mu=mu, a0=at_preload, **relaxed_fields),
+            "same_contact": Scene(mu=mu, a0=res.a0_result, **relaxed_fields),
+            "approach": Scene(mu=mu, a0=at_preload,
                               **{**relaxed_fields, "rate": fields["approach_rate"]}),
         }
         ran = {key: _timed(scene)[0] for key, scene in comparators.items()}
@@ -94,16 +135,27 @@ def measure() -> dict:
                "ratio": w["protocol"] / w["relaxed"],
                "ratio_same_contact": w["protocol"] / w["same_contact"],
                "ratio_two_relaxed": w["protocol"] / (w["relaxed"] + w["approach"])}
+        travel, relaxed_travel = crack_travel(res), sum(crack_travel(ran["relaxed"]).values())
+        row.update(mu=mu, bench=name.startswith("bench "), travel=travel,
+                   relaxed_travel=relaxed_travel,
+                   travel_ratio=sum(travel.values()) / relaxed_travel)
+        row["cost_per_travel_ratio"] = row["ratio"] / row["travel_ratio"]
         rows.append(row)
         print(f"{name:40s} {res.status}: {w['protocol']:.3f} s; relaxed start at the preload "
               f"{w['relaxed']:.3f} s ({row['ratio']:.2f}x), at the dwell's contact "
               f"{w['same_contact']:.3f} s ({row['ratio_same_contact']:.2f}x), the two relaxed "
               f"runs at the approach's and the retraction's speeds {row['ratio_two_relaxed']:.2f}x;"
-              f" pull-off {res.pull_off:.4f} against {ran['relaxed'].pull_off:.4f}", flush=True)
-    ratios = {key: [r[key] for r in rows]
-              for key in ("ratio", "ratio_same_contact", "ratio_two_relaxed")}
-    for key, x in ratios.items():
-        print(f"{key}: median {np.median(x):.2f}, range {min(x):.2f}-{max(x):.2f}")
+              f" pull-off {res.pull_off:.4f} against {ran['relaxed'].pull_off:.4f}; crack travel "
+              f"{row['travel_ratio']:.2f}x the relaxed start's (approach / dwell / retraction "
+              f"{travel['approach']:.3f} / {travel['dwell']:.3f} / {travel['retract']:.3f} a_ref),"
+              f" cost per travel {row['cost_per_travel_ratio']:.2f}x", flush=True)
+    keys = ("ratio", "ratio_same_contact", "ratio_two_relaxed", "travel_ratio",
+            "cost_per_travel_ratio")
+    ratios = {key: [r[key] for r in rows if not r["bench"]] for key in keys}
+    bench = {key: [r[key] for r in rows if r["bench"]] for key in keys}
+    for group, values in (("the four scenes", ratios), ("the bench scenes", bench)):
+        for key, x in values.items():
+            print(f"{group}, {key}: median {np.median(x):.2f}, range {min(x):.2f}-{max(x):.2f}")
     tables = table_cost()
     table_ratios = [r["ratio"] for r in tables]
     print(f"table over MPL: median {np.median(table_ratios):.3f}, range "
@@ -114,6 +166,10 @@ def measure() -> dict:
             "median_ratio": float(np.median(ratios["ratio"])),
             "median_ratio_same_contact": float(np.median(ratios["ratio_same_contact"])),
             "median_ratio_two_relaxed": float(np.median(ratios["ratio_two_relaxed"])),
+            "median_cost_per_travel_ratio": float(np.median(ratios["cost_per_travel_ratio"])),
+            "bench_median_ratio": float(np.median(bench["ratio"])),
+            "bench_median_cost_per_travel_ratio": float(
+                np.median(bench["cost_per_travel_ratio"])),
             "table_rows": tables,
             "table_median_ratio": float(np.median(table_ratios)), "provenance": provenance()}
 
