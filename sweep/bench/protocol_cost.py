@@ -38,6 +38,7 @@ import numpy as np
 from ..campaign.store import provenance
 from ..engine import bem
 from ..engine.problem import prepare
+from ..engine.protocol import PHASES
 from ..scene import Numerics, Scene
 from ..theory import jkr_contact_radius
 from . import measurement_main
@@ -89,22 +90,20 @@ def _timed(scene: Scene):
     return res, time.perf_counter() - t0
 
 
-PHASE_NAMES = ("approach", "dwell", "retract")
-
-
 def crack_travel(res) -> dict:
     """The crack tip's travel (a_ref) over a result's records: the sum of |da| of the contact
     radius between consecutive records, by phase (a relaxed start's records are all
     ``retract``)."""
     a = np.asarray(res.trajectory["a"], float)
-    phase = np.asarray(res.trajectory.get("phase", np.full(a.size, 2)))
+    phase = np.asarray(res.trajectory.get("phase", np.full(a.size, PHASES["retract"])))
     moved = np.abs(np.diff(a))
-    return {name: float(moved[phase[1:] == code].sum()) for code, name in enumerate(PHASE_NAMES)}
+    return {name: float(moved[phase[1:] == code].sum()) for name, code in PHASES.items()}
 
 
 def measure() -> dict:
     rows = []
-    for name, fields in [(n, dict(f, mu=MU)) for n, f in SCENES] + bench_scenes():
+    for name, fields, bench in ([(n, dict(f, mu=MU), False) for n, f in SCENES]
+                                + [(n, f, True) for n, f in bench_scenes()]):
         mu = fields.pop("mu")
         protocol_scene = Scene(mu=mu, **fields)
         res, _ = _timed(protocol_scene)
@@ -136,7 +135,7 @@ def measure() -> dict:
                "ratio_same_contact": w["protocol"] / w["same_contact"],
                "ratio_two_relaxed": w["protocol"] / (w["relaxed"] + w["approach"])}
         travel, relaxed_travel = crack_travel(res), sum(crack_travel(ran["relaxed"]).values())
-        row.update(mu=mu, bench=name.startswith("bench "), travel=travel,
+        row.update(mu=mu, bench=bench, travel=travel,
                    relaxed_travel=relaxed_travel,
                    travel_ratio=sum(travel.values()) / relaxed_travel)
         row["cost_per_travel_ratio"] = row["ratio"] / row["travel_ratio"]
