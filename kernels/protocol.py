@@ -27,14 +27,20 @@ others held, at the cost of those rows of A, before the solve of the whole.
 """
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 from numba import njit
 
+from .history import history_vector, step_coefficients, update_modes
 from .jacobian import (CACHE_STATE, STATE_SCALED, STATE_SUBSET, STATE_VALID, STATE_ZONE_HI,
                        apply_inverse, crack_tip_index, factorize, newton_direction)
-from .interface import TIP_GAP, traction_and_stiffness
-from .solve import (STAT_FACTOR, STAT_ITER, STAT_REFACTOR_SLOW, STAT_REFACTOR_ZONE,
-                    STAT_RESIDUALS, STAT_SUBSET, STAT_ZONE, positive_step, residual)
+from .interface import (TIP_GAP, crossing_radius, lj_traction, traction_and_stiffness,
+                        zone_factor)
+from .solve import (LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT, STAT_FACTOR, STAT_ITER,
+                    STAT_REFACTOR_SLOW, STAT_REFACTOR_ZONE, STAT_RESIDUALS, STAT_SUBSET,
+                    STAT_ZONE, load, newton, positive_step, predict, predict_lattice, residual,
+                    score_starts, settle_tip)
 
 #: an iteration whose residual ``max |F|`` falls by less than this factor refactorizes before
 #: the next (the unloading Newton's SLOW_CONTRACTION, :mod:`kernels.solve`)
@@ -165,3 +171,219 @@ def factorize_ahead(h, A, ceff, law, ahead, least, cache, stats):
         closed[i] = min(closed[i], below)
     _factorize_counted(closed, A, ceff, law, cache, stats)
     return True
+
+
+#: :func:`dwell_steps`' outcomes: the dwell ended; ``max_steps`` tries made (the caller checks
+#: its time budget and calls again); the solve of a step failed where the caller's fallback
+#: takes over (the held step's secant of ordinary solves, the smallest step's relaxation of a
+#: fold); the step opened a gap too fast for the march's law (a process zone: the caller
+#: raises with the reason)
+DWELL_ENDED = 0
+DWELL_CHUNK = 1
+DWELL_FAILED = 2
+DWELL_OPENED = 3
+#: the entries of :data:`MarchState`'s ``clock``: the march's time, indentation, next time
+#: step, last two time steps, tip predictor's score, states written to its ring, contact
+#: radius of the last state, and (on DWELL_FAILED / DWELL_OPENED) the step's time step,
+#: guessed indentation and whether the tip predictor made a start
+CLOCK_T = 0
+CLOCK_DELTA = 1
+CLOCK_DT = 2
+CLOCK_DT_PREV = 3
+CLOCK_DT_PREV2 = 4
+CLOCK_TIP_SCORE = 5
+CLOCK_RING = 6
+CLOCK_A = 7
+CLOCK_GUESS = 8
+CLOCK_MADE = 9
+CLOCK_SIZE = 10
+#: the rows of :data:`MarchState`'s ``recent``: the last three records' times, indentations
+#: and whether each was the dwell's (1.0) or the approach's (0.0); column 2 the newest
+RECENT_T = 0
+RECENT_DELTA = 1
+RECENT_DWELL = 2
+
+#: the dwell's settings: hm the gap at which the contact radius is read; hold_force the load
+#: held at ``force`` (else the indentation); tols Newton's (max |F| in h0 units times h0,
+#: |P - force| in pi dg R); end the dwell's end (tau0); da_max the most a step may move the
+#: contact radius (a_ref); dt_min the smallest step; growth the next step's factor after a
+#: step that moved the radius by less than grow_below da_max; tip_nodes, tip_iter the settle
+#: at the crack tip (:func:`kernels.solve.settle_tip`); max_iter Newton's iterations;
+#: max_steps the tries of one call; zone_bound the most traction a process zone may add at an
+#: opening node, zone_qs its smoothing rate (:func:`kernels.interface.zone_factor`)
+DwellControl = namedtuple("DwellControl", [
+    "hm", "hold_force", "force", "tols", "end", "da_max", "dt_min", "growth", "grow_below",
+    "tip_nodes", "tip_iter", "max_iter", "max_steps", "zone_bound", "zone_qs"])
+#: the march's state, in/out: the gaps h, h_prev, h_prev2 (N,) of the last three states, the
+#: Prony modes q (M, N), the traction sigma (N,) of h, the tip predictor's ring past (K, N)
+#: with its times and contact radii past_ta (2, K), clock (CLOCK_SIZE,) and recent (3, 3)
+MarchState = namedtuple("MarchState", ["h", "h_prev", "h_prev2", "q", "sigma", "past",
+                                       "past_ta", "clock", "recent"])
+#: what a call writes besides the state: records (5, max_steps) the accepted steps' t, delta,
+#: P, a, a_inner; starts (2, N) the predictor's two starts; h (N,) and sigma (N,) the state
+#: of a step that opened a gap too fast (DWELL_OPENED)
+DwellOut = namedtuple("DwellOut", ["records", "starts", "h", "sigma"])
+
+
+@njit(cache=True, inline='always')
+def held_guess(recent, x):
+    """The indentation the dwell at force is expected at at time ``x``: the Lagrange
+    extrapolation through the newest k records of ``recent``, k = 1 + the dwell's among the
+    newest two (constant, then linear, then quadratic; the same arithmetic, in the same order,
+    as ``sweep.engine.protocol._held_guess``)."""
+    k = 1
+    while k < 3 and recent[RECENT_DWELL, 3 - k] == 1.0:
+        k += 1
+    guess = 0.0
+    for j in range(1, k + 1):
+        weight = 1.0
+        for i in range(1, k + 1):
+            if i != j:
+                weight *= (x - recent[RECENT_T, 3 - i]) / (recent[RECENT_T, 3 - j]
+                                                          - recent[RECENT_T, 3 - i])
+        guess += weight * recent[RECENT_DELTA, 3 - j]
+    return guess
+
+
+@njit(cache=True)
+def dwell_steps(mesh, physics, law, control, state, out, cache, stats):
+    """The dwell's time steps, as ``sweep.engine.protocol`` takes them one by one from Python
+    (its ``_dwell_step``, :class:`_March`'s start, settle and accept): the same operations in
+    the same order, so that the march is the same to the last bit, without Python's cost per
+    step. ``mesh`` :data:`kernels.solve.MeshArrays`, ``physics`` :data:`kernels.solve.Physics`,
+    ``law`` the Lennard-Jones :data:`kernels.interface.Interface`, ``control``
+    :data:`DwellControl`, ``state`` :data:`MarchState` (in/out), ``out`` :data:`DwellOut`.
+    Returns (outcome, records written).
+
+    Each step dt = min(``clock[CLOCK_DT]``, end - t) is solved at the indentation held or,
+    holding the load, with its indentation (:func:`newton_at_load` from :func:`held_guess`),
+    from the predictor's start settled at the crack tip (:func:`_step_start`). A step whose
+    solve fails or whose contact radius moves by more than ``da_max`` is halved (down to
+    ``dt_min``); an accepted one is written (:func:`_accept`), and the next step grows by
+    ``growth`` where the radius moved by less than ``grow_below`` ``da_max``. Ends at ``end``
+    (DWELL_ENDED), after ``max_steps`` tries (DWELL_CHUNK), where the caller's fallback takes
+    over (DWELL_FAILED: the held step's solve failed, or the smallest step's; the step, its
+    guessed indentation and CLOCK_MADE in ``clock``, the starts in ``out``, the cache
+    invalidated), or where a process zone would add more than ``zone_bound`` at an opening
+    node (DWELL_OPENED, :func:`_opened`)."""
+    N, M = state.h.size, physics.weights.size
+    clock = state.clock
+    e, b, H, g = np.empty(M), np.empty(M), np.empty(N), np.empty(N)
+    hs, sig = np.empty(N), np.empty(N)
+    n = 0
+    for _ in range(control.max_steps):
+        t = clock[CLOCK_T]
+        if not t < control.end * (1.0 - 1e-12):
+            return DWELL_ENDED, n
+        dt = min(clock[CLOCK_DT], control.end - t)
+        smallest = dt <= control.dt_min
+        delta = held_guess(state.recent, t + dt) if control.hold_force else clock[CLOCK_DELTA]
+        clock[CLOCK_DT], clock[CLOCK_GUESS] = dt, delta
+        ceff = _step_start(mesh, physics, law, control, state, out.starts, dt, delta,
+                           (e, b, H, g, hs))
+        if control.hold_force:
+            ok, shift = newton_at_load(hs, g, mesh.A, mesh.wP, ceff, H, law, control.force,
+                                       control.tols, control.max_iter, cache, stats)
+            delta = delta + shift
+        else:
+            ok = newton(hs, g, mesh.A, ceff, H, law, control.tols[0], control.max_iter,
+                        cache, stats)
+        if not ok:
+            cache[CACHE_STATE][STATE_VALID] = 0         # jacobian.invalidate
+            if control.hold_force or smallest:
+                return DWELL_FAILED, n
+            clock[CLOCK_DT] = max(0.5 * dt, control.dt_min)
+            continue
+        lj_traction(hs, law.h0, law.c, sig)
+        a = crossing_radius(hs, mesh.r, control.hm)
+        moved = abs(a - clock[CLOCK_A])
+        if moved > control.da_max and not smallest:
+            clock[CLOCK_DT] = max(0.5 * dt, control.dt_min)
+            continue
+        if _opened(physics, control, state.h, hs, sig, dt):
+            for i in range(N):
+                out.h[i], out.sigma[i] = hs[i], sig[i]
+            return DWELL_OPENED, n
+        _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta)
+        n += 1
+        grows = moved < control.grow_below * control.da_max
+        clock[CLOCK_DT] = dt * control.growth if grows else dt
+    return DWELL_CHUNK, n
+
+
+@njit(cache=True, inline='always')
+def _step_start(mesh, physics, law, control, state, starts, dt, delta, work):
+    """The step's equation (``_March._equation``; ``work`` = (e, b, H, g, hs): the Prony
+    coefficients into ``e``, ``b``, the history into ``H``, the gap of the indentation
+    ``delta`` into ``g``; returns C_eff) and Newton's start into ``hs`` (``_March._start``:
+    the quadratic extrapolation, or the tip predictor's where made and its score says so, the
+    two in ``starts``; CLOCK_MADE), settled at the last crack tip (``_March._settle``)."""
+    e, b, H, g, hs = work
+    clock, r, N = state.clock, mesh.r, hs.size
+    ceff = step_coefficients(physics.weights, physics.times, dt, e, b)
+    history_vector(physics.weights, e, b, state.q, state.sigma, H)
+    c0 = -delta + law.h0
+    for i in range(N):
+        g[i] = c0 + 0.5 * r[i] ** 2
+    predict(state.h, state.h_prev, state.h_prev2, dt, clock[CLOCK_DT_PREV],
+            clock[CLOCK_DT_PREV2], starts[0])
+    for i in range(N):
+        starts[1, i] = starts[0, i]
+    made = predict_lattice(r, state.h, state.past, state.past_ta, int(clock[CLOCK_RING]), dt,
+                           starts[1])
+    clock[CLOCK_MADE] = 1.0 if made else 0.0
+    use = 0 if not made else int(clock[CLOCK_TIP_SCORE] < LATTICE_SCORE_USE)
+    for i in range(N):
+        hs[i] = starts[use, i]
+    tip = np.searchsorted(r, clock[CLOCK_A])
+    settle_tip(hs, g, mesh.A, ceff, H, law, max(tip - control.tip_nodes, 0),
+               min(tip + control.tip_nodes, N), control.tip_iter)
+    return ceff
+
+
+@njit(cache=True, inline='always')
+def _opened(physics, control, h, hs, sig, dt):
+    """Whether the step from ``h`` to ``hs`` (traction ``sig``) opened a node in tension fast
+    enough that the process zone would have added more than ``zone_bound`` there
+    (``_March._check_closing``; never without a process zone, ``hdot_c`` infinite)."""
+    if np.isinf(physics.hdot_c):
+        return False
+    worst = 0.0
+    for i in range(h.size):
+        rate = (hs[i] - h[i]) / (dt * physics.hdot_c)
+        if hs[i] > physics.h0 and rate > 0.0:
+            added = (zone_factor(rate, physics.xi, control.zone_qs)[0] - 1.0) * -sig[i]
+            worst = max(worst, added)
+    return worst > control.zone_bound
+
+
+@njit(cache=True, inline='always')
+def _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta):
+    """The step to the state ``hs`` (traction ``sig``, contact radius ``a``) accepted
+    (``_March.accept`` and ``_record``): the Prony modes updated, the tip predictor's score,
+    the states moved along, the clock, record ``n`` of ``out.records``, the tip predictor's
+    ring and ``recent``."""
+    clock, h, N = state.clock, state.h, hs.size
+    update_modes(e, b, state.q, sig, state.sigma)
+    if clock[CLOCK_MADE] == 1.0:
+        clock[CLOCK_TIP_SCORE] += LATTICE_SCORE_WEIGHT * (
+            score_starts(mesh.r, out.starts, hs, a) - clock[CLOCK_TIP_SCORE])
+    for i in range(N):
+        state.h_prev2[i], state.h_prev[i] = state.h_prev[i], h[i]
+        h[i], state.sigma[i] = hs[i], sig[i]
+    clock[CLOCK_DT_PREV2], clock[CLOCK_DT_PREV] = clock[CLOCK_DT_PREV], dt
+    clock[CLOCK_DELTA], clock[CLOCK_T] = delta, clock[CLOCK_T] + dt
+    rec = out.records
+    rec[0, n], rec[1, n], rec[2, n] = clock[CLOCK_T], delta, load(state.sigma, mesh.wP)
+    rec[3, n], rec[4, n] = a, crossing_radius(h, mesh.r, law.h0)
+    ring = int(clock[CLOCK_RING])
+    k = ring % state.past.shape[0]
+    for i in range(N):
+        state.past[k, i] = h[i]
+    state.past_ta[0, k], state.past_ta[1, k] = clock[CLOCK_T], a
+    clock[CLOCK_RING], clock[CLOCK_A] = ring + 1, a
+    recent = state.recent
+    for row in range(3):
+        recent[row, 0], recent[row, 1] = recent[row, 1], recent[row, 2]
+    recent[RECENT_T, 2], recent[RECENT_DELTA, 2], recent[RECENT_DWELL, 2] = (
+        clock[CLOCK_T], delta, 1.0)

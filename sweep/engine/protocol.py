@@ -22,9 +22,11 @@ Then
 
 Phases 1 and 2 march the same hereditary integral as the kernel (the Prony recursion of
 :mod:`sweep.kernels.history`, the Newton solve of :func:`sweep.kernels.solve.newton` on the
-Lennard-Jones law), step by step from Python: a few hundred solves, each a kernel call, Newton
-starting from the unloading kernel's predictors settled at the crack tip (:class:`_March`).
-Python's own share of the time is under a tenth; the rest is Newton's at the advancing crack
+Lennard-Jones law), Newton starting from the unloading kernel's predictors settled at the
+crack tip (:class:`_March`). The approach steps from Python, a kernel call a solve; the
+dwell's steps run in one compiled loop (:func:`sweep.kernels.protocol.dwell_steps`, the same
+operations as :func:`_dwell_step`'s Python, which takes the rare step whose solve failed;
+Python's glue had cost a fifth of a held step). The rest is Newton's at the advancing crack
 tip (docs/design.md, "The test protocol", for what it costs). A scene with a process zone
 (``pz_law``) runs it too: the approach and the dwell grow the contact, closing its crack, and
 on a closing gap the process zone's law is the Lennard-Jones law, so they march that; a step
@@ -42,10 +44,14 @@ from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import (crossing_radius, lennard_jones, lj_traction, smoothing_rate,
                                  zone_factor)
 from ..kernels.jacobian import use_drift_scaled
-from ..kernels.protocol import factorize_ahead, newton_at_load
+from ..kernels.protocol import (CLOCK_A, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, CLOCK_DT_PREV2,
+                                CLOCK_GUESS, CLOCK_MADE, CLOCK_RING, CLOCK_SIZE, CLOCK_T,
+                                CLOCK_TIP_SCORE, DWELL_FAILED, DWELL_OPENED, DwellControl,
+                                DwellOut, MarchState, dwell_steps, factorize_ahead,
+                                newton_at_load)
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
-                             invalidate, load, new_jacobian_cache, newton, predict,
-                             predict_lattice, relax, score_starts, settle_tip)
+                             MeshArrays, Physics, invalidate, load, new_jacobian_cache, newton,
+                             predict, predict_lattice, relax, score_starts, settle_tip)
 from .. import units
 from ..theory import jkr_contact_radius
 from ..scene import Protocol
@@ -57,11 +63,16 @@ __all__ = ["Protocol", "PHASES", "first_contact", "run_phases", "cycle_work"]
 PHASES = {"approach": 0, "dwell": 1, "retract": 2}
 #: the approach ends when the load is within this fraction of the preload
 PRELOAD_RTOL = 1e-6
-#: the dwell's time steps grow by this factor from the approach's last one ...
+#: the dwell's time steps grow by this factor from the approach's last one, after a step that
+#: moved the contact radius by less than DWELL_GROW_BELOW ``da_max`` spacings ...
 DWELL_GROWTH = 1.3
+DWELL_GROW_BELOW = 0.5
 #: ... starting no smaller than this fraction of the dwell, and halved no further than this one
 DWELL_FIRST = 1e-4
 DWELL_MIN_STEP = 1e-9
+#: the compiled dwell (:meth:`_March.compiled_dwell`) returns to Python, which checks the time
+#: budget, after this many tries (a few milliseconds)
+DWELL_CHUNK_STEPS = 32
 #: a dwell at force solves its indentation to this fraction of the preload (the load of a
 #: solve is known to about 1e-8 of it: Newton's tolerance is 1e-10 h0) ...
 HOLD_RTOL = 1e-7
@@ -263,6 +274,53 @@ class _March:
         self._record(phase)
 
 
+    def compiled_dwell(self, protocol: Protocol, end, dt, da_max, dt_min):
+        """At most DWELL_CHUNK_STEPS tries of the dwell's steps to ``end`` from the step
+        ``dt`` by the compiled march (:func:`sweep.kernels.protocol.dwell_steps`: what
+        :func:`_dwell_step` does, to the last bit), the state, counters and records carried
+        in and out: (outcome, the next step, None; on DWELL_FAILED the step whose solve
+        failed, and (its guessed indentation, the predictor's starts or None) for
+        :func:`_dwell_step`). A step that opened a gap too fast for the march's law raises
+        as :meth:`_check_closing` does."""
+        pb, N = self.pb, self.h.size
+        rec = self.records
+        clock = np.zeros(CLOCK_SIZE)
+        clock[[CLOCK_T, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, CLOCK_DT_PREV2, CLOCK_TIP_SCORE,
+               CLOCK_RING, CLOCK_A]] = (self.t, self.delta, dt, self.dt_prev, self.dt_prev2,
+                                        self.tip_score, self.past_count, rec["a"][-1])
+        recent = np.zeros((3, 3))               # the last three records (the newest last)
+        for j in range(1, min(3, len(rec["t"])) + 1):
+            recent[:, 3 - j] = (rec["t"][-j], rec["delta"][-j],
+                                float(rec["phase"][-j] == PHASES["dwell"]))
+        tols = np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * protocol.preload])
+        control = DwellControl(
+            pb.hm, protocol.hold != "depth", float(protocol.preload), tols, float(end),
+            float(da_max), float(dt_min), DWELL_GROWTH, DWELL_GROW_BELOW, TIP_NODES, TIP_ITER,
+            MAX_ITER, DWELL_CHUNK_STEPS, ZONE_IN_MARCH_RTOL * units.sigma0_hat(pb.scene.mu),
+            0.0 if np.isinf(pb.hdot_c) else smoothing_rate(pb.pz_xi))
+        state = MarchState(self.h, self.h_prev, self.h_prev2, self.q, self.sigma, self.past,
+                           self.past_ta, clock, recent)
+        out = DwellOut(np.empty((5, DWELL_CHUNK_STEPS)), np.empty((2, N)), np.empty(N),
+                       np.empty(N))
+        outcome, n = dwell_steps(MeshArrays(pb.A, pb.mesh.r, pb.wP),
+                                 Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times,
+                                         pb.scene.rate, pb.hdot_c, pb.pz_xi),
+                                 self.law, control, state, out, self.cache, self.stats)
+        for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):
+            rec[key].extend(float(x) for x in out.records[i, :n])
+        rec["phase"].extend([PHASES["dwell"]] * n)
+        self.t, self.delta = float(clock[CLOCK_T]), float(clock[CLOCK_DELTA])
+        self.dt_prev, self.dt_prev2 = float(clock[CLOCK_DT_PREV]), float(clock[CLOCK_DT_PREV2])
+        self.tip_score, self.past_count = float(clock[CLOCK_TIP_SCORE]), int(clock[CLOCK_RING])
+        if outcome == DWELL_OPENED:
+            self._check_closing(out.h, out.sigma, clock[CLOCK_DT], PHASES["dwell"])
+            raise AssertionError("the compiled dwell's process-zone check disagrees with "
+                                 "_March._check_closing")
+        failed = None
+        if outcome == DWELL_FAILED:
+            failed = (float(clock[CLOCK_GUESS]), out.starts if clock[CLOCK_MADE] else None)
+        return outcome, float(clock[CLOCK_DT]), failed
+
     def _check_closing(self, h, sig, dt, phase):
         """With a process zone, raise where the step to ``h`` (LJ traction ``sig``) opened a
         node in tension fast enough that the process zone would have added more than
@@ -367,12 +425,18 @@ def _cut_to_preload(m: _March, protocol: Protocol, dd, speed, solved):
     return dd, solved
 
 
-def _dwell(m: _March, protocol: Protocol) -> None:
+def _dwell(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     """Time steps from max(the approach's last, DWELL_FIRST dwell), growing by DWELL_GROWTH,
-    the last cut to end at ``dwell``; at each the indentation held, or solved (secant) so
-    that the load stays at the preload. A step whose solve fails, or whose contact radius
-    moves by more than ``da_max`` spacings (a contact creeping outward), is halved, down to
-    DWELL_MIN_STEP of the dwell, where a fold of the path is relaxed."""
+    the last cut to end at ``dwell``; at each the indentation held, or solved so that the
+    load stays at the preload. A step whose solve fails, or whose contact radius moves by
+    more than ``da_max`` spacings (a contact creeping outward), is halved, down to
+    DWELL_MIN_STEP of the dwell, where a fold of the path is relaxed.
+
+    The steps are taken by the compiled march (:meth:`_March.compiled_dwell`), which
+    returns every DWELL_CHUNK_STEPS tries for the time budget and hands a step whose solve
+    failed to :func:`_dwell_step` (the held step's secant, the relaxation of a fold);
+    ``compiled`` False takes every step with :func:`_dwell_step`, the same march in Python
+    (the compiled one's reference: the same records to the last bit)."""
     if protocol.dwell <= 0.0:
         return
     m.advancing = False     # a creeping contact: no fewer iterations with the zone ahead
@@ -382,33 +446,59 @@ def _dwell(m: _March, protocol: Protocol) -> None:
     end = m.t + protocol.dwell
     while m.t < end * (1.0 - 1e-12):
         budget.check("the dwell")
-        dt = min(dt, end - m.t)
-        smallest = dt <= dt_min
-        if protocol.hold == "depth":
-            solved, delta = m.solve(m.delta, dt, fold=smallest), m.delta
-        else:
-            delta, solved = _held_step(m, protocol.preload, dt, fold=smallest)
-        moved = abs(crossing_radius(solved[1], m.pb.mesh.r, m.pb.hm) - m.records["a"][-1])
-        if (not solved[0] or moved > da_max) and not smallest:
-            dt = max(0.5 * dt, dt_min)
+        if not compiled:
+            dt = _dwell_step(m, protocol, min(dt, end - m.t), da_max, dt_min)
             continue
-        if not solved[0]:
-            raise RuntimeError(f"dwell: no equilibrium at t = {m.t + dt:.6g}")
-        m.accept(delta, dt, solved, PHASES["dwell"])
-        dt = dt * DWELL_GROWTH if moved < 0.5 * da_max else dt
+        outcome, dt, failed = m.compiled_dwell(protocol, end, dt, da_max, dt_min)
+        if outcome == DWELL_FAILED:
+            dt = _dwell_step(m, protocol, dt, da_max, dt_min, failed)
+
+
+def _dwell_step(m: _March, protocol: Protocol, dt, da_max, dt_min, failed=None):
+    """One try of the dwell's step ``dt`` in Python; returns the next step (halved where the
+    try failed or moved the contact radius by more than ``da_max``). ``failed`` = (guessed
+    indentation, the predictor's starts or None): the compiled march's solve of this step
+    failed, and the try goes on from there (held at force: the secant of ordinary solves,
+    :func:`_held_fallback`; held at depth, the smallest step: the fold's relaxation)."""
+    smallest = dt <= dt_min
+    if protocol.hold == "depth":
+        delta = m.delta
+        if failed is None:
+            solved = m.solve(delta, dt, fold=smallest)
+        else:
+            e, b, ceff, H, g = m._equation(delta, dt)
+            h, ok = m._jump(delta, g, ceff, H)
+            solved = m._state(ok, h, e, b, failed[1])
+    elif failed is None:
+        delta, solved = _held_step(m, protocol.preload, dt, fold=smallest)
+    else:
+        delta, solved = _held_fallback(m, protocol.preload, dt, smallest, failed[0])
+    moved = abs(crossing_radius(solved[1], m.pb.mesh.r, m.pb.hm) - m.records["a"][-1])
+    if (not solved[0] or moved > da_max) and not smallest:
+        return max(0.5 * dt, dt_min)
+    if not solved[0]:
+        raise RuntimeError(f"dwell: no equilibrium at t = {m.t + dt:.6g}")
+    m.accept(delta, dt, solved, PHASES["dwell"])
+    return dt * DWELL_GROWTH if moved < DWELL_GROW_BELOW * da_max else dt
 
 
 def _held_step(m: _March, force: float, dt, fold=False):
     """The indentation at which the step ``dt`` ends at the load ``force`` and its state:
     the gap and the indentation solved together from the indentation the dwell's last steps
     extrapolate to (:func:`_held_guess`, :meth:`_March.solve_at_load`); where that does
-    not converge, a secant of ordinary solves from there, the first slope the last held
-    step's (else from a step of 1e-3 h0), each solve after the first starting from the one
-    before (``fold``: :meth:`_March.solve`)."""
+    not converge, :func:`_held_fallback`."""
     d0 = _held_guess(m, dt)
     held = m.solve_at_load(d0, dt, force)
     if held is not None:
         return held
+    return _held_fallback(m, force, dt, fold, d0)
+
+
+def _held_fallback(m: _March, force: float, dt, fold, d0):
+    """The held step ``dt`` where the gap and indentation solved together did not converge:
+    a secant of ordinary solves from the guess ``d0``, the first slope the last held step's
+    (else from a step of 1e-3 h0), each solve after the first starting from the one before
+    (``fold``: :meth:`_March.solve`)."""
     s0 = m.solve(d0, dt, fold)
     if s0[0] and abs(s0[3] - force) <= HOLD_RTOL * force:
         return d0, s0
@@ -486,14 +576,15 @@ def first_contact(pb, stats):
     return h, float(delta)
 
 
-def run_phases(pb, protocol: Protocol, stats):
+def run_phases(pb, protocol: Protocol, stats, compiled: bool = True):
     """Approach and dwell on the prepared problem ``pb``, the solver's counters into
     ``stats`` (:data:`sweep.kernels.solve.N_STATS`): the march (:class:`_March`) whose state
-    and records the retraction continues."""
+    and records the retraction continues. ``compiled`` False: the dwell's steps in Python
+    (:func:`_dwell`), the compiled march's reference."""
     h, delta = first_contact(pb, stats)
     m = _March(pb, h, delta, stats)
     _approach(m, protocol)
-    _dwell(m, protocol)
+    _dwell(m, protocol, compiled)
     return m
 
 
