@@ -41,6 +41,7 @@ and raises one :class:`~sweep.errors.InputError` that lists them all, each namin
 from __future__ import annotations
 
 import dataclasses
+import decimal
 import hashlib
 import itertools
 import json
@@ -74,6 +75,24 @@ AXES = tuple(sorted(SCENE_AXIS_INFO, key=lambda a: SCENE_AXIS_INFO[a].order))
 AXIS_DEFAULTS = {a.name: a.default for a in SCENE_AXIS_INFO.values() if a.default is not None}
 STORE_KEYS = ("trajectories",)
 RANGE_KINDS = ("log10", "linspace")
+
+
+def powers_of_ten(start: float, stop: float, num: int) -> list[float]:
+    """10**x at ``num`` exponents x evenly spaced from ``start`` to ``stop`` (``np.linspace``'s,
+    exact to IEEE arithmetic), each power correctly rounded (decimal arithmetic to 40 digits),
+    so that a grid, and the ids of its scenes, are the same on every machine.
+
+    ``np.logspace`` evaluates the powers with the processor's own vector code, whose last bit
+    differs between processors: 10^2.5 came out 316.2277660168379 on the machine that made
+    the committed campaigns of 2026-11-27 and 316.22776601683796 (correctly rounded) on
+    another, so that the same config gave other scene ids there and a file could not be
+    resumed on the other machine. Files written before this keep resuming: a stored scene
+    that differs from the config's in the last bits of a float counts as that scene
+    (:func:`sweep.campaign.scheduler.rounding_twins`)."""
+    with decimal.localcontext() as ctx:
+        ctx.prec = 40
+        return [float(decimal.Decimal(10) ** decimal.Decimal(float(x)))
+                for x in np.linspace(start, stop, num)]
 MAX_SCENES = 200_000
 MAX_RANGE_NUM = 10_000
 _NAME_RE = re.compile(r"^[A-Za-z0-9_.-]+$")
@@ -279,7 +298,7 @@ def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) ->
                 problems.append(f"{where}.log10: start and stop are exponents of 10 and must "
                                 f"be in [-300, 300] (got {start:g}, {stop:g})")
                 return None
-            vals = [float(v) for v in np.logspace(start, stop, num)]
+            vals = powers_of_ten(start, stop, num)
         else:
             vals = [float(v) for v in np.linspace(start, stop, num)]
         label = lambda i: f"{where} ({kind} value {i})"  # noqa: E731

@@ -348,6 +348,76 @@ def load_results(path) -> pd.DataFrame:
         raise InputError(f"results: {str(path)!r} is not a sweep results file ({exc})") from None
 
 
+#: a stored scene is a config's scene whose floats differ from it in the last bits (a grid
+#: whose powers of ten another machine's numpy rounded otherwise, before
+#: :func:`sweep.campaign.config.powers_of_ten`) where every float agrees to this relative
+#: difference (a few units in the last place) and every other field is equal
+TWIN_RTOL = 1e-14
+#: the significant digits of the floats by which candidate twins are looked up (two floats
+#: TWIN_RTOL apart round apart here once in about 1e4: that scene then runs again)
+TWIN_DIGITS = 10
+
+
+def _twin_fields(scene, numerics) -> dict | None:
+    """A task's fields as a stored row holds them (the scene's, the numerics' as ``num_``),
+    numbers as floats, None for none; None where a field is not a scalar."""
+    out = {}
+    for key, value in [*scene.to_dict().items(),
+                       *((f"num_{k}", v) for k, v in numerics.to_dict().items())]:
+        v = _twin_scalar(value)
+        if v is NotImplemented:
+            return None
+        out[key] = v
+    return out
+
+
+def _twin_scalar(value):
+    if value is None or isinstance(value, (bool, np.bool_, str)):
+        return value
+    if isinstance(value, bytes):
+        return value.decode()
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        x = float(value)
+        return None if math.isnan(x) else x
+    return NotImplemented
+
+
+def _twin_key(fields: dict) -> tuple:
+    return tuple(sorted((k, float(f"{v:.{TWIN_DIGITS}g}") if isinstance(v, float) else v)
+                        for k, v in fields.items() if k != "scene_id"))
+
+
+def rounding_twins(tasks, rows, numerics) -> dict[str, str]:
+    """The ids of ``tasks`` ((scene id, Scene) with the config's ``numerics``) whose scene a
+    stored row (``rows``) holds with other last bits (TWIN_RTOL): a file written on a
+    machine whose numpy rounded a ``log10`` grid otherwise, before the grids' powers of ten
+    were correctly rounded (:func:`sweep.campaign.config.powers_of_ten`). Such a scene is
+    finished, not run again (its row keeps the floats it ran with). Rows of an internal
+    error do not count. Returns {task's id: the stored row's id}."""
+    wanted = [(sid, f) for sid, f in ((sid, _twin_fields(scene, numerics))
+                                      for sid, scene in tasks) if f is not None]
+    if not wanted:
+        return {}
+    keys = sorted(wanted[0][1])
+    keys_with_id = [*keys, "scene_id"]
+    index: dict = {}
+    for row in rows:
+        if row.get("status") == "error":
+            continue
+        fields = {k: _twin_scalar(row.get(k)) for k in keys_with_id}
+        if NotImplemented not in fields.values():
+            index.setdefault(_twin_key(fields), []).append(fields)
+    found = {}
+    for sid, want in wanted:
+        for fields in index.get(_twin_key(want), []):
+            if all(v == fields.get(k) or (
+                    isinstance(v, float) and isinstance(fields.get(k), float)
+                    and abs(v - fields[k]) <= TWIN_RTOL * abs(v)) for k, v in want.items()):
+                found[sid] = fields["scene_id"]
+                break
+    return found
+
+
 def recorded_numerics(path) -> Numerics | None:
     """The numerics the rows of the results at ``path`` ran with (their ``num_*`` columns;
     fields added since take their defaults), or None when the file has no rows or its rows
@@ -638,6 +708,12 @@ class ResultStore:
                         f"wrote it, or use --out to write elsewhere")
                 if h != self.config_hash and text and text == self.meta.get("config_text"):
                     ran = recorded_numerics(self.path)
+                    if (ran is not None and self.config is not None
+                            and ran == self.config.numerics):
+                        # the same numerics: the grid's floats came out otherwise where the
+                        # file was written (sweep.campaign.config.powers_of_ten); its
+                        # scenes count as the config's (scheduler.rounding_twins)
+                        continue
                     diff = (_numerics_diff(ran, self.config.numerics)
                             if ran is not None and self.config is not None else "")
                     what = f" (its rows ran with other values: {diff})" if diff else ""
@@ -744,8 +820,15 @@ class ResultStore:
             self._dirty = True   # consolidate now: the main file records the grown grid
         if history:
             self.meta["config_history"] = json.dumps(history)
+        # the config's scenes that a row holds with other last bits count as finished
+        twins = {}
+        if self.config is not None and self.rows:
+            tasks = self.config.tasks()
+            missing = [(sid, scene) for sid, scene in tasks if sid not in self._ids]
+            twins = rounding_twins(missing, self.rows, self.config.numerics) if missing else {}
         if self.config is not None and (self.grown_from or history):
-            ids = {sid for sid, _ in self.config.tasks()} | set(self._ids) | self._grow_ids
+            ids = ({sid for sid, _ in self.config.tasks()}
+                   | ((set(self._ids) | self._grow_ids) - set(twins.values())))
             self.meta["n_scenes"] = len(ids)
         # the main file exists before the journal does, so a reader always finds a schema
         if not self.path.exists() or self._dirty:
@@ -763,7 +846,7 @@ class ResultStore:
                 with open(jp, "r+b") as fh:
                     fh.truncate(data.rfind(b"\n") + 1)
         self._jfd = os.open(jp, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
-        return set(self._ids)
+        return set(self._ids) | set(twins)
 
     def _add(self, row: dict) -> None:
         self._ids[row["scene_id"]] = len(self.rows)

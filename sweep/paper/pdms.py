@@ -61,6 +61,7 @@ from scipy.optimize import brentq
 from .. import units
 from ..engine.crack_front import scene_law, unload
 from ..errors import InputError
+from ..campaign.config import powers_of_ten
 from ..campaign.si import SIScene
 from ..theory import A_PULL_OFF_FORCE, gent_schultz, paper_v_vs_r_fit, pb_gamma_eff
 
@@ -98,8 +99,10 @@ CRACK_MODELS = {"crack_pb": "law_pb", "crack_gs": "law_gs", "crack_pb_pz": "law_
 
 
 def _speeds(spec) -> np.ndarray:
+    """The speeds of a ``{log10: [a, b, num]}`` spec, as a config's grid gives them
+    (:func:`sweep.campaign.config.powers_of_ten`: the same on every machine)."""
     a, b, num = spec["log10"]
-    return np.logspace(a, b, int(num))
+    return np.array(powers_of_ten(a, b, int(num)))
 
 
 def pdms_scene(speed_m_s: float, case=PDMS_CASE, **process_zone) -> SIScene:

@@ -507,3 +507,65 @@ def test_resume_runs_the_scenes_that_hit_an_internal_error_again(tmp_path):
     df = load(out)
     assert len(df) == 4 and set(df.status) <= {"ok", "failed"}
     assert (tmp_path / "r.h5.errors.log").read_text().count("ZeroDivisionError: boom") == 2
+
+
+def _fake_simulate(scene, numerics):
+    from sweep.scene import Result
+    return Result(scene=scene, numerics=numerics, status="ok", pull_off=scene.n + scene.rate)
+
+
+def test_a_log10_grid_is_correctly_rounded():
+    """Its powers of ten are the correctly rounded ones (exact decimal arithmetic), so that a
+    config gives the same scenes (and ids) on every machine: numpy's logspace gave
+    10^2.5 = 316.2277660168379 on one machine, 316.22776601683796 on another."""
+    from decimal import Decimal, localcontext
+
+    from sweep.campaign.config import powers_of_ten
+
+    values = powers_of_ten(-1.0, 8.0, 19)
+    with localcontext() as ctx:
+        ctx.prec = 60
+        for i, v in enumerate(values):
+            exact = Decimal(10) ** (Decimal(-1) + Decimal(i) / 2)
+            below, above = np.nextafter(v, 0.0), np.nextafter(v, np.inf)
+            assert abs(Decimal(v) - exact) <= abs(Decimal(below) - exact)
+            assert abs(Decimal(v) - exact) <= abs(Decimal(above) - exact)
+    assert values[7] == 316.22776601683796 and values[2] == 1.0 and values[-1] == 1e8
+
+
+@pytest.mark.parametrize("form", ["yaml", "dict"])
+def test_a_file_whose_grid_came_out_otherwise_resumes(tmp_path, monkeypatch, form):
+    """A file written where the log10 grid's powers of ten came out one unit in the last place
+    otherwise (another machine's numpy, before they were correctly rounded) resumes under the
+    same config, a YAML file's (the same text) or a mapping's: its scenes count as the
+    config's, none runs again, nothing is lost, and a scene the config adds still runs."""
+    import yaml
+
+    from sweep.campaign import config as config_module
+    from sweep.campaign.store import load, read_attrs
+
+    spec = {"name": "g", "grid": {"n": [0.4, 0.8], "rate": {"log10": [0, 2, 5]}, "a0": 2.0},
+            "numerics": {"preset": "fast", "nodes": 60}}
+    path = tmp_path / "g.yaml"
+    path.write_text(yaml.safe_dump(spec))
+
+    def config(s=spec):
+        return config_module.as_config(path) if form == "yaml" and s is spec else \
+            config_module.config_from_dict(s)
+
+    right = config_module.powers_of_ten
+    monkeypatch.setattr(config_module, "powers_of_ten", lambda *a: [
+        float(np.nextafter(v, np.inf)) if v != round(v) else v for v in right(*a)])
+    old = config()
+    out = tmp_path / "g.h5"
+    assert run_sweep(old, jobs=1, out=out, simulate=_fake_simulate, progress="none").ran == 10
+    monkeypatch.setattr(config_module, "powers_of_ten", right)
+    new = config()
+    assert new.config_hash != old.config_hash            # two scenes' rates moved by an ulp
+    again = run_sweep(new, jobs=1, out=out, simulate=_fake_simulate, progress="none")
+    assert again.ran == 0 and again.skipped == 10
+    df = load(out)
+    assert len(df) == 10 and read_attrs(out)["complete"]
+    # a scene the config adds still runs
+    grown = config({**spec, "grid": {**spec["grid"], "n": [0.4, 0.8, 1.6]}})
+    assert run_sweep(grown, jobs=1, out=out, simulate=_fake_simulate, progress="none").ran == 5
