@@ -105,3 +105,40 @@ def test_a_relaxed_start_whose_radius_jumps_past_a0_is_refused(monkeypatch):
     with pytest.raises(RuntimeError, match=r"no relaxed state of contact radius a0=2 on this "
                                            r"mesh: the radius jumps past it"):
         initial._solve_relaxed(el, a0=SCENE.a0)
+
+
+@pytest.mark.parametrize("below, above", [(-0.2, 2.5), (-2.5, 0.2)])
+def test_a_bracket_that_ends_on_a_step_returns_its_end_within_the_tolerance(monkeypatch, below,
+                                                                            above):
+    """Where the bracket shrinks to nothing on a step of the radius, its two ends are
+    equilibria at one indentation on either side of a0; the start is the one within
+    RADIUS_JUMP_SPACINGS spacings of a0, whichever end the bisection's last iterate lands on
+    (the last bits of the solves decide that: the uniform 160-node mesh at mu 5, a0 2 of
+    tests/engine/test_machine_compliance.py ended 0.18 spacings below and 2.12 above, its
+    last iterate above and refused with one machine's BLAS, accepted with another's). Here
+    the radius reads ``below`` spacings off a0 up to an indentation, ``above`` beyond, each
+    side sloped (d a/d delta = 1: the secant, which crosses a step from its near side in
+    ever smaller steps, then reaches the bracket's collapse within its 60 iterations)."""
+    el, pb, _ = _counted_solver(monkeypatch)
+    spacing = initial._spacing_at(pb.mesh.r, SCENE.a0)
+    assert max(-below, above) > initial.RADIUS_JUMP_SPACINGS    # one end off the tolerance
+    d_jump = SCENE.a0 ** 2 - (2.0 * SCENE.a0) ** 0.5 + 0.05
+    states = {}
+    solve = el.solve
+
+    def solve_noting(delta, guess):
+        ok, h = solve(delta, guess)
+        states[id(h)] = delta
+        return ok, h
+
+    def radius(h, *a):
+        delta = states.get(id(h), 0.0)
+        return SCENE.a0 + spacing * (above if delta > d_jump else below) + (delta - d_jump)
+
+    el.solve = solve_noting
+    el.radius = radius
+    h, delta = initial._solve_relaxed(el, a0=SCENE.a0)
+    near = below if -below < above else above
+    assert abs(radius(h) - (SCENE.a0 + spacing * near)) <= 1e-12
+    assert abs(states[id(h)] - delta) <= 1e-13 * delta
+    assert abs(delta - d_jump) <= 1e-12 * d_jump
