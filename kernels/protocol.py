@@ -182,10 +182,11 @@ DWELL_ENDED = 0
 DWELL_CHUNK = 1
 DWELL_FAILED = 2
 DWELL_OPENED = 3
-#: the entries of :data:`MarchState`'s ``clock``: the march's time, indentation, next time
-#: step, last two time steps, tip predictor's score, states written to its ring, contact
-#: radius of the last state, and (on DWELL_FAILED / DWELL_OPENED) the step's time step,
-#: guessed indentation and whether the tip predictor made a start
+#: the entries of :data:`MarchState`'s ``clock``: the march's time, indentation, next step
+#: (the dwell's time step, the approach's indentation step), last two time steps, tip
+#: predictor's score, states written to its ring, contact radius of the last state, (on a
+#: hand-over to the caller) the step's time step, indentation and whether the tip predictor
+#: made a start, the last state's load, and the phase (1.0 the dwell, 0.0 the approach)
 CLOCK_T = 0
 CLOCK_DELTA = 1
 CLOCK_DT = 2
@@ -196,7 +197,9 @@ CLOCK_RING = 6
 CLOCK_A = 7
 CLOCK_GUESS = 8
 CLOCK_MADE = 9
-CLOCK_SIZE = 10
+CLOCK_P = 10
+CLOCK_PHASE = 11
+CLOCK_SIZE = 12
 #: the rows of :data:`MarchState`'s ``recent``: the last three records' times, indentations
 #: and whether each was the dwell's (1.0) or the approach's (0.0); column 2 the newest
 RECENT_T = 0
@@ -221,7 +224,7 @@ MarchState = namedtuple("MarchState", ["h", "h_prev", "h_prev2", "q", "sigma", "
                                        "past_ta", "clock", "recent"])
 #: what a call writes besides the state: records (5, max_steps) the accepted steps' t, delta,
 #: P, a, a_inner; starts (2, N) the predictor's two starts; h (N,) and sigma (N,) the state
-#: of a step that opened a gap too fast (DWELL_OPENED)
+#: of the step handed over (DWELL_OPENED, APPROACH_PASSED)
 DwellOut = namedtuple("DwellOut", ["records", "starts", "h", "sigma"])
 
 
@@ -294,9 +297,7 @@ def dwell_steps(mesh, physics, law, control, state, out, cache, stats):
                 return DWELL_FAILED, n
             clock[CLOCK_DT] = max(0.5 * dt, control.dt_min)
             continue
-        lj_traction(hs, law.h0, law.c, sig)
-        a = crossing_radius(hs, mesh.r, control.hm)
-        moved = abs(a - clock[CLOCK_A])
+        a, moved = _radius_moved(mesh, law, control, clock, hs, sig)
         if moved > control.da_max and not smallest:
             clock[CLOCK_DT] = max(0.5 * dt, control.dt_min)
             continue
@@ -342,6 +343,15 @@ def _step_start(mesh, physics, law, control, state, starts, dt, delta, work):
 
 
 @njit(cache=True, inline='always')
+def _radius_moved(mesh, law, control, clock, hs, sig):
+    """The traction of the step's state ``hs`` into ``sig``; its contact radius and how far
+    that moved from the last state's."""
+    lj_traction(hs, law.h0, law.c, sig)
+    a = crossing_radius(hs, mesh.r, control.hm)
+    return a, abs(a - clock[CLOCK_A])
+
+
+@njit(cache=True, inline='always')
 def _opened(physics, control, h, hs, sig, dt):
     """Whether the step from ``h`` to ``hs`` (traction ``sig``) opened a node in tension fast
     enough that the process zone would have added more than ``zone_bound`` there
@@ -374,7 +384,8 @@ def _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta):
     clock[CLOCK_DT_PREV2], clock[CLOCK_DT_PREV] = clock[CLOCK_DT_PREV], dt
     clock[CLOCK_DELTA], clock[CLOCK_T] = delta, clock[CLOCK_T] + dt
     rec = out.records
-    rec[0, n], rec[1, n], rec[2, n] = clock[CLOCK_T], delta, load(state.sigma, mesh.wP)
+    clock[CLOCK_P] = load(state.sigma, mesh.wP)
+    rec[0, n], rec[1, n], rec[2, n] = clock[CLOCK_T], delta, clock[CLOCK_P]
     rec[3, n], rec[4, n] = a, crossing_radius(h, mesh.r, law.h0)
     ring = int(clock[CLOCK_RING])
     k = ring % state.past.shape[0]
@@ -386,4 +397,79 @@ def _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta):
     for row in range(3):
         recent[row, 0], recent[row, 1] = recent[row, 1], recent[row, 2]
     recent[RECENT_T, 2], recent[RECENT_DELTA, 2], recent[RECENT_DWELL, 2] = (
-        clock[CLOCK_T], delta, 1.0)
+        clock[CLOCK_T], delta, clock[CLOCK_PHASE])
+
+
+#: :func:`approach_steps`' outcomes beyond DWELL_ENDED (the load reached the preload),
+#: DWELL_CHUNK, DWELL_FAILED (the smallest step's solve failed: the caller relaxes the fold)
+#: and DWELL_OPENED: the step's load passed the preload (the caller cuts it to end there)
+APPROACH_PASSED = 4
+
+#: the approach's settings: hm the gap at which the contact radius is read; preload (pi dg R)
+#: and preload_rtol the load it ends at; speed d delta/dt (d_ref / tau0); dd_max, dd_min the
+#: largest and smallest indentation steps; da_max the most a step but the smallest may move
+#: the contact radius; tol Newton's (h0 units times h0), trial_iter its iterations on a step
+#: that may still be halved, max_iter on the smallest; tip_nodes, tip_iter the settle at the
+#: crack tip; ahead_nodes, ahead_least the factorization's zone ahead of the advancing tip
+#: (:func:`factorize_ahead`); max_steps the tries of one call; zone_bound, zone_qs as
+#: :data:`DwellControl`'s
+ApproachControl = namedtuple("ApproachControl", [
+    "hm", "preload", "preload_rtol", "speed", "dd_max", "dd_min", "da_max", "tol",
+    "trial_iter", "max_iter", "tip_nodes", "tip_iter", "ahead_nodes", "ahead_least",
+    "max_steps", "zone_bound", "zone_qs"])
+
+
+@njit(cache=True)
+def approach_steps(mesh, physics, law, control, state, out, cache, stats):
+    """The approach's indentation steps after its first, as ``sweep.engine.protocol`` takes
+    them one by one from Python (``_approach``, ``_trial``, :class:`_March`'s solve and
+    accept): the same operations in the same order. Arguments as :func:`dwell_steps`'s,
+    ``control`` an :data:`ApproachControl`; returns (outcome, records written).
+
+    Each step dd = ``clock[CLOCK_DT]`` to the indentation delta + dd over dd / speed is solved
+    from the predictor's start settled at the crack tip, the factorization's zone kept ahead
+    of the tip, by at most ``trial_iter`` Newton iterations (``max_iter`` on the smallest
+    step, dd <= ``dd_min``). A step whose solve fails or whose contact radius moves by more
+    than ``da_max`` is halved (down to ``dd_min``); an accepted one is written and the next
+    step doubles (up to ``dd_max``) where the radius moved by less than half ``da_max``. Ends
+    where the load reaches the preload (DWELL_ENDED), after ``max_steps`` tries
+    (DWELL_CHUNK), or hands the step over: its load passed the preload (APPROACH_PASSED:
+    its state in ``out``), the smallest step's solve failed (DWELL_FAILED), a process zone
+    would add more than ``zone_bound`` at an opening node (DWELL_OPENED)."""
+    N, M = state.h.size, physics.weights.size
+    clock = state.clock
+    e, b, H, g = np.empty(M), np.empty(M), np.empty(N), np.empty(N)
+    hs, sig = np.empty(N), np.empty(N)
+    n = 0
+    for _ in range(control.max_steps):
+        if not clock[CLOCK_P] < control.preload * (1.0 - control.preload_rtol):
+            return DWELL_ENDED, n
+        dd = clock[CLOCK_DT]
+        smallest = dd <= control.dd_min
+        delta, dt = clock[CLOCK_DELTA] + dd, dd / control.speed
+        clock[CLOCK_GUESS] = delta
+        ceff = _step_start(mesh, physics, law, control, state, out.starts, dt, delta,
+                           (e, b, H, g, hs))
+        factorize_ahead(hs, mesh.A, ceff, law, control.ahead_nodes, control.ahead_least,
+                        cache, stats)
+        ok = newton(hs, g, mesh.A, ceff, H, law, control.tol,
+                    control.max_iter if smallest else control.trial_iter, cache, stats)
+        if not ok:
+            cache[CACHE_STATE][STATE_VALID] = 0         # jacobian.invalidate
+            if smallest:
+                return DWELL_FAILED, n
+            clock[CLOCK_DT] = max(0.5 * dd, control.dd_min)
+            continue
+        a, moved = _radius_moved(mesh, law, control, clock, hs, sig)
+        if moved > control.da_max and not smallest:
+            clock[CLOCK_DT] = max(0.5 * dd, control.dd_min)
+            continue
+        passed = load(sig, mesh.wP) > control.preload
+        if passed or _opened(physics, control, state.h, hs, sig, dt):
+            for i in range(N):
+                out.h[i], out.sigma[i] = hs[i], sig[i]
+            return (APPROACH_PASSED if passed else DWELL_OPENED), n
+        _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta)
+        n += 1
+        clock[CLOCK_DT] = min(2.0 * dd, control.dd_max) if moved < 0.5 * control.da_max else dd
+    return DWELL_CHUNK, n

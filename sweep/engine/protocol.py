@@ -23,10 +23,11 @@ Then
 Phases 1 and 2 march the same hereditary integral as the kernel (the Prony recursion of
 :mod:`sweep.kernels.history`, the Newton solve of :func:`sweep.kernels.solve.newton` on the
 Lennard-Jones law), Newton starting from the unloading kernel's predictors settled at the
-crack tip (:class:`_March`). The approach steps from Python, a kernel call a solve; the
-dwell's steps run in one compiled loop (:func:`sweep.kernels.protocol.dwell_steps`, the same
-operations as :func:`_dwell_step`'s Python, which takes the rare step whose solve failed;
-Python's glue had cost a fifth of a held step). The rest is Newton's at the advancing crack
+crack tip (:class:`_March`). Their steps run in compiled loops
+(:func:`sweep.kernels.protocol.approach_steps`, :func:`sweep.kernels.protocol.dwell_steps`:
+the same operations as :func:`_trial`'s and :func:`_dwell_step`'s Python, which take the
+approach's first step, its cut to the preload and the rare step whose solve failed; Python's
+glue had cost a fifth of a step). The rest is Newton's at the advancing crack
 tip (docs/design.md, "The test protocol", for what it costs). A scene with a process zone
 (``pz_law``) runs it too: the approach and the dwell grow the contact, closing its crack, and
 on a closing gap the process zone's law is the Lennard-Jones law, so they march that; a step
@@ -46,9 +47,10 @@ from ..kernels.interface import (crossing_radius, lennard_jones, lj_traction, sm
 from ..kernels.jacobian import use_drift_scaled
 from ..kernels.protocol import (CLOCK_A, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, CLOCK_DT_PREV2,
                                 CLOCK_GUESS, CLOCK_MADE, CLOCK_RING, CLOCK_SIZE, CLOCK_T,
-                                CLOCK_TIP_SCORE, DWELL_FAILED, DWELL_OPENED, DwellControl,
-                                DwellOut, MarchState, dwell_steps, factorize_ahead,
-                                newton_at_load)
+                                CLOCK_P, CLOCK_PHASE, CLOCK_TIP_SCORE, APPROACH_PASSED,
+                                DWELL_FAILED, DWELL_OPENED, ApproachControl, DwellControl,
+                                DwellOut, MarchState, approach_steps, dwell_steps,
+                                factorize_ahead, newton_at_load)
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
                              MeshArrays, Physics, invalidate, load, new_jacobian_cache, newton,
                              predict, predict_lattice, relax, score_starts, settle_tip)
@@ -277,49 +279,95 @@ class _March:
     def compiled_dwell(self, protocol: Protocol, end, dt, da_max, dt_min):
         """At most DWELL_CHUNK_STEPS tries of the dwell's steps to ``end`` from the step
         ``dt`` by the compiled march (:func:`sweep.kernels.protocol.dwell_steps`: what
-        :func:`_dwell_step` does, to the last bit), the state, counters and records carried
-        in and out: (outcome, the next step, None; on DWELL_FAILED the step whose solve
-        failed, and (its guessed indentation, the predictor's starts or None) for
-        :func:`_dwell_step`). A step that opened a gap too fast for the march's law raises
-        as :meth:`_check_closing` does."""
-        pb, N = self.pb, self.h.size
-        rec = self.records
-        clock = np.zeros(CLOCK_SIZE)
-        clock[[CLOCK_T, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, CLOCK_DT_PREV2, CLOCK_TIP_SCORE,
-               CLOCK_RING, CLOCK_A]] = (self.t, self.delta, dt, self.dt_prev, self.dt_prev2,
-                                        self.tip_score, self.past_count, rec["a"][-1])
-        recent = np.zeros((3, 3))               # the last three records (the newest last)
-        for j in range(1, min(3, len(rec["t"])) + 1):
-            recent[:, 3 - j] = (rec["t"][-j], rec["delta"][-j],
-                                float(rec["phase"][-j] == PHASES["dwell"]))
-        tols = np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * protocol.preload])
+        :func:`_dwell_step` does, to the last bit): (outcome, the next step, None; on
+        DWELL_FAILED the step whose solve failed, and (its guessed indentation, the
+        predictor's starts or None) for :func:`_dwell_step`). A step that opened a gap too
+        fast for the march's law raises as :meth:`_check_closing` does."""
+        pb = self.pb
         control = DwellControl(
-            pb.hm, protocol.hold != "depth", float(protocol.preload), tols, float(end),
+            pb.hm, protocol.hold != "depth", float(protocol.preload),
+            np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * protocol.preload]), float(end),
             float(da_max), float(dt_min), DWELL_GROWTH, DWELL_GROW_BELOW, TIP_NODES, TIP_ITER,
-            MAX_ITER, DWELL_CHUNK_STEPS, ZONE_IN_MARCH_RTOL * units.sigma0_hat(pb.scene.mu),
-            0.0 if np.isinf(pb.hdot_c) else smoothing_rate(pb.pz_xi))
-        state = MarchState(self.h, self.h_prev, self.h_prev2, self.q, self.sigma, self.past,
-                           self.past_ta, clock, recent)
-        out = DwellOut(np.empty((5, DWELL_CHUNK_STEPS)), np.empty((2, N)), np.empty(N),
-                       np.empty(N))
-        outcome, n = dwell_steps(MeshArrays(pb.A, pb.mesh.r, pb.wP),
-                                 Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times,
-                                         pb.scene.rate, pb.hdot_c, pb.pz_xi),
-                                 self.law, control, state, out, self.cache, self.stats)
-        for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):
-            rec[key].extend(float(x) for x in out.records[i, :n])
-        rec["phase"].extend([PHASES["dwell"]] * n)
-        self.t, self.delta = float(clock[CLOCK_T]), float(clock[CLOCK_DELTA])
-        self.dt_prev, self.dt_prev2 = float(clock[CLOCK_DT_PREV]), float(clock[CLOCK_DT_PREV2])
-        self.tip_score, self.past_count = float(clock[CLOCK_TIP_SCORE]), int(clock[CLOCK_RING])
-        if outcome == DWELL_OPENED:
-            self._check_closing(out.h, out.sigma, clock[CLOCK_DT], PHASES["dwell"])
-            raise AssertionError("the compiled dwell's process-zone check disagrees with "
-                                 "_March._check_closing")
+            MAX_ITER, DWELL_CHUNK_STEPS, *self._zone_bound())
+        outcome, clock, out = self._compiled(dwell_steps, control, dt, PHASES["dwell"])
         failed = None
         if outcome == DWELL_FAILED:
             failed = (float(clock[CLOCK_GUESS]), out.starts if clock[CLOCK_MADE] else None)
         return outcome, float(clock[CLOCK_DT]), failed
+
+    def compiled_march(self, protocol: Protocol, dd, speed, dd_max, da_max):
+        """At most DWELL_CHUNK_STEPS tries of the approach's steps from the indentation step
+        ``dd`` by the compiled march (:func:`sweep.kernels.protocol.approach_steps`: what
+        :func:`_approach` does with :func:`_trial`, to the last bit): (outcome, the next
+        step, None; or where a step is handed over, its step and (the solved state as
+        :meth:`solve` returns it, the contact radius's change) for :func:`_approach` to end:
+        the step whose load passed the preload, and the smallest step whose solve failed,
+        its fold relaxed here as :meth:`solve` does). A step that opened a gap too fast for
+        the march's law raises as :meth:`_check_closing` does."""
+        pb = self.pb
+        control = ApproachControl(
+            pb.hm, float(protocol.preload), PRELOAD_RTOL, float(speed), float(dd_max),
+            MIN_STEP_FRACTION * dd_max, float(da_max), pb.numerics.tol * pb.h0, TRIAL_ITER,
+            MAX_ITER, TIP_NODES, TIP_ITER, AHEAD_NODES, AHEAD_LEAST, DWELL_CHUNK_STEPS,
+            *self._zone_bound())
+        outcome, clock, out = self._compiled(approach_steps, control, dd, PHASES["approach"])
+        dd = float(clock[CLOCK_DT])
+        if outcome not in (APPROACH_PASSED, DWELL_FAILED):
+            return outcome, dd, None
+        delta = float(clock[CLOCK_GUESS])
+        e, b, ceff, H, g = self._equation(delta, dd / speed)
+        starts = out.starts.copy() if clock[CLOCK_MADE] else None
+        if outcome == APPROACH_PASSED:
+            h, ok = out.h.copy(), True
+        else:                   # the smallest step: relax the fold (solve's fold)
+            h, ok = self._jump(delta, g, ceff, H)
+        solved = self._state(ok, h, e, b, starts)
+        moved = abs(crossing_radius(solved[1], pb.mesh.r, pb.hm) - self.records["a"][-1])
+        return outcome, dd, (solved, moved)
+
+    def _zone_bound(self):
+        """(the most traction a process zone may add at an opening node, its smoothing
+        rate): ZONE_IN_MARCH_RTOL of the peak tension (:meth:`_check_closing`)."""
+        pb = self.pb
+        return (ZONE_IN_MARCH_RTOL * units.sigma0_hat(pb.scene.mu),
+                0.0 if np.isinf(pb.hdot_c) else smoothing_rate(pb.pz_xi))
+
+    def _compiled(self, kernel, control, step, phase):
+        """The compiled march's call: the state, counters and records carried in and out
+        (the kernel's records appended with ``phase``); returns (outcome, clock, out). A step
+        that opened a gap too fast raises here, as :meth:`_check_closing` does."""
+        pb, N = self.pb, self.h.size
+        rec = self.records
+        clock = np.zeros(CLOCK_SIZE)
+        clock[[CLOCK_T, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, CLOCK_DT_PREV2, CLOCK_TIP_SCORE,
+               CLOCK_RING, CLOCK_A, CLOCK_P, CLOCK_PHASE]] = (
+            self.t, self.delta, step, self.dt_prev, self.dt_prev2, self.tip_score,
+            self.past_count, rec["a"][-1], rec["P"][-1], float(phase == PHASES["dwell"]))
+        recent = np.zeros((3, 3))               # the last three records (the newest last)
+        for j in range(1, min(3, len(rec["t"])) + 1):
+            recent[:, 3 - j] = (rec["t"][-j], rec["delta"][-j],
+                                float(rec["phase"][-j] == PHASES["dwell"]))
+        state = MarchState(self.h, self.h_prev, self.h_prev2, self.q, self.sigma, self.past,
+                           self.past_ta, clock, recent)
+        out = DwellOut(np.empty((5, DWELL_CHUNK_STEPS)), np.empty((2, N)), np.empty(N),
+                       np.empty(N))
+        outcome, n = kernel(MeshArrays(pb.A, pb.mesh.r, pb.wP),
+                            Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times,
+                                    pb.scene.rate, pb.hdot_c, pb.pz_xi),
+                            self.law, control, state, out, self.cache, self.stats)
+        for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):
+            rec[key].extend(float(x) for x in out.records[i, :n])
+        rec["phase"].extend([phase] * n)
+        self.t, self.delta = float(clock[CLOCK_T]), float(clock[CLOCK_DELTA])
+        self.dt_prev, self.dt_prev2 = float(clock[CLOCK_DT_PREV]), float(clock[CLOCK_DT_PREV2])
+        self.tip_score, self.past_count = float(clock[CLOCK_TIP_SCORE]), int(clock[CLOCK_RING])
+        if outcome == DWELL_OPENED:
+            dt = (clock[CLOCK_DT] if phase == PHASES["dwell"]      # the approach's: dd / speed
+                  else clock[CLOCK_DT] / control.speed)
+            self._check_closing(out.h, out.sigma, dt, phase)
+            raise AssertionError("the compiled march's process-zone check disagrees with "
+                                 "_March._check_closing")
+        return outcome, clock, out
 
     def _check_closing(self, h, sig, dt, phase):
         """With a process zone, raise where the step to ``h`` (LJ traction ``sig``) opened a
@@ -346,11 +394,17 @@ class _March:
                 f"the Lennard-Jones law, do not carry")
 
 
-def _approach(m: _March, protocol: Protocol) -> None:
+def _approach(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     """Indentation steps of ``numerics.step`` h0 (halved where Newton fails or the contact
     radius moves by more than APPROACH_DA_FACTOR ``da_max`` spacings) until the load reaches
     the preload; the step that passes it is cut to end there. The first step is the one
-    halving would give, found from below (:func:`_first_step`)."""
+    halving would give, found from below (:func:`_first_step`).
+
+    The steps after the first are taken by the compiled march (:meth:`_March.compiled_march`),
+    which returns every DWELL_CHUNK_STEPS tries for the time budget and hands over the step
+    whose load passed the preload (cut here) and the smallest step whose solve failed (its
+    fold relaxed here); ``compiled`` False takes every step in Python (:func:`_trial`), the
+    compiled one's reference."""
     pb = m.pb
     m.advancing = True
     speed = protocol.approach_rate * pb.h0
@@ -361,6 +415,12 @@ def _approach(m: _March, protocol: Protocol) -> None:
         budget.check("the approach")
         if dd is None:
             dd, solved, moved = _first_step(m, speed, dd_max, da_max)
+        elif compiled:
+            outcome, dd, handed = m.compiled_march(protocol, dd, speed=speed, dd_max=dd_max,
+                                                   da_max=da_max)
+            if handed is None:
+                continue
+            solved, moved = handed
         else:
             smallest = dd <= MIN_STEP_FRACTION * dd_max
             solved, moved, passed = _trial(m, dd, speed, smallest, da_max)
@@ -579,11 +639,11 @@ def first_contact(pb, stats):
 def run_phases(pb, protocol: Protocol, stats, compiled: bool = True):
     """Approach and dwell on the prepared problem ``pb``, the solver's counters into
     ``stats`` (:data:`sweep.kernels.solve.N_STATS`): the march (:class:`_March`) whose state
-    and records the retraction continues. ``compiled`` False: the dwell's steps in Python
-    (:func:`_dwell`), the compiled march's reference."""
+    and records the retraction continues. ``compiled`` False: every step in Python
+    (:func:`_approach`, :func:`_dwell`), the compiled march's reference."""
     h, delta = first_contact(pb, stats)
     m = _March(pb, h, delta, stats)
-    _approach(m, protocol)
+    _approach(m, protocol, compiled)
     _dwell(m, protocol, compiled)
     return m
 

@@ -244,12 +244,13 @@ def test_the_first_approach_step_is_the_one_halving_from_the_largest_accepts(mat
     dict(BASE, k=0.2, **PROTOCOL, dwell_hold="depth"),
     dict(BASE, material="sls", k=0.2, approach_rate=1.0, preload=4.0, dwell=100.0, **PZ),
 ], ids=["force", "depth", "sls-process-zone"])
-def test_the_compiled_dwell_is_the_python_march(fields):
-    """The dwell's steps are taken by a compiled kernel (kernels.protocol.dwell_steps) that
-    does what engine.protocol._dwell_step does from Python, operation for operation: the
-    records, the state the retraction starts from and the solver's counters are the same.
-    Measured equal to the last bit; the tolerance, 1e-12 relative, leaves room for a
-    compiler that contracts a multiply-add differently in the two."""
+def test_the_compiled_march_is_the_python_march(fields):
+    """The approach's steps after the first and the dwell's are taken by compiled kernels
+    (kernels.protocol.approach_steps, dwell_steps) that do what engine.protocol's _trial and
+    _dwell_step do from Python, operation for operation: the records and the state the
+    retraction starts from are the same. Measured equal to the last bit; the tolerance,
+    1e-12 relative, leaves room for a compiler that contracts a multiply-add differently in
+    the two."""
     from sweep.engine import protocol
     from sweep.kernels.solve import N_STATS
 
@@ -259,8 +260,9 @@ def test_the_compiled_dwell_is_the_python_march(fields):
     for compiled in (False, True):
         stats = np.zeros(N_STATS, dtype=np.int64)
         marches.append((protocol.run_phases(pb, scene.protocol(), stats, compiled), stats))
-    (python, python_stats), (kernel, kernel_stats) = marches
-    assert np.sum(np.asarray(kernel.records["phase"]) == 1) > 10     # a dwell was marched
+    (python, _), (kernel, _) = marches
+    phase = np.asarray(kernel.records["phase"])
+    assert np.sum(phase == 0) > 10 and np.sum(phase == 1) > 10      # both phases marched
     for key in python.records:
         np.testing.assert_allclose(kernel.records[key], python.records[key], rtol=1e-12,
                                    atol=0.0, err_msg=key)
@@ -270,22 +272,42 @@ def test_the_compiled_dwell_is_the_python_march(fields):
     assert kernel.tip_score == pytest.approx(python.tip_score, rel=1e-12, abs=1e-12)
 
 
+def _refusals(scene, match):
+    """The reasons the Python march and the compiled one refuse ``scene`` with (both must)."""
+    from sweep.engine import protocol
+    from sweep.kernels.solve import N_STATS
+
+    pb = prepare(scene, Numerics.preset("balanced"))
+    reasons = []
+    for compiled in (False, True):
+        with pytest.raises(RuntimeError, match=match) as caught:
+            protocol.run_phases(pb, scene.protocol(), np.zeros(N_STATS, dtype=np.int64),
+                                compiled)
+        reasons.append(str(caught.value))
+    return reasons
+
+
+SLS_PROTOCOL = dict(BASE, material="sls", k=0.2, approach_rate=1.0, preload=4.0, dwell=100.0)
+
+
+def test_the_compiled_approach_refuses_an_opening_gap_as_the_python_march():
+    """The SLS approach with a process zone of pz_v0 1e-6 opens a node by 2.1e-2 of the peak
+    tension (test_a_march_that_opens_a_gap_under_a_strong_process_zone_is_refused): the
+    compiled approach and the Python march refuse it at the same step, with the same
+    reason."""
+    scene = Scene(model="bem", **SLS_PROTOCOL, **dict(PZ, pz_v0=1e-6))
+    python, compiled = _refusals(scene, "the approach opened the gap")
+    assert python == compiled
+
+
 def test_the_compiled_dwell_refuses_an_opening_gap_as_the_python_march(monkeypatch):
     """The SLS dwell with a process zone opens one node by 2.2e-4 of the peak tension
     (engine.protocol.ZONE_IN_MARCH_RTOL's measurements); with the bound set below that, the
     compiled dwell and the Python march refuse the scene at the same step, with the same
     reason."""
     from sweep.engine import protocol
-    from sweep.kernels.solve import N_STATS
 
     monkeypatch.setattr(protocol, "ZONE_IN_MARCH_RTOL", 1e-4)
-    scene = Scene(model="bem", **BASE, material="sls", k=0.2, approach_rate=1.0, preload=4.0,
-                  dwell=100.0, **PZ)
-    pb = prepare(scene, Numerics.preset("balanced"))
-    reasons = []
-    for compiled in (False, True):
-        with pytest.raises(RuntimeError, match="the dwell opened the gap") as caught:
-            protocol.run_phases(pb, scene.protocol(), np.zeros(N_STATS, dtype=np.int64),
-                                compiled)
-        reasons.append(str(caught.value))
-    assert reasons[0] == reasons[1]
+    python, compiled = _refusals(Scene(model="bem", **SLS_PROTOCOL, **PZ),
+                                 "the dwell opened the gap")
+    assert python == compiled
