@@ -189,9 +189,11 @@ class GentSchultzLaw:
         return (self.c * (1.0 + (v / self.v0) ** self.xi))[()]
 
     def speed(self, g):
-        """``V(g)`` and ``dV/dg`` (0 where ``g <= c``)."""
+        """``V(g)`` and ``dV/dg`` (0 where ``g <= c``; inf where ``V`` overflows: a trial
+        stage of the integrator far off the solution, without a warning)."""
         x = np.maximum(np.asarray(g, dtype=float) / self.c - 1.0, 0.0)
-        v = self.v0 * x ** (1.0 / self.xi)
+        with np.errstate(over="ignore"):
+            v = self.v0 * x ** (1.0 / self.xi)
         with np.errstate(divide="ignore", invalid="ignore"):
             dv = np.where(x > 0, v / (self.xi * x * self.c), 0.0)
         return v[()], dv[()]
