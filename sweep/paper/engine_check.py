@@ -19,12 +19,23 @@ PDMS report (``results/pdms/pdms.json``, ``make pdms``) is checked there too: th
 fits it used must be the committed ones, and its crack-front curves are computed again at five
 of its speeds.
 
-The tolerances are far above what the processor's last digits move (the same scene in two
-processes gives the same bits, ``tests/engine/test_reproducible.py``; another processor's
-BLAS may round differently, which Newton's tolerance, 1e-6 h0 or finer, carries into the
-pull-off at about that size) and below what a change of numerics moves: the Newton tolerance
-from 1e-7 to 1e-6 h0 moved the threshold grid's pull-offs by up to 2.2e-5 and crack speeds
-by up to 6.8e-4, a step or mesh change by 1e-4 or more (docs/performance.md).
+The tolerances are above what the processor's last digits move in most rows (the same
+scene in two processes gives the same bits, ``tests/engine/test_reproducible.py``; another
+processor's BLAS rounds differently, which Newton's tolerance, 1e-6 h0 or finer, carries
+into the pull-off at about that size) and below what a change of numerics moves: the Newton
+tolerance from 1e-7 to 1e-6 h0 moved the threshold grid's pull-offs by up to 2.2e-5 and
+crack speeds by up to 6.8e-4, a step or mesh change by 1e-4 or more (docs/performance.md).
+In a few rows another processor moves the pull-off further: its BLAS fits another Prony
+series, as valid (within the numerics' ``prony_rtol`` of the compliance), from the
+disk-cached fits' nonnegative least squares, or pins the crack tip at a neighbouring node.
+Measured with OpenBLAS's Sandybridge kernels and a fresh disk cache against results made
+with its Haswell kernels (an AMD EPYC, 2026-11-27): 5 of the 28 sample rows moved, by
+1.6e-5 to 1.4e-4 (at most 2 of a file's 8, the others by at most 5e-8), crack speeds by
+up to 5e-4; with a kept disk cache every row within 3e-10. So at most a quarter of a
+sample's rows (:data:`HOP_FRACTION`) may differ by up to the numerics' ``prony_rtol``
+(1e-3 fast, 1e-4 balanced): an engine change that moves the rows systematically by more
+than PULL_OFF_RTOL still fails the check, one that moves a few rows by less than
+``prony_rtol`` does not.
 """
 from __future__ import annotations
 
@@ -36,7 +47,7 @@ import numpy as np
 from .._version import __version__
 from ..scene import AXES, Numerics, Scene
 
-__all__ = ["SAMPLE_SIZE", "SAMPLE_FAILED", "PULL_OFF_RTOL", "CRACK_SPEED_RTOL",
+__all__ = ["SAMPLE_SIZE", "SAMPLE_FAILED", "PULL_OFF_RTOL", "CRACK_SPEED_RTOL", "HOP_FRACTION",
            "COMMITTED", "sample_rows", "record", "rerun", "differences", "config_for"]
 
 #: scenes of a campaign's sample (the cheapest, spread over the grid) and failed scenes in it
@@ -45,6 +56,9 @@ SAMPLE_FAILED = 2
 #: relative tolerances of the comparison (see the module docstring)
 PULL_OFF_RTOL = 1e-5
 CRACK_SPEED_RTOL = 1e-3
+#: the fraction of a sample's rows whose pull-off may differ by more than PULL_OFF_RTOL, up
+#: to the numerics' prony_rtol (module docstring)
+HOP_FRACTION = 0.25
 #: the committed results that carry a check, relative to the repository root
 COMMITTED = ("results/threshold/fit.json", "results/vr/fit.json", "results/fig3/fig3.json",
              "results/aconv/aconv.json")
@@ -114,22 +128,33 @@ def _rel(a, b) -> float:
     return abs(a - b) / max(abs(b), 1e-300)
 
 
-def differences(recorded: list[dict], computed: list[dict]) -> list[str]:
+def differences(recorded: list[dict], computed: list[dict], hop_rtol: float = 0.0) -> list[str]:
     """One line per sample row whose computed status, pull-off or crack speed differs from
-    the recorded one beyond the tolerances."""
-    lines = []
+    the recorded one beyond the tolerances: the pull-off within PULL_OFF_RTOL, except at
+    most a quarter of the rows (HOP_FRACTION) within ``hop_rtol`` (the numerics'
+    ``prony_rtol``: another processor's BLAS fits another valid Prony series, or pins the
+    crack tip at a neighbouring node; module docstring); the crack speed within
+    CRACK_SPEED_RTOL."""
+    lines, hops = [], []
     for rec, now in zip(recorded, computed):
         what = []
         if rec["status"] != now["status"]:
             what.append(f"status {now['status']} (committed {rec['status']})")
         elif rec["status"] == "ok":
-            if _rel(now["pull_off"], rec["pull_off"]) > PULL_OFF_RTOL:
-                what.append(f"pull-off {now['pull_off']:.8g} (committed {rec['pull_off']:.8g})")
+            rel = _rel(now["pull_off"], rec["pull_off"])
+            if rel > PULL_OFF_RTOL:
+                text = f"pull-off {now['pull_off']:.8g} (committed {rec['pull_off']:.8g})"
+                if rel <= hop_rtol:
+                    hops.append(f"{rec['scene']}: {text}, within {hop_rtol:g}")
+                else:
+                    what.append(text)
             if _rel(now["crack_speed"], rec["crack_speed"]) > CRACK_SPEED_RTOL:
                 what.append(f"crack speed {now['crack_speed']:.6g} (committed "
                             f"{rec['crack_speed']:.6g})")
         if what:
             lines.append(f"{rec['scene']}: {', '.join(what)}")
+    if len(hops) > HOP_FRACTION * len(recorded):
+        lines += hops
     return lines
 
 

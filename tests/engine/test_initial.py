@@ -54,15 +54,24 @@ def test_the_walk_reaches_an_equilibrium_of_radius_a0_in_few_solves(monkeypatch)
     assert abs(el.radius(h) - SCENE.a0) <= spacing
 
 
+#: the walks' solves allowed in the test below, far fewer than the start's walks take: 24 in
+#: ten walks with OpenBLAS's Haswell kernels, 29 with its Sandybridge kernels (another
+#: machine's last bits), the first walk alone 9 on both. Allowing 20, as the test did, left
+#: it to the last bits whether the walk that crossed the limit was the start's last: with
+#: the Sandybridge kernels the start succeeded and the test failed.
+FEW_SOLVES = 3
+
+
 def test_a_relaxed_start_stops_after_walk_max_solves(monkeypatch):
     # with too few solves allowed the same start fails, in a bounded number of solves (the
     # direct solves of the root find and of the walks' starting points, and the walks'
     # WALK_MAX_SOLVES), saying why
     el, _, counts = _counted_solver(monkeypatch)
-    monkeypatch.setattr(initial, "WALK_MAX_SOLVES", 20)
-    with pytest.raises(RuntimeError, match=r"the continuation stopped after 20 solves"):
+    monkeypatch.setattr(initial, "WALK_MAX_SOLVES", FEW_SOLVES)
+    with pytest.raises(RuntimeError,
+                       match=rf"the continuation stopped after {FEW_SOLVES} solves"):
         initial._solve_relaxed(el, a0=SCENE.a0)
-    assert counts["solves"] <= 20 + 60 + 2 * 9
+    assert counts["solves"] <= FEW_SOLVES + 60 + 2 * 9
 
 
 def test_the_walk_holds_the_estimates_half_resolution_start_and_the_estimate_covers():
