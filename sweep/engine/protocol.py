@@ -295,7 +295,7 @@ class _March:
             failed = (float(clock[CLOCK_GUESS]), out.starts if clock[CLOCK_MADE] else None)
         return outcome, float(clock[CLOCK_DT]), failed
 
-    def compiled_march(self, protocol: Protocol, dd, speed, dd_max, da_max):
+    def compiled_approach(self, protocol: Protocol, dd, speed, dd_max, da_max):
         """At most DWELL_CHUNK_STEPS tries of the approach's steps from the indentation step
         ``dd`` by the compiled march (:func:`sweep.kernels.protocol.approach_steps`: what
         :func:`_approach` does with :func:`_trial`, to the last bit): (outcome, the next
@@ -400,7 +400,7 @@ def _approach(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     the preload; the step that passes it is cut to end there. The first step is the one
     halving would give, found from below (:func:`_first_step`).
 
-    The steps after the first are taken by the compiled march (:meth:`_March.compiled_march`),
+    The steps after the first are taken by the compiled march (:meth:`_March.compiled_approach`),
     which returns every DWELL_CHUNK_STEPS tries for the time budget and hands over the step
     whose load passed the preload (cut here) and the smallest step whose solve failed (its
     fold relaxed here); ``compiled`` False takes every step in Python (:func:`_trial`), the
@@ -416,8 +416,8 @@ def _approach(m: _March, protocol: Protocol, compiled: bool = True) -> None:
         if dd is None:
             dd, solved, moved = _first_step(m, speed, dd_max, da_max)
         elif compiled:
-            outcome, dd, handed = m.compiled_march(protocol, dd, speed=speed, dd_max=dd_max,
-                                                   da_max=da_max)
+            outcome, dd, handed = m.compiled_approach(protocol, dd, speed=speed,
+                                                      dd_max=dd_max, da_max=da_max)
             if handed is None:
                 continue
             solved, moved = handed

@@ -93,14 +93,9 @@ def test_the_walk_holds_the_estimates_half_resolution_start_and_the_estimate_cov
     assert res.error_estimate >= true, (res.error_estimate, true)
 
 
-def test_a_relaxed_start_whose_radius_jumps_past_a0_is_refused(monkeypatch):
-    """The root find in the indentation ends on a bracket shrunk to nothing: where the
-    radius jumps past a0 there (a fold of the walk's discrete branch), the start is refused
-    with the reason, not returned at another radius (a seed-11 scene at a0 0.571 had started
-    at 0.806, its row ok and 29 % off). Here the radius is made to jump by hand: every state
-    reads 0.3 below a0 up to an indentation, 0.3 above it beyond."""
-    el, _, _ = _counted_solver(monkeypatch)
-    d_jump = SCENE.a0 ** 2 - (2.0 * SCENE.a0) ** 0.5 + 0.05   # near the JKR indentation
+def _note_indentations(el) -> dict:
+    """``el.solve`` made to note the indentation of each gap it returns: {id(gap): delta}
+    (for a radius made by hand from it)."""
     states = {}
     solve = el.solve
 
@@ -110,6 +105,18 @@ def test_a_relaxed_start_whose_radius_jumps_past_a0_is_refused(monkeypatch):
         return ok, h
 
     el.solve = solve_noting
+    return states
+
+
+def test_a_relaxed_start_whose_radius_jumps_past_a0_is_refused(monkeypatch):
+    """The root find in the indentation ends on a bracket shrunk to nothing: where the
+    radius jumps past a0 there (a fold of the walk's discrete branch), the start is refused
+    with the reason, not returned at another radius (a seed-11 scene at a0 0.571 had started
+    at 0.806, its row ok and 29 % off). Here the radius is made to jump by hand: every state
+    reads 0.3 below a0 up to an indentation, 0.3 above it beyond."""
+    el, _, _ = _counted_solver(monkeypatch)
+    d_jump = SCENE.a0 ** 2 - (2.0 * SCENE.a0) ** 0.5 + 0.05   # near the JKR indentation
+    states = _note_indentations(el)
     el.radius = lambda h, *a: SCENE.a0 + (0.3 if states.get(id(h), 0.0) > d_jump else -0.3)
     with pytest.raises(RuntimeError, match=r"no relaxed state of contact radius a0=2 on this "
                                            r"mesh: the radius jumps past it"):
@@ -132,19 +139,12 @@ def test_a_bracket_that_ends_on_a_step_returns_its_end_within_the_tolerance(monk
     spacing = initial._spacing_at(pb.mesh.r, SCENE.a0)
     assert max(-below, above) > initial.RADIUS_JUMP_SPACINGS    # one end off the tolerance
     d_jump = SCENE.a0 ** 2 - (2.0 * SCENE.a0) ** 0.5 + 0.05
-    states = {}
-    solve = el.solve
-
-    def solve_noting(delta, guess):
-        ok, h = solve(delta, guess)
-        states[id(h)] = delta
-        return ok, h
+    states = _note_indentations(el)
 
     def radius(h, *a):
         delta = states.get(id(h), 0.0)
         return SCENE.a0 + spacing * (above if delta > d_jump else below) + (delta - d_jump)
 
-    el.solve = solve_noting
     el.radius = radius
     h, delta = initial._solve_relaxed(el, a0=SCENE.a0)
     near = below if -below < above else above
