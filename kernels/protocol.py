@@ -213,10 +213,11 @@ RECENT_DWELL = 2
 #: step that moved the radius by less than grow_below da_max; tip_nodes, tip_iter the settle
 #: at the crack tip (:func:`kernels.solve.settle_tip`); max_iter Newton's iterations;
 #: max_steps the tries of one call; zone_bound the most traction a process zone may add at an
-#: opening node, zone_qs its smoothing rate (:func:`kernels.interface.zone_factor`)
+#: opening node, zone_qs its smoothing rate (:func:`kernels.interface.zone_factor`); origin
+#: the origin of the predictors' clock (:func:`dwell_clock`)
 DwellControl = namedtuple("DwellControl", [
     "hm", "hold_force", "force", "tols", "end", "da_max", "dt_min", "growth", "grow_below",
-    "tip_nodes", "tip_iter", "max_iter", "max_steps", "zone_bound", "zone_qs"])
+    "tip_nodes", "tip_iter", "max_iter", "max_steps", "zone_bound", "zone_qs", "origin"])
 #: the march's state, in/out: the gaps h, h_prev, h_prev2 (N,) of the last three states, the
 #: Prony modes q (M, N), the traction sigma (N,) of h, the tip predictor's ring past (K, N)
 #: with its times and contact radii past_ta (2, K), clock (CLOCK_SIZE,) and recent (3, 3)
@@ -229,21 +230,56 @@ DwellOut = namedtuple("DwellOut", ["records", "starts", "h", "sigma"])
 
 
 @njit(cache=True, inline='always')
-def held_guess(recent, x):
+def dwell_clock(t, origin):
+    """The dwell's clock of the predictors at time ``t``: log(t - ``origin``), ``origin`` a
+    little before the dwell's start (``sweep.engine.protocol.DWELL_LOG_SHIFT``). A contact held
+    at a load or a depth creeps or relaxes as the material's compliance or modulus does, about
+    as a power of the time since the hold began: smooth in its logarithm, over the dwell's
+    steps that grow geometrically (DWELL_GROWTH), where a polynomial in t is not."""
+    return np.log(t - origin)
+
+
+@njit(cache=True, inline='always')
+def predictor_steps(t, dt, dt_prev, dt_prev2, origin):
+    """The three time steps the quadratic predictor (:func:`kernels.solve.predict`) takes for
+    the step ``dt`` from the state at ``t`` (the last two steps ``dt_prev``, ``dt_prev2``):
+    the steps themselves, or where ``origin`` lies before the oldest of the three states (a
+    dwell's, :func:`dwell_clock`; nan: never), their lengths on the dwell's clock. A step
+    that does not exist (0) stays 0."""
+    if not origin < t - dt_prev - dt_prev2:
+        return dt, dt_prev, dt_prev2
+    now = dwell_clock(t, origin)
+    x = dwell_clock(t + dt, origin) - now
+    x_prev, x_prev2 = 0.0, 0.0
+    if dt_prev > 0.0:
+        before = dwell_clock(t - dt_prev, origin)
+        x_prev = now - before
+        if dt_prev2 > 0.0:
+            x_prev2 = before - dwell_clock(t - dt_prev - dt_prev2, origin)
+    return x, x_prev, x_prev2
+
+
+@njit(cache=True)
+def held_guess(recent, x, origin):
     """The indentation the dwell at force is expected at at time ``x``: the Lagrange
     extrapolation through the newest k records of ``recent``, k = 1 + the dwell's among the
-    newest two (constant, then linear, then quadratic; the same arithmetic, in the same order,
-    as ``sweep.engine.protocol._held_guess``)."""
+    newest two (constant, then linear, then quadratic), in the dwell's clock
+    (:func:`dwell_clock`) where ``origin`` lies before the oldest of them, else in time (the
+    Python march, ``sweep.engine.protocol._held_guess``, calls this too)."""
     k = 1
     while k < 3 and recent[RECENT_DWELL, 3 - k] == 1.0:
         k += 1
+    clock = np.empty(k + 1)
+    logs = origin < recent[RECENT_T, 3 - k]
+    for j in range(k + 1):
+        t = x if j == 0 else recent[RECENT_T, 3 - j]
+        clock[j] = dwell_clock(t, origin) if logs else t
     guess = 0.0
     for j in range(1, k + 1):
         weight = 1.0
         for i in range(1, k + 1):
             if i != j:
-                weight *= (x - recent[RECENT_T, 3 - i]) / (recent[RECENT_T, 3 - j]
-                                                          - recent[RECENT_T, 3 - i])
+                weight *= (clock[0] - clock[i]) / (clock[j] - clock[i])
         guess += weight * recent[RECENT_DELTA, 3 - j]
     return guess
 
@@ -280,10 +316,11 @@ def dwell_steps(mesh, physics, law, control, state, out, cache, stats):
             return DWELL_ENDED, n
         dt = min(clock[CLOCK_DT], control.end - t)
         smallest = dt <= control.dt_min
-        delta = held_guess(state.recent, t + dt) if control.hold_force else clock[CLOCK_DELTA]
+        delta = (held_guess(state.recent, t + dt, control.origin) if control.hold_force
+                 else clock[CLOCK_DELTA])
         clock[CLOCK_DT], clock[CLOCK_GUESS] = dt, delta
         ceff = _step_start(mesh, physics, law, control, state, out.starts, dt, delta,
-                           (e, b, H, g, hs))
+                           (e, b, H, g, hs), control.origin)
         if control.hold_force:
             ok, shift = newton_at_load(hs, g, mesh.A, mesh.wP, ceff, H, law, control.force,
                                        control.tols, control.max_iter, cache, stats)
@@ -313,12 +350,13 @@ def dwell_steps(mesh, physics, law, control, state, out, cache, stats):
 
 
 @njit(cache=True, inline='always')
-def _step_start(mesh, physics, law, control, state, starts, dt, delta, work):
+def _step_start(mesh, physics, law, control, state, starts, dt, delta, work, origin):
     """The step's equation (``_March._equation``; ``work`` = (e, b, H, g, hs): the Prony
     coefficients into ``e``, ``b``, the history into ``H``, the gap of the indentation
     ``delta`` into ``g``; returns C_eff) and Newton's start into ``hs`` (``_March._start``:
-    the quadratic extrapolation, or the tip predictor's where made and its score says so, the
-    two in ``starts``; CLOCK_MADE), settled at the last crack tip (``_March._settle``)."""
+    the quadratic extrapolation, on the dwell's clock from ``origin`` (:func:`predictor_steps`;
+    nan: in time), or the tip predictor's where made and its score says so, the two in
+    ``starts``; CLOCK_MADE), settled at the last crack tip (``_March._settle``)."""
     e, b, H, g, hs = work
     clock, r, N = state.clock, mesh.r, hs.size
     ceff = step_coefficients(physics.weights, physics.times, dt, e, b)
@@ -326,8 +364,9 @@ def _step_start(mesh, physics, law, control, state, starts, dt, delta, work):
     c0 = -delta + law.h0
     for i in range(N):
         g[i] = c0 + 0.5 * r[i] ** 2
-    predict(state.h, state.h_prev, state.h_prev2, dt, clock[CLOCK_DT_PREV],
-            clock[CLOCK_DT_PREV2], starts[0])
+    x, x_prev, x_prev2 = predictor_steps(clock[CLOCK_T], dt, clock[CLOCK_DT_PREV],
+                                         clock[CLOCK_DT_PREV2], origin)
+    predict(state.h, state.h_prev, state.h_prev2, x, x_prev, x_prev2, starts[0])
     for i in range(N):
         starts[1, i] = starts[0, i]
     made = predict_lattice(r, state.h, state.past, state.past_ta, int(clock[CLOCK_RING]), dt,
@@ -449,7 +488,7 @@ def approach_steps(mesh, physics, law, control, state, out, cache, stats):
         delta, dt = clock[CLOCK_DELTA] + dd, dd / control.speed
         clock[CLOCK_GUESS] = delta
         ceff = _step_start(mesh, physics, law, control, state, out.starts, dt, delta,
-                           (e, b, H, g, hs))
+                           (e, b, H, g, hs), np.nan)
         factorize_ahead(hs, mesh.A, ceff, law, control.ahead_nodes, control.ahead_least,
                         cache, stats)
         ok = newton(hs, g, mesh.A, ceff, H, law, control.tol,

@@ -49,8 +49,9 @@ from ..kernels.protocol import (CLOCK_A, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, C
                                 CLOCK_GUESS, CLOCK_MADE, CLOCK_RING, CLOCK_SIZE, CLOCK_T,
                                 CLOCK_P, CLOCK_PHASE, CLOCK_TIP_SCORE, APPROACH_PASSED,
                                 DWELL_FAILED, DWELL_OPENED, ApproachControl, DwellControl,
-                                DwellOut, MarchState, approach_steps, dwell_steps,
-                                factorize_ahead, newton_at_load)
+                                DwellOut, MarchState, RECENT_DELTA, RECENT_DWELL, RECENT_T,
+                                approach_steps, dwell_steps, factorize_ahead, held_guess,
+                                newton_at_load, predictor_steps)
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
                              MeshArrays, Physics, invalidate, load, new_jacobian_cache, newton,
                              predict, predict_lattice, relax, score_starts, settle_tip)
@@ -72,6 +73,17 @@ DWELL_GROW_BELOW = 0.5
 #: ... starting no smaller than this fraction of the dwell, and halved no further than this one
 DWELL_FIRST = 1e-4
 DWELL_MIN_STEP = 1e-9
+#: the dwell's predictors (the indentation held at force, Newton's start) extrapolate in
+#: log(t - t_start + DWELL_LOG_SHIFT dwell) rather than in t
+#: (:func:`sweep.kernels.protocol.dwell_clock`): the held contact creeps or relaxes about as a
+#: power of the time since the hold began. Measured on the dwells at force of ``make
+#: protocol-cost`` (the Python march, an instrumented Newton): the start's residual 150-230
+#: -> 50-190 tolerances (median over the steps), Newton iterations a step 2.25 / 4.63 / 2.29
+#: -> 1.75 / 3.66 / 1.80 on the three bench scenes and 3.17 / 3.08 -> 2.45 / 2.31 on the MPL
+#: and SLS scenes at mu 5, the pull-offs within 2e-7; 1e-4 and 1e-5 did as well but on the
+#: rate-1e4 bench scene (1.99 and 2.01, with steps of 10-37 iterations); the indentation's
+#: guess alone on that clock 2.15 / 3.63 / 2.20, Newton's start alone no fewer
+DWELL_LOG_SHIFT = 1e-3
 #: the compiled dwell (:meth:`_March.compiled_dwell`) returns to Python, which checks the time
 #: budget, after this many tries (a few milliseconds)
 DWELL_CHUNK_STEPS = 32
@@ -145,6 +157,7 @@ class _March:
         self.h_prev, self.dt_prev = h.copy(), 0.0
         self.h_prev2, self.dt_prev2 = h.copy(), 0.0
         self.hold_slope = None      # dP/d delta of the last step held at force
+        self.clock_origin = np.nan  # the dwell's predictors' clock (kernels.protocol.dwell_clock)
         self.advancing = False      # the crack tip advances: the approach
         self.law = lennard_jones(pb.h0, pb.c, N)
         self.cache, self.stats = new_jacobian_cache(N), stats
@@ -164,6 +177,15 @@ class _March:
         k = self.past_count % LATTICE_HISTORY       # the tip predictor's ring
         self.past[k], self.past_ta[:, k] = self.h, (self.t, self.records["a"][-1])
         self.past_count += 1
+
+    def recent(self):
+        """The last three records' times, indentations and whether each was the dwell's, the
+        newest last: the compiled march's ``recent`` (kernels.protocol.RECENT_*)."""
+        rec, recent = self.records, np.zeros((3, 3))
+        for j in range(1, min(3, len(rec["t"])) + 1):
+            recent[[RECENT_T, RECENT_DELTA, RECENT_DWELL], 3 - j] = (
+                rec["t"][-j], rec["delta"][-j], float(rec["phase"][-j] == PHASES["dwell"]))
+        return recent
 
     @property
     def load(self) -> float:
@@ -243,7 +265,8 @@ class _March:
         """Newton's start for the step ``dt`` and the two starts, quadratic and tip
         predictor's (None where the tip predictor made none)."""
         starts = np.empty((2, self.h.size))
-        predict(self.h, self.h_prev, self.h_prev2, dt, self.dt_prev, self.dt_prev2, starts[0])
+        steps = predictor_steps(self.t, dt, self.dt_prev, self.dt_prev2, self.clock_origin)
+        predict(self.h, self.h_prev, self.h_prev2, *steps, starts[0])
         starts[1] = starts[0]
         if not predict_lattice(self.pb.mesh.r, self.h, self.past, self.past_ta,
                                self.past_count, dt, starts[1]):
@@ -288,7 +311,7 @@ class _March:
             pb.hm, protocol.hold != "depth", float(protocol.preload),
             np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * protocol.preload]), float(end),
             float(da_max), float(dt_min), DWELL_GROWTH, DWELL_GROW_BELOW, TIP_NODES, TIP_ITER,
-            MAX_ITER, DWELL_CHUNK_STEPS, *self._zone_bound())
+            MAX_ITER, DWELL_CHUNK_STEPS, *self._zone_bound(), self.clock_origin)
         outcome, clock, out = self._compiled(dwell_steps, control, dt, PHASES["dwell"])
         failed = None
         if outcome == DWELL_FAILED:
@@ -343,12 +366,8 @@ class _March:
                CLOCK_RING, CLOCK_A, CLOCK_P, CLOCK_PHASE]] = (
             self.t, self.delta, step, self.dt_prev, self.dt_prev2, self.tip_score,
             self.past_count, rec["a"][-1], rec["P"][-1], float(phase == PHASES["dwell"]))
-        recent = np.zeros((3, 3))               # the last three records (the newest last)
-        for j in range(1, min(3, len(rec["t"])) + 1):
-            recent[:, 3 - j] = (rec["t"][-j], rec["delta"][-j],
-                                float(rec["phase"][-j] == PHASES["dwell"]))
         state = MarchState(self.h, self.h_prev, self.h_prev2, self.q, self.sigma, self.past,
-                           self.past_ta, clock, recent)
+                           self.past_ta, clock, self.recent())
         out = DwellOut(np.empty((5, DWELL_CHUNK_STEPS)), np.empty((2, N)), np.empty(N),
                        np.empty(N))
         outcome, n = kernel(MeshArrays(pb.A, pb.mesh.r, pb.wP),
@@ -504,6 +523,7 @@ def _dwell(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     dt_min = DWELL_MIN_STEP * protocol.dwell
     dt = max(m.dt_prev, DWELL_FIRST * protocol.dwell)
     end = m.t + protocol.dwell
+    m.clock_origin = m.t - DWELL_LOG_SHIFT * protocol.dwell
     while m.t < end * (1.0 - 1e-12):
         budget.check("the dwell")
         if not compiled:
@@ -599,20 +619,10 @@ def _solve_near(m: _March, delta, dt, fold, near):
 
 def _held_guess(m: _March, dt) -> float:
     """The indentation the dwell at force is expected at after the step ``dt``: the
-    quadratic extrapolation in time through its last three states (the dwell's start among
-    them; linear through two, the last indentation at the dwell's first step)."""
-    t, d, phase = m.records["t"], m.records["delta"], m.records["phase"]
-    k = 1
-    while k < 3 and phase[-k] == PHASES["dwell"]:
-        k += 1
-    x, guess = t[-1] + dt, 0.0
-    for j in range(1, k + 1):
-        weight = 1.0
-        for i in range(1, k + 1):
-            if i != j:
-                weight *= (x - t[-i]) / (t[-j] - t[-i])
-        guess += weight * d[-j]
-    return guess
+    quadratic extrapolation on the dwell's clock through its last three states (the dwell's
+    start among them; linear through two, the last indentation at the dwell's first step):
+    :func:`sweep.kernels.protocol.held_guess`, which the compiled dwell calls."""
+    return float(held_guess(m.recent(), m.t + dt, m.clock_origin))
 
 
 def first_contact(pb, stats):

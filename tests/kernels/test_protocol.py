@@ -4,7 +4,9 @@ found, carry the load asked for, and be the state the ordinary Newton solve find
 indentation. Newton's start settled at the crack tip (settle_tip): the residual there falls,
 no other node moves. A factorization with its crack-tip zone ahead of the tip
 (factorize_ahead): placed where asked, the rest of it the ordinary one's, kept while the tip
-lies far enough inside the zone, and Newton with it finds the ordinary solve's state."""
+lies far enough inside the zone, and Newton with it finds the ordinary solve's state. The
+dwell's predictors on the clock log(t - origin) (predictor_steps, held_guess): exact for a
+quadratic in that clock, and the plain extrapolation in time without an origin."""
 import numpy as np
 import pytest
 
@@ -14,8 +16,9 @@ from sweep.engine.problem import lj_constants
 from sweep.kernels import solve as ks
 from sweep.kernels.interface import lennard_jones, lj_traction_and_stiffness
 from sweep.kernels import jacobian as jac
-from sweep.kernels.protocol import factorize_ahead, newton_at_load
-from sweep.kernels.solve import settle_tip
+from sweep.kernels.protocol import (RECENT_DELTA, RECENT_DWELL, RECENT_T, factorize_ahead,
+                                    held_guess, newton_at_load, predictor_steps)
+from sweep.kernels.solve import predict, settle_tip
 
 N = 120
 TOL = 1e-10        # units of h0
@@ -119,3 +122,61 @@ def test_the_zone_ahead_of_the_tip_is_placed_there_and_newton_finds_the_same_sta
     assert ks.newton(h_plain, g, A, ceff, H, law, TOL * h0, 40, ks.new_jacobian_cache(N),
                      np.zeros(ks.N_STATS, np.int64))
     assert np.max(np.abs(h - h_plain)) <= 1e-6 * h0
+
+
+#: three states of a dwell and the step to take: times since its start (the dwell's steps
+#: grow geometrically), the clock's origin a little before the start
+DWELL_TIMES = np.array([2.0, 2.0 + 0.013, 2.0 + 0.013 + 0.0169])
+DWELL_STEP = 0.022
+ORIGIN = 2.0 - 1e-3
+
+
+def _quadratic_in(clock, coefficients):
+    a, b, c = coefficients
+    return a + b * clock + c * clock ** 2
+
+
+@pytest.mark.parametrize("origin", [ORIGIN, np.nan], ids=["dwell clock", "time"])
+def test_the_predictor_is_exact_for_a_quadratic_on_its_clock(origin):
+    """predict with predictor_steps' steps extrapolates a gap quadratic in log(t - origin)
+    exactly (in t where the origin is nan): a closed form, to rounding (gaps that stay above
+    the predictor's floor, half the last one)."""
+    t2, t1, t0 = DWELL_TIMES               # oldest, previous, newest
+    clock = (lambda t: np.log(t - origin)) if np.isfinite(origin) else (lambda t: t)
+    coefficients = (np.array([1.0, 0.7, 0.5]), np.array([0.03, -0.01, 0.02]),
+                    np.array([0.002, 0.001, -0.003]))
+    h = [_quadratic_in(clock(t), coefficients) for t in (t0, t1, t2, t0 + DWELL_STEP)]
+    steps = predictor_steps(t0, DWELL_STEP, t0 - t1, t1 - t2, origin)
+    if np.isnan(origin):
+        assert steps == (DWELL_STEP, t0 - t1, t1 - t2)
+    out = np.empty(3)
+    assert predict(h[0], h[1], h[2], *steps, out)
+    np.testing.assert_allclose(out, h[3], rtol=1e-10)
+
+
+def test_the_predictor_keeps_time_where_the_origin_is_after_a_state():
+    """A state older than the origin (the approach's, before the dwell) leaves the steps in
+    time."""
+    t0 = DWELL_TIMES[2]
+    assert predictor_steps(t0, DWELL_STEP, 0.5, 0.5, ORIGIN) == (DWELL_STEP, 0.5, 0.5)
+
+
+@pytest.mark.parametrize("origin", [ORIGIN, np.nan], ids=["dwell clock", "time"])
+def test_the_held_indentation_is_exact_for_a_quadratic_on_its_clock(origin):
+    """held_guess through the dwell's last three records extrapolates an indentation
+    quadratic in log(t - origin) exactly (in t where the origin is nan); through two, the
+    line on that clock."""
+    clock = (lambda t: np.log(t - origin)) if np.isfinite(origin) else (lambda t: t)
+    coefficients = (1.3, 0.04, -0.002)
+    recent = np.zeros((3, 3))
+    recent[RECENT_T] = DWELL_TIMES
+    recent[RECENT_DELTA] = [_quadratic_in(clock(t), coefficients) for t in DWELL_TIMES]
+    recent[RECENT_DWELL] = [0.0, 1.0, 1.0]          # the dwell's start, then two of its steps
+    x = DWELL_TIMES[2] + DWELL_STEP
+    assert held_guess(recent, x, origin) == pytest.approx(_quadratic_in(clock(x), coefficients),
+                                                          rel=1e-12)
+    recent[RECENT_DWELL, 1] = 0.0                   # one step into the dwell: the line
+    line = (coefficients[0], coefficients[1], 0.0)
+    recent[RECENT_DELTA] = [_quadratic_in(clock(t), line) for t in DWELL_TIMES]
+    assert held_guess(recent, x, origin) == pytest.approx(_quadratic_in(clock(x), line),
+                                                          rel=1e-12)
