@@ -82,9 +82,22 @@ PDMS_CASE = {
 #: the experiment as the paper ran it (its section "Experimental adhesion tests": loading to the
 #: preload, a 60 s dwell, unloading): the approach speed, not in the paper ("gradually
 #: loaded"), is its slowest measured speed rounded, 1 um/s; run with the BEM's numerics
-#: preset (sweep.paper.pdms_protocol, make pdms-protocol)
+#: preset, a run whose error estimate exceeds the preset's tolerance refined and solved again
+#: up to ``refinements`` times (sweep.paper.pdms_protocol, make pdms-protocol; without them
+#: mu 5 at 1 um/s ended unresolved, relaxed and as run: its crossing check's quarter-resolution
+#: solve 5.6 % off, refined once to band resolution 30, estimate 5e-4)
 PDMS_PROTOCOL = {"approach_speed_um_s": 1.0, "dwell_s": 60.0, "dwell_hold": "force",
-                 "preset": "balanced"}
+                 "preset": "balanced", "refinements": 2}
+#: the keys of PDMS_PROTOCOL that choose the numerics, not the test
+PROTOCOL_NUMERICS = ("preset", "refinements")
+
+
+def protocol_key() -> dict:
+    """What a protocol curve (results/pdms/protocol.json) was made for: the case, the test
+    and the numerics; a file made for another is made again (:func:`load_protocol`)."""
+    return {"case": json.loads(json.dumps(dict(PDMS_CASE))),
+            "protocol": {k: v for k, v in PDMS_PROTOCOL.items() if k not in PROTOCOL_NUMERICS},
+            **{k: PDMS_PROTOCOL[k] for k in PROTOCOL_NUMERICS}}
 
 #: Integrator tolerance of the crack-front runs: at 1e-6 um/s the pull-off is 1.5 (1 + 9e-6),
 #: so the default 1e-8 (error ~5e-6 there) would blur the monotonic growth.
@@ -895,17 +908,16 @@ def _bulk_and_process_zone_lines(res: dict) -> list[str]:
 
 
 def load_protocol(path) -> dict | None:
-    """The experiment as run (:func:`sweep.paper.pdms_protocol.protocol_curve`) kept in ``path``, or None where there is none or it was made for
-    another case, protocol or preset (said on stdout: ``make pdms-protocol`` makes it again)."""
+    """The experiment as run (:func:`sweep.paper.pdms_protocol.protocol_curve`) kept in ``path``,
+    or None where there is none or it was made for another case, protocol or numerics
+    (:func:`protocol_key`; said on stdout, the file left as it is: ``make pdms-protocol`` makes
+    it again)."""
     path = Path(path)
     if not path.is_file():
         return None
     data = json.loads(path.read_text())
-    key = {"case": json.loads(json.dumps(dict(PDMS_CASE))),
-           "protocol": {k: v for k, v in PDMS_PROTOCOL.items() if k != "preset"},
-           "preset": PDMS_PROTOCOL["preset"]}
-    if any(data.get(k) != v for k, v in key.items()):
-        print(f"{path}: made for another case, protocol or preset; ignored (make pdms-protocol)")
+    if any(data.get(k) != v for k, v in protocol_key().items()):
+        print(f"{path}: made for another case, protocol or numerics; ignored (make pdms-protocol)")
         return None
     return data
 
@@ -954,6 +966,13 @@ def protocol_lines(data: dict | None, crack_pb_mN: dict | None = None) -> list[s
                  + ("--" if relaxed is None else f"{relaxed:.4f}") + " | "
                  + ("--" if relaxed is None or top["ratio_same_radius"] is None
                     else f"{relaxed * top['ratio_same_radius']:.4f}") + " |")
+    labels = {"relaxed": "relaxed at the JKR radius", "relaxed_same_radius":
+              "relaxed at the same radius", "protocol": "as run"}
+    failed = [f"* mu {m:g}, {v:g} um/s, {label}: {p[name]['reason'].split(';')[0]}"
+              for (m, v), p in sorted(pts.items()) for name, label in labels.items()
+              if name in p and p[name]["status"] != "ok"]
+    if failed:
+        L += ["", "-- : a run that did not end ok (said as it is):", ""] + failed
     history = max(abs(p["ratio_same_radius"] - 1.0) for p in pts.values()
                   if p["ratio_same_radius"] is not None)
     today = max(abs(p["ratio"] - 1.0) for p in pts.values() if p["ratio"] is not None)

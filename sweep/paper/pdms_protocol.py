@@ -36,24 +36,26 @@ import time
 from pathlib import Path
 
 from ..scene import Numerics
-from .pdms import PDMS_CASE, PDMS_PROTOCOL, bem_case, pdms_scene
+from .pdms import (PDMS_CASE, PDMS_PROTOCOL, PROTOCOL_NUMERICS, bem_case, pdms_scene,
+                   protocol_key)
 
-PROTOCOL = {k: v for k, v in PDMS_PROTOCOL.items() if k != "preset"}
+PROTOCOL = {k: v for k, v in PDMS_PROTOCOL.items() if k not in PROTOCOL_NUMERICS}
 PRESET = PDMS_PROTOCOL["preset"]
+REFINEMENTS = PDMS_PROTOCOL["refinements"]
 
 #: the Tabor parameters the BEM runs the PDMS at (h0 scaled; sweep.paper.pdms.bem_case)
 MUS = (3.0, 5.0, 8.0)
 #: the paper's unloading speeds (um/s)
 SPEEDS_UM_S = (1.0, 10.0, 100.0, 1.0e3, 1.0e4)
-#: the numerics: the preset of PDMS_PROTOCOL, its node cap raised so that mu = 8's protocol
-#: mesh fits
+#: the numerics: the preset of PDMS_PROTOCOL with its refinements, the node cap raised so that
+#: mu = 8's protocol mesh fits
 MAX_NODES = 1400
 #: (mu, unloading speed um/s, approach speed um/s): the approach ten times faster
 APPROACH_CHECK = (5.0, 1.0e4, 10.0)
 
 
 def _numerics() -> Numerics:
-    return Numerics.preset(PRESET, max_nodes=MAX_NODES)
+    return Numerics.preset(PRESET, max_nodes=MAX_NODES, refinements=REFINEMENTS)
 
 
 def _row(res, si, wall) -> dict:
@@ -141,8 +143,7 @@ def protocol_curve(path, mus=MUS, speeds=SPEEDS_UM_S, log=print) -> dict:
         the largest mu.
     """
     path = Path(path)
-    key = {"case": json.loads(json.dumps(dict(PDMS_CASE))), "protocol": dict(PROTOCOL),
-           "preset": PRESET}
+    key = protocol_key()
     data = {**key, "points": [], "approach_check": None}
     if path.is_file():
         old = json.loads(path.read_text())
