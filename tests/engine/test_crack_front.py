@@ -170,3 +170,38 @@ def test_a_frozen_contact_opens_within_the_time_span():
     res = simulate_crack(Scene(n=3.55, k=0.000302, mu=13.72, a0=0.911, rate=1.44e9))
     assert res.ok, res.reason
     assert 1.5 < res.pull_off < 2 / 0.000302
+
+
+@pytest.mark.parametrize("rate", [1e-2, 1.0, 1e4])
+def test_radau_on_lapack_directly_is_radau_on_scipy_linalg(monkeypatch, rate):
+    """unload gives Radau LAPACK's getrf/getrs directly (crack_front._lapack_lu,
+    _lapack_solve), as scipy.linalg.lu_factor and lu_solve call them, without their per-call
+    overhead: the same solution to the last bit (the same routines on the same numbers)."""
+    from scipy.linalg import lu_factor, lu_solve
+
+    from sweep.engine import crack_front
+
+    law = pb_law_for_scene(0.3, 1e-3, 50.0)
+    fast = unload(law, rate=rate, mu=50.0, a0=1.75)
+    monkeypatch.setattr(crack_front, "_lapack_lu", lambda A: lu_factor(A, overwrite_a=True))
+    monkeypatch.setattr(crack_front, "_lapack_solve",
+                        lambda factors, b: lu_solve(factors, b, overwrite_b=True))
+    plain = unload(law, rate=rate, mu=50.0, a0=1.75)
+    assert fast.ok and plain.ok
+    assert fast.pull_off == plain.pull_off and fast.crack_speed == plain.crack_speed
+    np.testing.assert_array_equal(fast.trajectory["a"], plain.trajectory["a"])
+
+
+def test_the_lapack_lu_refuses_what_scipy_refuses():
+    """A non-finite matrix or right-hand side raises scipy's ValueError (the integrator
+    reports it as its failure), and the solve is the 1 x 1 system's (real and complex)."""
+    from sweep.engine.crack_front import _lapack_lu, _lapack_solve
+
+    with pytest.raises(ValueError, match="infs or NaNs"):
+        _lapack_lu(np.array([[np.inf]]))
+    factors = _lapack_lu(np.array([[4.0]]))
+    with pytest.raises(ValueError, match="infs or NaNs"):
+        _lapack_solve(factors, np.array([np.nan]))
+    assert _lapack_solve(factors, np.array([2.0]))[0] == 0.5
+    z = _lapack_solve(_lapack_lu(np.array([[2.0 + 2.0j]])), np.array([4.0 + 0.0j]))
+    assert z[0] == pytest.approx(1.0 - 1.0j, rel=1e-15)
