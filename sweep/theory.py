@@ -37,6 +37,7 @@ between 1 and 2, so it converges in a few steps.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -108,20 +109,70 @@ def _kernel_w(s):
 def _mpl_integrals(n: float, c: np.ndarray):
     """I(c), J(c) = 1 - I(c) and c dJ/dc for the Gamma(n) spectrum; c is a 1-D array > 0.
 
-    Each node costs one incomplete gamma function: ``Q(n, x)`` above ``max(1, n)``, ``P(n, x)``
-    at or below it, the other as its complement (what scipy's own ``gammainc`` does above
-    that point, so ``J`` there is the same number; below it ``Q = 1 - P >= Q(n, max(1, n))``
-    loses nothing that counts). Beyond ``x =`` :data:`_X_DEAD` the nodes are ``P = 1``,
-    ``Q = 0`` and ``x p(x) = 0`` in double precision and are not evaluated.
+    The trapezoid rule in s = ln(x / c) at the step :data:`_STEP` over the window
+    [min(-T, -ln c - T), max(T, -ln c + T)], T = :data:`_TAIL`, taken on the lattice
+    t = ln x = j _STEP that every c shares (:func:`_mpl_lattice`): the incomplete gamma
+    functions, the costly part, are evaluated once per n at the lattice's nodes, and each c
+    weighs them by the kernel w(t - ln c) = y / (R (1 + R)), y = e^t / c (a product, no
+    exponential per node). The sum runs over the whole lattice: the nodes beyond a c's own
+    window weigh less than e^-T ~ 2e-16 of it. Against a window anchored at each c (the
+    trapezoid rule on another lattice: the sums differ by its aliasing, e^-49 here) the
+    integrals agree to 2e-15 relative, at a third to a quarter of the time (n 0.22-3, 681
+    values of c over 34 decades). Where ln c lies beyond +-:data:`_LATTICE_LNC` (the
+    lattice's e^t would overflow) the window anchored at each such c is kept
+    (:func:`_mpl_integrals_windowed`, on those c alone: one window as wide as the widest
+    overflowed where a speed near 0 and one near VHAT_MAX were solved together).
     """
-    from scipy.special import gammainc, gammaincc, gammaln  # lazy: not on a BEM scene's path
     lnc = np.log(c)
-    s0 = np.minimum(-_TAIL, -lnc - _TAIL)
-    s1 = np.maximum(_TAIL, -lnc + _TAIL)
-    m = int(np.ceil(np.max(s1 - s0) / _STEP)) + 1
-    s = s0[:, None] + _STEP * np.arange(m)[None, :]
-    w = _STEP * _kernel_w(s)
-    x = c[:, None] * np.exp(s)
+    far = ~(np.abs(lnc) <= _LATTICE_LNC)
+    if np.any(far):             # those on their own windows, the others on the lattice
+        out = [np.empty(c.size) for _ in range(3)]
+        for rows, integrals in ((far, _mpl_integrals_windowed), (~far, _mpl_integrals)):
+            if np.any(rows):
+                for o, x in zip(out, integrals(n, c[rows])):
+                    o[rows] = x
+        return tuple(out)
+    lo = float(min(np.min(lnc) - _TAIL, -_TAIL))
+    hi = float(max(np.max(lnc) + _TAIL, _TAIL))
+    # the lattice's ends in blocks of _LATTICE_BLOCK nodes: Newton's shrinking set of c
+    # (sweep.theory._solve_gamma) shares one lattice
+    j_lo = int(math.floor(lo / _STEP / _LATTICE_BLOCK)) * _LATTICE_BLOCK
+    j_hi = int(math.ceil(hi / _STEP / _LATTICE_BLOCK)) * _LATTICE_BLOCK
+    e_t, p, q, xp = _mpl_lattice(float(n), j_lo, j_hi)
+    y = e_t[None, :] / c[:, None]
+    r = np.hypot(1.0, y)
+    w = _STEP * y / (r * (1.0 + r))
+    return np.sum(w * q, axis=1), np.sum(w * p, axis=1), np.sum(w * xp, axis=1)
+
+
+#: :func:`_mpl_integrals` takes the shared lattice where |ln c| is at most this (its nodes
+#: reach ln c +- _TAIL, and e^t overflows beyond 709) ...
+_LATTICE_LNC = 600.0
+#: ... and extends the lattice in blocks of this many nodes
+_LATTICE_BLOCK = 64
+
+
+@lru_cache(maxsize=16)
+def _mpl_lattice(n: float, j_lo: int, j_hi: int):
+    """(e^t, P(n, e^t), Q(n, e^t), e^t p(n, e^t)) on the lattice t = j _STEP, j_lo <= j <=
+    j_hi (read-only; :func:`_gamma_nodes`)."""
+    t = _STEP * np.arange(j_lo, j_hi + 1)
+    x = np.exp(t)
+    p, q, xp = _gamma_nodes(n, x, t)
+    for a in (x, p, q, xp):
+        a.flags.writeable = False
+    return x, p, q, xp
+
+
+def _gamma_nodes(n: float, x: np.ndarray, ln_x: np.ndarray):
+    """P(n, x), Q(n, x) and x p(x) = x^n e^-x / Gamma(n) (the Newton slope's integrand) at
+    the nodes ``x`` (``ln_x`` their logarithms), one incomplete gamma function each:
+    ``Q(n, x)`` above ``max(1, n)``, ``P(n, x)`` at or below it, the other as its complement
+    (what scipy's own ``gammainc`` does above that point, so ``J`` there is the same number;
+    below it ``Q = 1 - P >= Q(n, max(1, n))`` loses nothing that counts). Beyond ``x =``
+    :data:`_X_DEAD` the nodes are ``P = 1``, ``Q = 0`` and ``x p(x) = 0`` in double precision
+    and are not evaluated."""
+    from scipy.special import gammainc, gammaincc, gammaln  # lazy: not on a BEM scene's path
     live = x < _X_DEAD
     lower = live & (x <= max(1.0, n))
     upper = live & ~lower
@@ -131,14 +182,25 @@ def _mpl_integrals(n: float, c: np.ndarray):
     q[upper] = gammaincc(n, x[upper])
     q[lower] = 1.0 - p[lower]
     p[upper] = 1.0 - q[upper]
-    big_i = np.sum(w * q, axis=1)
-    big_j = np.sum(w * p, axis=1)
-    # c dJ/dc = int w(s) x p(x) ds, x p(x) = x^n e^-x / Gamma(n) (only the Newton slope)
     xp = np.zeros_like(x)
     with np.errstate(under="ignore"):
-        np.exp(n * (lnc[:, None] + s) - x - gammaln(n), out=xp, where=live)
-    c_dj = np.sum(w * xp, axis=1)
-    return big_i, big_j, c_dj
+        np.exp(n * ln_x - x - gammaln(n), out=xp, where=live)
+    return p, q, xp
+
+
+def _mpl_integrals_windowed(n: float, c: np.ndarray):
+    """:func:`_mpl_integrals` on a window anchored at each c (its incomplete gamma functions
+    evaluated at every node of every c): for ln c beyond the shared lattice's reach."""
+    lnc = np.log(c)
+    s0 = np.minimum(-_TAIL, -lnc - _TAIL)
+    s1 = np.maximum(_TAIL, -lnc + _TAIL)
+    m = int(np.ceil(np.max(s1 - s0) / _STEP)) + 1
+    s = s0[:, None] + _STEP * np.arange(m)[None, :]
+    w = _STEP * _kernel_w(s)
+    with np.errstate(over="ignore"):        # x beyond 1e308: a node beyond _X_DEAD, as it is
+        x = c[:, None] * np.exp(s)
+    p, q, xp = _gamma_nodes(n, x, lnc[:, None] + s)
+    return np.sum(w * q, axis=1), np.sum(w * p, axis=1), np.sum(w * xp, axis=1)
 
 
 def _spectrum_integrals(weights: np.ndarray, times: np.ndarray, c: np.ndarray):

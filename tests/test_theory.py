@@ -432,3 +432,25 @@ def test_maugis_lambda_from_physical_constants():
     assert theory.maugis_lambda(1.0) == pytest.approx(1.157, abs=5e-4)
     with pytest.raises(InputError):
         theory.maugis_lambda(0.0)
+
+
+@pytest.mark.parametrize("n", [0.05, 0.22, 1.0, 3.0])
+def test_mpl_integrals_on_the_shared_lattice_are_those_on_each_window(n):
+    """The MPL integrals summed on the lattice every c shares (its incomplete gamma functions
+    evaluated once) against the same trapezoid rule on a window anchored at each c (a second
+    lattice: the two differ by the rule's aliasing, e^-49), over 34 decades of c."""
+    from sweep.theory import _mpl_integrals, _mpl_integrals_windowed
+
+    c = np.exp(np.linspace(-57.0, 21.0, 300))
+    for shared, own in zip(_mpl_integrals(n, c), _mpl_integrals_windowed(n, c)):
+        np.testing.assert_allclose(shared, own, rtol=1e-13, atol=0.0)
+
+
+def test_pb_gamma_eff_takes_speeds_near_0_and_near_vhat_max_together():
+    """A speed whose c overflows the shared lattice (vhat 1e-300) solved beside one near
+    VHAT_MAX: the values each gives alone (one window as wide as the widest overflowed)."""
+    v = [1e-300, 1e-10, 1.0, 1e24, 1e100]
+    together = pb_gamma_eff(0.22, 1e-3, v)
+    alone = [pb_gamma_eff(0.22, 1e-3, x) for x in v]
+    np.testing.assert_allclose(together, alone, rtol=1e-14)
+    assert together[0] == pytest.approx(1.0, abs=1e-12) and together[-1] == pytest.approx(1e3)
