@@ -114,6 +114,18 @@ TRIAL_ITER = 12
 #: by 5e-7 to 1.3e-5, the hysteresis energy by 1.5e-5 to 1.1e-4, with 26-34 % fewer
 #: approach steps (4: more factorizations, no faster)
 APPROACH_DA_FACTOR = 2.0
+#: the dwell's crack tip may move by this many times ``numerics.da_max`` spacings a step. The
+#: retraction's bound serves the crack speed read at its pull-off; the dwell reports none, and
+#: its steps are what a protocol's cost over its relaxed start is made of where the held
+#: contact creeps far (a glassy approach, then the dwell: ``make protocol-cost``'s two fast
+#: bench scenes, where the dwell's crack travels 1.4-1.5 times the retraction's). Measured on the
+#: seven scenes of ``make protocol-cost`` against references at band resolution 48 (balanced,
+#: against 1): dwell steps 164 / 178 -> 61 / 65 and Newton iterations 289 / 445 -> 166 / 230 on
+#: those two, their rows' walls 0.75 and 0.69 of before; every pull-off's error within its
+#: row's estimate, by 2.9 to 12 times (errors 1.9e-5 / 5.5e-5 -> 8.2e-5 / 3.9e-5 there, the
+#: estimates 2.4e-4 / 1.6e-4; the other five scenes' within 2e-5 of before). 2: walls 0.81
+#: and 0.77; 4 and 6: no fewer steps, more iterations, errors 1.6e-4 and 1e-4
+DWELL_DA_FACTOR = 3.0
 #: the approach's Newton keeps its factorization with the crack-tip zone placed this many
 #: nodes further out than the unloading's (:func:`sweep.kernels.protocol.factorize_ahead`:
 #: 24 nodes inside the advancing tip, 48 outside), made again before a step whose start's
@@ -508,7 +520,7 @@ def _dwell(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     """Time steps from max(the approach's last, DWELL_FIRST dwell), growing by DWELL_GROWTH,
     the last cut to end at ``dwell``; at each the indentation held, or solved so that the
     load stays at the preload. A step whose solve fails, or whose contact radius moves by
-    more than ``da_max`` spacings (a contact creeping outward), is halved, down to
+    more than DWELL_DA_FACTOR ``da_max`` spacings (a contact creeping outward), is halved, down to
     DWELL_MIN_STEP of the dwell, where a fold of the path is relaxed.
 
     The steps are taken by the compiled march (:meth:`_March.compiled_dwell`), which
@@ -519,7 +531,7 @@ def _dwell(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     if protocol.dwell <= 0.0:
         return
     m.advancing = False     # a creeping contact: no fewer iterations with the zone ahead
-    da_max = m.pb.numerics.da_max * m.pb.mesh.spacing
+    da_max = DWELL_DA_FACTOR * m.pb.numerics.da_max * m.pb.mesh.spacing
     dt_min = DWELL_MIN_STEP * protocol.dwell
     dt = max(m.dt_prev, DWELL_FIRST * protocol.dwell)
     end = m.t + protocol.dwell
