@@ -13,6 +13,9 @@ time of the protocol (approach to the preload, dwell, retraction) against
 * ``ratio_two_relaxed``: the sum of two relaxed starts at the preload, one retracted at the
   approach's rate, one at the retraction's (the cost model: an approach costs about what a
   march over the same contacts at its speed costs);
+* ``solve_ratio``: the protocol's solve alone against the relaxed start's, both without the
+  error estimate (``pull_off_rtol: 0``: one solve each, where a row with its estimate solves
+  its scene two or three times: :mod:`sweep.engine.resolution`);
 * ``travel_ratio``: the crack tip's travel over the protocol (the contact radius's path, sum
   of |da| over the fine solve's records, by phase in ``travel``) over the relaxed start's, and
   ``cost_per_travel_ratio`` = ``ratio`` / ``travel_ratio``: what the protocol costs per unit
@@ -87,9 +90,13 @@ REPEATS = 7
 OUT = Path("results") / "protocol" / "cost.json"
 
 
-def _timed(scene: Scene):
+def _timed(scene: Scene, estimate: bool = True):
+    """(the result, its wall) of ``scene`` at the balanced preset, with its error estimate
+    or (``estimate`` False) without: one solve."""
+    numerics = (Numerics.preset("balanced") if estimate
+                else Numerics.preset("balanced", pull_off_rtol=0.0))
     t0 = time.perf_counter()
-    res = bem.simulate(scene, Numerics.preset("balanced"))
+    res = bem.simulate(scene, numerics)
     return res, time.perf_counter() - t0
 
 
@@ -120,11 +127,16 @@ def measure() -> dict:
                               **{**relaxed_fields, "rate": fields["approach_rate"]}),
         }
         ran = {key: _timed(scene)[0] for key, scene in comparators.items()}
-        walls = {key: [] for key in ("protocol", *comparators)}
+        solves = {"protocol_solve": protocol_scene, "relaxed_solve": comparators["relaxed"]}
+        for scene in solves.values():
+            _timed(scene, estimate=False)
+        walls = {key: [] for key in ("protocol", *comparators, *solves)}
         for _ in range(REPEATS):
             walls["protocol"].append(_timed(protocol_scene)[1])
             for key, scene in comparators.items():
                 walls[key].append(_timed(scene)[1])
+            for key, scene in solves.items():
+                walls[key].append(_timed(scene, estimate=False)[1])
         w = {key: float(np.min(x)) for key, x in walls.items()}
         row = {"scene": name, "status": res.status, "pull_off": res.pull_off,
                "relaxed_pull_off": ran["relaxed"].pull_off,
@@ -136,7 +148,9 @@ def measure() -> dict:
                "approach_relaxed_wall_s": w["approach"],
                "ratio": w["protocol"] / w["relaxed"],
                "ratio_same_contact": w["protocol"] / w["same_contact"],
-               "ratio_two_relaxed": w["protocol"] / (w["relaxed"] + w["approach"])}
+               "ratio_two_relaxed": w["protocol"] / (w["relaxed"] + w["approach"]),
+               "solve_wall_s": w["protocol_solve"], "relaxed_solve_wall_s": w["relaxed_solve"],
+               "solve_ratio": w["protocol_solve"] / w["relaxed_solve"]}
         travel, relaxed_travel = crack_travel(res), sum(crack_travel(ran["relaxed"]).values())
         row.update(mu=mu, bench=bench, travel=travel,
                    relaxed_travel=relaxed_travel,
@@ -146,12 +160,13 @@ def measure() -> dict:
         print(f"{name:40s} {res.status}: {w['protocol']:.3f} s; relaxed start at the preload "
               f"{w['relaxed']:.3f} s ({row['ratio']:.2f}x), at the dwell's contact "
               f"{w['same_contact']:.3f} s ({row['ratio_same_contact']:.2f}x), the two relaxed "
-              f"runs at the approach's and the retraction's speeds {row['ratio_two_relaxed']:.2f}x;"
+              f"runs at the approach's and the retraction's speeds {row['ratio_two_relaxed']:.2f}x,"
+              f" the solve alone (no error estimate) {row['solve_ratio']:.2f}x;"
               f" pull-off {res.pull_off:.4f} against {ran['relaxed'].pull_off:.4f}; crack travel "
               f"{row['travel_ratio']:.2f}x the relaxed start's (approach / dwell / retraction "
               f"{travel['approach']:.3f} / {travel['dwell']:.3f} / {travel['retract']:.3f} a_ref),"
               f" cost per travel {row['cost_per_travel_ratio']:.2f}x", flush=True)
-    keys = ("ratio", "ratio_same_contact", "ratio_two_relaxed", "travel_ratio",
+    keys = ("ratio", "ratio_same_contact", "ratio_two_relaxed", "solve_ratio", "travel_ratio",
             "cost_per_travel_ratio")
     ratios = {key: [r[key] for r in rows if not r["bench"]] for key in keys}
     bench = {key: [r[key] for r in rows if r["bench"]] for key in keys}
@@ -170,6 +185,7 @@ def measure() -> dict:
             "median_ratio_two_relaxed": float(np.median(ratios["ratio_two_relaxed"])),
             "median_cost_per_travel_ratio": float(np.median(ratios["cost_per_travel_ratio"])),
             "bench_median_ratio": float(np.median(bench["ratio"])),
+            "bench_median_solve_ratio": float(np.median(bench["solve_ratio"])),
             "bench_median_cost_per_travel_ratio": float(
                 np.median(bench["cost_per_travel_ratio"])),
             "table_rows": tables,
