@@ -523,6 +523,16 @@ def _dwell(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     more than DWELL_DA_FACTOR ``da_max`` spacings (a contact creeping outward), is halved, down to
     DWELL_MIN_STEP of the dwell, where a fold of the path is relaxed.
 
+    Newton's first start is the approach's last state, the second the linear extrapolation
+    through it and the dwell's first: the approach's motion, extrapolated from its last steps
+    (an indentation step over the approach's speed, 1e-6 to 1e-5 tau0 at the fast bench
+    scenes' rates) over the dwell's first (DWELL_FIRST dwell), started Newton 1e6-1e7
+    tolerances off, and its iteration diverged. Measured on ``make protocol-cost``'s rate-1e4
+    bench scene: the held steps that fell back to the secant 3 -> 0 in the fine solve, 2 -> 0
+    and 8 -> 6 in the error estimate's, Newton iterations of the dwells' solves 665 -> 525,
+    the row 0.87-0.91 of its wall (two A/B runs), the pull-off within 5e-8; the other scenes'
+    pull-offs within 3e-11.
+
     The steps are taken by the compiled march (:meth:`_March.compiled_dwell`), which
     returns every DWELL_CHUNK_STEPS tries for the time budget and hands a step whose solve
     failed to :func:`_dwell_step` (the held step's secant, the relaxation of a fold);
@@ -534,6 +544,7 @@ def _dwell(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     da_max = DWELL_DA_FACTOR * m.pb.numerics.da_max * m.pb.mesh.spacing
     dt_min = DWELL_MIN_STEP * protocol.dwell
     dt = max(m.dt_prev, DWELL_FIRST * protocol.dwell)
+    m.dt_prev = m.dt_prev2 = 0.0        # the first start: the approach's last state (below)
     end = m.t + protocol.dwell
     m.clock_origin = m.t - DWELL_LOG_SHIFT * protocol.dwell
     while m.t < end * (1.0 - 1e-12):

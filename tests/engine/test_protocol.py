@@ -277,8 +277,9 @@ def test_the_dwell_predicts_on_its_clock_with_fewer_newton_iterations(monkeypatc
     kernels.protocol.dwell_clock) rather than in t: the same march to Newton's tolerance (the
     same steps, the same state after the dwell) from starts nearer the solution, so fewer
     Newton iterations. The bench scene at rate 10^2.5 (make protocol-cost), whose dwell at
-    force creeps 0.9 a_ref: 314 -> 228 iterations of the approach and the dwell (measured;
-    434 -> 351 with the retraction's bound on the dwell's steps, DWELL_DA_FACTOR 1)."""
+    force creeps 0.9 a_ref: 279 -> 222 iterations of the approach and the dwell (measured;
+    434 -> 351 with the retraction's bound on the dwell's steps, DWELL_DA_FACTOR 1, and the
+    approach's motion extrapolated into the dwell's first steps)."""
     from sweep.engine import protocol
     from sweep.kernels.solve import N_STATS, STAT_ITER
 
