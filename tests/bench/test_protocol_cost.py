@@ -64,7 +64,8 @@ def test_the_committed_ratios_are_the_walls():
         assert row["travel_ratio"] == pytest.approx(
             sum(row["travel"].values()) / row["relaxed_travel"])
         assert row["cost_per_travel_ratio"] == pytest.approx(row["ratio"] / row["travel_ratio"])
-        assert row["solve_ratio"] == pytest.approx(row["solve_wall_s"] / row["relaxed_solve_wall_s"])
+        assert row["solve_ratio"] == pytest.approx(
+            row["solve_wall_s"] / row["relaxed_solve_wall_s"])
     for row in doc["table_rows"]:
         assert row["prony_terms"] == row["mpl_prony_terms"]
         assert row["pull_off"] == pytest.approx(row["mpl_pull_off"], rel=1e-4)

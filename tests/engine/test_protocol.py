@@ -318,7 +318,8 @@ def test_the_dwell_steps_over_more_crack_travel_within_the_error_estimate(monkey
     fine = run(**scene)
 
     def dwell_steps(res):
-        return int(np.count_nonzero(np.asarray(res.trajectory["phase"]) == protocol.PHASES["dwell"]))
+        phase = np.asarray(res.trajectory["phase"])
+        return int(np.count_nonzero(phase == protocol.PHASES["dwell"]))
 
     assert dwell_steps(coarse) <= 0.5 * dwell_steps(fine)
     assert abs(coarse.pull_off / fine.pull_off - 1.0) < coarse.error_estimate
