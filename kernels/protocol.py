@@ -23,7 +23,8 @@ The march's starts (an extrapolation of the last states) are furthest off at the
 where the gap equation is most nonlinear: the node behind an advancing tip lands on the
 repulsive wall, and even exact Newton from there took three iterations.
 :func:`kernels.solve.settle_tip` runs Newton on the few nodes around the tip alone, the
-others held, at the cost of those rows of A, before the solve of the whole.
+others held, at the cost of those rows of A, before the solve of the whole; a node it opens
+from deep in the wall moves as the wall's power law says (SETTLE_WALL_POWER).
 """
 from __future__ import annotations
 
@@ -49,6 +50,17 @@ HELD_SLOW_CONTRACTION = 0.1
 #: :func:`factorize_ahead` closes the nodes ahead of the crack tip to this fraction below
 #: the tip gap
 CLOSED_BELOW = 1e-3
+#: the march's settle at the crack tip takes a node in the repulsive wall that Newton opens
+#: in (h0/h)^SETTLE_WALL_POWER, at most to h0 (:func:`kernels.solve.wall_step`). On the
+#: quarter-resolution mesh of the error estimate's crossing check the dwell's starts put the
+#: node at the crack tip deep in the wall, 1e6-1e8 tolerances off, where the settle's three
+#: Newton steps in h barely move it: the dwells at force of ``make protocol-cost``'s bench
+#: scenes took 326 / 510 / 311 Newton iterations there, 7 / 5 / 6 held steps falling back to
+#: the secant of ordinary solves; with the wall step 237 / 458 / 254 and 0 / 4 / 2 (the SLS
+#: scene 964 -> 835 and 7 -> 4), the fine and half-resolution solves within 1 %, every
+#: row's pull-off within 2e-8. The power: 9 (the wall's own) 267 / 462 / 277 iterations,
+#: 12 249 / 458 / 252, 18 the fewest fallbacks
+SETTLE_WALL_POWER = 18.0
 #: an iteration whose residual grows by more than this factor ends the solve unconverged
 #: (the caller falls back to a secant of ordinary solves)
 HELD_DIVERGENCE = 10.0
@@ -388,7 +400,7 @@ def _step_start(mesh, physics, law, control, state, starts, dt, delta, work, ori
         hs[i] = starts[use, i]
     tip = np.searchsorted(r, clock[CLOCK_A])
     settle_tip(hs, g, mesh.A, ceff, H, law, max(tip - control.tip_nodes, 0),
-               min(tip + control.tip_nodes, N), control.tip_iter)
+               min(tip + control.tip_nodes, N), control.tip_iter, SETTLE_WALL_POWER)
     return ceff
 
 

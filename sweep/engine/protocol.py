@@ -50,6 +50,7 @@ from ..kernels.protocol import (CLOCK_A, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, C
                                 CLOCK_P, CLOCK_PHASE, CLOCK_TIP_SCORE, APPROACH_PASSED,
                                 DWELL_FAILED, DWELL_OPENED, ApproachControl, DwellControl,
                                 DwellOut, MarchState, RECENT_DELTA, RECENT_DWELL, RECENT_T,
+                                SETTLE_WALL_POWER,
                                 approach_steps, dwell_steps, factorize_ahead, held_guess,
                                 newton_at_load, predictor_steps)
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
@@ -249,7 +250,7 @@ class _March:
         either side, TIP_ITER iterations: :func:`sweep.kernels.solve.settle_tip`)."""
         tip = int(np.searchsorted(self.pb.mesh.r, self.records["a"][-1]))
         settle_tip(h, g, self.pb.A, ceff, H, self.law, max(tip - TIP_NODES, 0),
-                   min(tip + TIP_NODES, h.size), TIP_ITER)
+                   min(tip + TIP_NODES, h.size), TIP_ITER, SETTLE_WALL_POWER)
 
     def _ahead(self, h, ceff):
         """Where the crack tip advances (``advancing``), the factorization kept with its

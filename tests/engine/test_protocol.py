@@ -277,9 +277,11 @@ def test_the_dwell_predicts_on_its_clock_with_fewer_newton_iterations(monkeypatc
     kernels.protocol.dwell_clock) rather than in t: the same march to Newton's tolerance (the
     same steps, the same state after the dwell) from starts nearer the solution, so fewer
     Newton iterations. The bench scene at rate 10^2.5 (make protocol-cost), whose dwell at
-    force creeps 0.9 a_ref: 279 -> 222 iterations of the approach and the dwell (measured;
-    434 -> 351 with the retraction's bound on the dwell's steps, DWELL_DA_FACTOR 1, and the
-    approach's motion extrapolated into the dwell's first steps)."""
+    force creeps 0.9 a_ref: 246 -> 222 iterations of the approach and the dwell (measured
+    with the settle's wall step, kernels.protocol.SETTLE_WALL_POWER, which mends the worst of
+    the starts in time: 279 -> 222 without it; 434 -> 351 with the retraction's bound on the
+    dwell's steps, DWELL_DA_FACTOR 1, and the approach's motion extrapolated into the dwell's
+    first steps)."""
     from sweep.engine import protocol
     from sweep.kernels.solve import N_STATS, STAT_ITER
 
@@ -296,7 +298,7 @@ def test_the_dwell_predicts_on_its_clock_with_fewer_newton_iterations(monkeypatc
     assert len(on_clock.records["t"]) == len(in_time.records["t"])
     for key in ("t", "delta", "a"):
         assert on_clock.records[key][-1] == pytest.approx(in_time.records[key][-1], rel=1e-6)
-    assert iterations_on_clock <= 0.9 * iterations_in_time
+    assert iterations_on_clock <= 0.95 * iterations_in_time
 
 
 def test_the_dwell_steps_over_more_crack_travel_within_the_error_estimate(monkeypatch):
