@@ -17,6 +17,7 @@ import pytest
 
 from sweep.campaign.store import load
 from tests.campaign.test_scheduler import ROOT, cfg, fake_simulate
+from tests.test_cli_sweep import _default_sigint
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"),
                                 reason="forked workers are used on Linux only")
@@ -183,13 +184,16 @@ rep = run_sweep(cfg(n=(0.4, 0.6, 0.8), rate=(1, 3, 10, 30)), jobs=2, out=sys.arg
 def test_ctrl_c_reaches_the_parent_which_keeps_the_rows_and_ends_its_workers(tmp_path):
     """SIGINT to the whole process group (a Ctrl-C in a terminal): the forked workers ignore
     it, the parent stops the sweep as SweepInterrupted, keeps the finished rows, and its
-    workers end with it."""
+    workers end with it. The parent starts with SIGINT at its default, as in a terminal
+    (tests/test_cli_sweep.py's ``_default_sigint``): a suite run as a background job of a
+    non-interactive shell (``make test &``) inherits SIGINT ignored, and then the parent never
+    saw the Ctrl-C and the test waited 60 s for a sweep that went on."""
     import signal
 
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]))
     proc = subprocess.Popen([sys.executable, "-c", _CTRL_C, str(tmp_path / "r.h5")], env=env,
                             cwd=ROOT, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=_default_sigint)
     try:
         t0 = time.monotonic()
         log = ""
