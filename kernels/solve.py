@@ -136,7 +136,7 @@ StepControl = namedtuple("StepControl", ["step_max", "step_min", "da_max", "step
 #: (0: a new run, record 0 is the initial state; n >= 1: continue after record n - 1, the
 #: stop rule sees all records); step (1,) the indentation step (units of h0), in/out (<= 0
 #: starts at step_max; on return the step the run would take next; step[1], where given, the
-#: time step that made h); sigma (N,) the traction of h and h_prev (N,) the state before it,
+#: time step that made h; step[2], where given, 1 during a lead-in: LEAD_GROWTH); sigma (N,) the traction of h and h_prev (N,) the state before it,
 #: in/out: read when resuming with a process zone (its traction depends on the step that made
 #: h, not on h alone, and Newton starts from the extrapolation through both), on return
 #: those of the last accepted state
@@ -251,6 +251,13 @@ REJECT_TARGET = 0.8
 #: SMOOTH_DA_FRACTION da_max per step
 SMOOTH_STEP_FACTOR = 8.0
 SMOOTH_DA_FRACTION = 0.6
+#: a lead-in (RunState ``step[2]`` set: a test protocol's retraction whose first step, the
+#: march's last time step, is shorter than step_max) grows its step by this factor after
+#: every accepted step that moved the crack tip by less than EASY_DA_FRACTION da_max, up to
+#: step_max, where the ordinary control takes over; the dwell's growth
+#: (``sweep.engine.protocol.DWELL_GROWTH``): the load relaxes on the approach's time scale
+#: first, and the steps grow geometrically in time, as the dwell's do
+LEAD_GROWTH = 1.3
 #: a process zone's first step may take this many times max_iter Newton iterations: its factor
 #: jumps from 1 at rest to 1 + (rate h0/hdot_c)^xi at once, and Newton converges slowly but
 #: surely there (25-34 iterations on n 0.4, k 0.1, mu 3.24, delta0 4.95, rate 10^0.5, pz_v0 the
@@ -1196,6 +1203,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
     run = np.zeros(N_RUN)
     n, i_min = start_run(mesh, physics, start, records, work, run, hm)
     run[RUN_DD] = start.step[0] * h0 if start.step[0] > 0.0 else control.step_max * h0
+    lead = start.step.size > 2 and start.step[2] > 0.0
     easy = 0
     status = STATUS_STEP_LIMIT
     while n <= control.max_steps:
@@ -1226,12 +1234,19 @@ def unload(mesh, physics, control, start, records, cache, stats):
         if stop != STATUS_RUNNING:
             status = stop
             break
-        run[RUN_DD], easy = next_step(run[RUN_DD], easy, da, da_max, err,
-                                      control.step_max * h0, control.step_tol * h0)
+        if lead:
+            dd = run[RUN_DD] * (LEAD_GROWTH if da < EASY_DA_FRACTION * da_max else 1.0)
+            run[RUN_DD] = min(dd, control.step_max * h0)
+            lead = run[RUN_DD] < control.step_max * h0
+        else:
+            run[RUN_DD], easy = next_step(run[RUN_DD], easy, da, da_max, err,
+                                          control.step_max * h0, control.step_tol * h0)
     _copy(work.h, records.h)
     _copy(work.sigma, start.sigma)
     _copy(work.h_prev, start.h_prev)
     if start.step.size > 1:
         start.step[1] = run[RUN_DT_PREV]
+    if start.step.size > 2:
+        start.step[2] = 1.0 if lead else 0.0
     start.step[0] = run[RUN_DD] / h0
     return status, n

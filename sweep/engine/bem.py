@@ -155,7 +155,7 @@ class UnloadingState:
         return cls(h=np.asarray(h_init, float).copy(), delta0=float(delta0),
                    q=np.zeros((pb.prony_weights.size, N)),
                    records=[np.empty(pb.numerics.max_steps + 1) for _ in range(5)], n=0,
-                   step=np.zeros(2), cache=cache, stats=stats, sigma=np.zeros(N),
+                   step=np.zeros(3), cache=cache, stats=stats, sigma=np.zeros(N),
                    h_prev=np.zeros(N))
 
 
@@ -272,7 +272,8 @@ def _finish(pb: Problem, res: Result, status: int, stats,
     finish(res, status, res.trajectory, dr, min_travel, pb.scales,
            advice=refine_advice(pb.numerics),
            remeshed=(retraction_from,) if retraction_from > 0 else (),
-           machine_stiffness=pb.scene.machine_stiffness)
+           machine_stiffness=pb.scene.machine_stiffness,
+           first=retraction_from)
     return None
 
 
@@ -297,26 +298,47 @@ def _simulate_protocol(pb: Problem, res: Result, deadline: float):
         res.reason = (f"the contact at the preload, radius {res.a0_result:.4g}, reaches the "
                       f"mesh edge (domain {pb.mesh.domain:.4g})")
         return None
-    # the retraction's records follow the march's: room for both
-    pb = dataclasses.replace(pb, numerics=dataclasses.replace(
-        pb.numerics, max_steps=pb.numerics.max_steps + n0))
+    # the retraction is an unloading from the dwell's last state, its record 0: its stop rule
+    # and pull-off see the retraction's records only
     invalidate(march.cache)
     run = UnloadingState.start(pb, march.h, march.delta, march.cache, stats)
     for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):
-        run.records[i][:n0] = rec[key]
-    run.n, run.q, run.sigma, run.h_prev = n0, march.q, march.sigma, march.h_prev
+        run.records[i][0] = rec[key][-1]
+    run.n, run.q, run.sigma, run.h_prev = 1, march.q, march.sigma, march.h_prev
+    run.step[0], run.step[2] = _retraction_first_step(pb, march)
     status = _unload(pb, run, deadline)
     n = run.n
-    res.trajectory = {key: x[:n].copy() for key, x in
-                      zip(("t", "delta", "P", "a", "a_inner"), run.records)}
+    res.trajectory = {key: np.concatenate([np.asarray(rec[key][:-1], float), x[:n]])
+                      for key, x in zip(("t", "delta", "P", "a", "a_inner"), run.records)}
     res.trajectory["phase"] = np.concatenate(
-        [np.asarray(rec["phase"], float), np.full(n - n0, float(PHASES["retract"]))])
+        [np.asarray(rec["phase"], float), np.full(n - 1, float(PHASES["retract"]))])
     res.hysteresis_energy = cycle_work(res.trajectory)
     # the pull-off is read on the retraction only (its first record the dwell's last state):
     # the approach passed the same radii, and a crack-speed fit over the records near the
     # pull-off's radius took them in (0.056 against 0.051 a_ref/tau0 after a dwell long
     # enough to relax, SLS k 0.2)
     return _finish(pb, res, status, stats, retraction_from=n0 - 1)
+
+
+def _retraction_first_step(pb: Problem, march) -> tuple[float, float]:
+    """(the retraction's first indentation step in h0, the lead-in flag): the march's last
+    time step at the retraction's rate (the larger of its last two: the approach's last is cut
+    to end at the preload), where that is shorter than ``numerics.step``; the unloading kernel
+    then grows it by LEAD_GROWTH a step up to ``numerics.step`` (:func:`kernels.solve.unload`).
+    Else ``numerics.step`` and no lead-in.
+
+    A retraction that starts right after a fast approach (no dwell, or a short one) starts
+    from an unrelaxed contact whose load relaxes on the approach's time scale. A first step of
+    ``numerics.step`` is then orders of magnitude longer than the approach's, and the load
+    jumped across the relaxation: n 1.617, k 0.01603, mu 0.9055, approach rate 928.1, preload
+    11.59, no dwell, rate 0.03025 fell from 11.59 to -2.67 in one step of 0.052 tau0 (75
+    times the approach's last), a spurious minimum 1.5 times the pull-off (-1.76 at t = 52,
+    which steps ten times shorter find)."""
+    dt = max(march.dt_prev, march.dt_prev2)
+    step = pb.scene.rate * dt
+    if 0.0 < step < pb.numerics.step:
+        return step, 1.0
+    return pb.numerics.step, 0.0
 
 
 def kernels_cached() -> bool:

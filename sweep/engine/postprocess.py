@@ -160,7 +160,7 @@ def one_mesh_span(i: int, n: int, remeshed=()) -> tuple[int, int]:
 
 
 def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float, scales,
-           advice: str, remeshed=(), machine_stiffness=None) -> None:
+           advice: str, remeshed=(), machine_stiffness=None, first: int = 0) -> None:
     """Fill ``res`` from a finished unloading, in place: ``ok`` with the pull-off, the state
     and crack speed at the pull-off instant, or a failure with its reason.
 
@@ -192,9 +192,13 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     machine_stiffness : the scene's compliant machine K (pi dg R/d_ref), None for a rigid
         one: a solve failing at its fold after the minimum (:func:`machine_fold`) has passed
         the pull-off.
+    first : the unloading's first record (a test protocol's retraction: the records before
+        it are the approach's and the dwell's). The pull-off is the load minimum from there
+        on: an approach's first contact can pull as hard as the pull-off (a low Tabor
+        parameter's, where both are near the DMT value 2).
     """
     t, delta, P, a, a_inner = (trajectory[k] for k in ("t", "delta", "P", "a", "a_inner"))
-    i = int(np.argmin(P))
+    i = first + int(np.argmin(P[first:]))
     lo, hi = one_mesh_span(i, len(P), remeshed)
     i, t_star, P_star = refine_minimum(t[lo:hi], P[lo:hi])
     i += lo
@@ -225,12 +229,12 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         res.reason = "no tensile load reached"
         return
     span = slice(lo, hi)
-    at_start = i == 0 and hi > 1
+    at_start = i == first and hi > first + 1
     if at_start:
         # the contact starts at or beyond its pull-off (e.g. past the JKR fold, a0 >= 1/2 at
         # low mu): the load only rises from the initial state, and a fit centred there is
         # one-sided and as poor as the few records it spans; the first step's radius change
-        speed = float((a[0] - a[1]) / (t[1] - t[0]))
+        speed = float((a[i] - a[i + 1]) / (t[i + 1] - t[i]))
     else:
         speed = float(crack_speed_on_mesh(t, a, t_star, spacing, lo, hi))
         if _FIT_LOG is not None:

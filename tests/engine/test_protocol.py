@@ -366,3 +366,49 @@ def test_the_compiled_dwell_refuses_an_opening_gap_as_the_python_march(monkeypat
     python, compiled = _refusals(Scene(model="bem", **SLS_PROTOCOL, **PZ),
                                  "the dwell opened the gap")
     assert python == compiled
+
+
+#: two protocols without a dwell from a random sample of protocol scenes (model auto,
+#: balanced), each failed before its fix ("negative crack speed at the pull-off"); their
+#: independent values are the accurate preset's pull-offs (a finer mesh, smaller steps,
+#: tighter Newton and Prony tolerances), measured 3.3e-5 and 1.4e-4 from the balanced ones
+FIRST_CONTACT_PULLS = dict(n=0.5133, k=0.006117, mu=0.4475, rate=0.04988,
+                           approach_rate=0.0578, preload=0.5256, dwell=0.0)
+FAST_APPROACH_SLOW_RETRACTION = dict(n=1.617, k=0.01603, mu=0.9055, rate=0.03025,
+                                     approach_rate=928.1, preload=11.59, dwell=0.0)
+#: the balanced pull-off against the accurate one
+CONVERGED_RTOL = 1e-3
+
+
+def test_the_pull_off_is_read_on_the_retraction_not_at_first_contact():
+    """A slow approach of a soft, strongly relaxing material at a low Tabor parameter first
+    touches at a load more tensile than the retraction's pull-off (-1.844 against -1.839): the
+    load minimum of the whole path lies at first contact, where the contact advances. The
+    pull-off is the retraction's (as the paper defines it: the largest tensile force while
+    unloading), and it agrees with the accurate preset's."""
+    res = run(**FIRST_CONTACT_PULLS)
+    traj = res.trajectory
+    retraction = traj["phase"] == 2
+    assert traj["P"][0] < traj["P"][retraction].min()          # the case under test
+    assert -res.pull_off == pytest.approx(traj["P"][retraction].min(), rel=1e-3)
+    assert res.crack_speed > 0
+    reference = run(Numerics.preset("accurate", pull_off_rtol=0.0), **FIRST_CONTACT_PULLS)
+    assert res.pull_off == pytest.approx(reference.pull_off, rel=CONVERGED_RTOL)
+
+
+def test_a_retraction_after_a_fast_approach_starts_at_the_approachs_time_step():
+    """Right after a fast approach (no dwell) the load relaxes on the approach's time scale.
+    The retraction's first step is the approach's last full time step (the one before the step
+    cut to the preload), growing from there, so the load falls through the relaxation in
+    steps (each less than 0.2 of the preload; one step of 75 times the approach's took it from
+    11.59 to -2.67, a spurious pull-off); the pull-off agrees with the accurate preset's."""
+    res = run(**FAST_APPROACH_SLOW_RETRACTION)
+    traj = res.trajectory
+    t, P = traj["t"], traj["P"]
+    k = int(np.argmax(traj["phase"] == 2)) - 1         # the retraction's first record
+    assert t[k + 1] - t[k] == pytest.approx(max(t[k] - t[k - 1], t[k - 1] - t[k - 2]),
+                                            rel=1e-9)
+    assert np.abs(np.diff(P[k:])).max() < 0.2 * FAST_APPROACH_SLOW_RETRACTION["preload"]
+    reference = run(Numerics.preset("accurate", pull_off_rtol=0.0),
+                    **FAST_APPROACH_SLOW_RETRACTION)
+    assert res.pull_off == pytest.approx(reference.pull_off, rel=CONVERGED_RTOL)
