@@ -3,7 +3,8 @@ r"""A seeded random sample across the declared ranges, run as a user runs it: ``
 ``python -m sweep.bench.random_sample configs --count 60`` writes the sweep configurations
 ``configs/random/auto.yaml`` and ``configs/random/bem.yaml`` (the same scenes, drawn
 log-uniformly across the Scene's declared ranges, model ``auto`` and the default ``bem``;
-balanced preset, 20 s time budget a scene). After ``sweep run`` of each (``make
+balanced preset, 20 s time budget a scene), and ``configs/random/protocol.yaml``: 80 scenes
+with a test protocol (approach, dwell, retract; :func:`protocol_sample`). After ``sweep run`` of each (``make
 random-sample``), ``python -m sweep.bench.random_sample summary`` counts, per model, the
 scenes answered (``ok``), physically refused (:func:`sweep.errors.is_physical_refusal`),
 failed otherwise, and hit by an internal error, and the sweep's wall (:func:`scene_span`)
@@ -19,6 +20,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from ..campaign.store import load
@@ -30,6 +32,17 @@ CONFIGS = ROOT / "configs" / "random"
 RESULTS = ROOT / "results" / "random"
 MODELS = ("auto", "bem")
 BUDGET_S = 20.0
+#: the protocol sample (``configs/random/protocol.yaml``): its size, seed, and ranges,
+#: log-uniform but n (uniform). mu stays at or below 6: a protocol runs on the BEM's graded
+#: mesh, whose fine band reaches in to first contact, and at the balanced preset that band
+#: exceeds max_nodes (1000) from mu of about 7 (the engine's refusal, "mesh too large"; 16
+#: of 40 scenes drawn at mu 1-20)
+PROTOCOL_COUNT, PROTOCOL_SEED = 80, 41
+PROTOCOL_RANGES = {"k": (0.005, 0.9), "mu": (0.3, 6.0), "rate": (1e-2, 1e6),
+                   "approach_rate": (1e-2, 1e6), "preload": (0.05, 20.0)}
+#: a fifth of the scenes without a dwell, the others a dwell of 0.01-1e4 tau0 (log-uniform),
+#: held at depth in three of ten; a fifth SLS
+PROTOCOL_DWELL = (0.01, 1e4)
 
 
 def sample_config(count: int, seed: int, model: str) -> dict:
@@ -42,6 +55,37 @@ def sample_config(count: int, seed: int, model: str) -> dict:
             "output": f"results/random/{model}.h5"}
 
 
+def protocol_sample(count: int = PROTOCOL_COUNT, seed: int = PROTOCOL_SEED) -> list[dict]:
+    """``count`` scenes with a test protocol (approach, dwell, retract), drawn from
+    :data:`PROTOCOL_RANGES` and :data:`PROTOCOL_DWELL`, 4 significant digits."""
+    rng = np.random.default_rng(seed)
+
+    def log_uniform(lo, hi):
+        return float(f"{math.exp(rng.uniform(math.log(lo), math.log(hi))):.4g}")
+
+    out = []
+    for _ in range(count):
+        d = {"n": float(f"{rng.uniform(0.2, 1.9):.4g}")}
+        d.update({name: log_uniform(lo, hi) for name, (lo, hi) in PROTOCOL_RANGES.items()})
+        d["dwell"] = 0.0 if rng.uniform() < 0.2 else log_uniform(*PROTOCOL_DWELL)
+        d["dwell_hold"] = "depth" if rng.uniform() < 0.3 else "force"
+        d["material"] = "sls" if rng.uniform() < 0.2 else "mpl"
+        d["model"] = "auto"
+        out.append(d)
+    return out
+
+
+def protocol_config() -> dict:
+    """The sweep configuration of the protocol sample (balanced, :data:`BUDGET_S`)."""
+    return {"name": "random-protocol",
+            "description": f"{PROTOCOL_COUNT} scenes with a test protocol (seed "
+                           f"{PROTOCOL_SEED}), model auto",
+            "grid": protocol_sample(),
+            "numerics": {"preset": "balanced", "time_budget_s": BUDGET_S},
+            "store": {"trajectories": False},
+            "output": "results/random/protocol.h5"}
+
+
 def write_configs(count: int = 60, seed: int = 21) -> list[Path]:
     CONFIGS.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -52,6 +96,11 @@ def write_configs(count: int = 60, seed: int = 21) -> list[Path]:
         path.write_text(head + yaml.safe_dump(sample_config(count, seed, model),
                                               sort_keys=False, width=100))
         paths.append(path)
+    path = CONFIGS / "protocol.yaml"
+    path.write_text("# written by `python -m sweep.bench.random_sample configs`; run by `make "
+                    "random-sample`\n" + yaml.safe_dump(protocol_config(), sort_keys=False,
+                                                        width=100))
+    paths.append(path)
     return paths
 
 
@@ -64,7 +113,7 @@ def outcome(row) -> str:
 
 def summarize(results: Path = RESULTS) -> dict:
     out = {}
-    for model in MODELS:
+    for model in MODELS + ("protocol",):
         path = results / f"{model}.h5"
         if not path.exists():
             continue
@@ -75,12 +124,26 @@ def summarize(results: Path = RESULTS) -> dict:
                       "answered_or_refused": (kinds.count("ok") + kinds.count("refused"))
                       / max(len(df), 1),
                       "model_used": df.model_used.value_counts().to_dict(),
-                      "failures": [{"n": r.n, "k": r.k, "mu": r.mu, "a0": r.a0, "rate": r.rate,
-                                    "material": r.material, "reason": r.reason}
-                                   for (_, r), kind in zip(df.iterrows(), kinds)
+                      "failures": [_failure(r) for (_, r), kind in zip(df.iterrows(), kinds)
                                    if kind in ("failed", "error")],
                       "scene_seconds": float(df.task_wall_s.sum()),
                       "sweep_wall_s": scene_span(df)}
+    return out
+
+
+#: a failed row's fields in the summary: the scene's, and a protocol scene's protocol (it has
+#: no a0)
+FAILURE_FIELDS = ("n", "k", "mu", "a0", "rate", "material")
+PROTOCOL_FIELDS = ("approach_rate", "preload", "dwell", "dwell_hold")
+
+
+def _failure(row) -> dict:
+    def given(value):
+        return value is not None and not (isinstance(value, float) and math.isnan(value))
+
+    names = FAILURE_FIELDS + (PROTOCOL_FIELDS if given(row.get("preload")) else ())
+    out = {name: row.get(name) for name in names if given(row.get(name))}
+    out["reason"] = row["reason"]
     return out
 
 
@@ -149,7 +212,7 @@ def _main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m sweep.bench.random_sample",
                                 description="a random sample across the declared ranges")
     sub = p.add_subparsers(dest="command", required=True)
-    c = sub.add_parser("configs", help="write configs/random/{auto,bem}.yaml")
+    c = sub.add_parser("configs", help="write configs/random/{auto,bem,protocol}.yaml")
     c.add_argument("--count", type=int, default=60)
     c.add_argument("--seed", type=int, default=21)
     sub.add_parser("summary", help="count the outcomes, draw the model map")
@@ -167,8 +230,9 @@ def _main(argv=None) -> int:
               f"({100 * s['answered_or_refused']:.0f} % answered or refused); models used "
               f"{s['model_used']}")
         for f in s["failures"]:
-            print(f"    failed: mu={f['mu']:.4g} a0={f['a0']:.3g} n={f['n']:.3g} "
-                  f"k={f['k']:.3g} rate={f['rate']:.3g}: {f['reason'][:110]}")
+            fields = " ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
+                              for k, v in f.items() if k != "reason")
+            print(f"    failed: {fields}: {f['reason'][:110]}")
     out = plot_map()
     if out:
         print(out.relative_to(ROOT))

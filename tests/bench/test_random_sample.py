@@ -34,3 +34,27 @@ def test_the_sweep_wall_is_the_span_of_its_scenes_not_their_sum():
     df = pd.DataFrame({"finished_at": [13.0, 12.0, 16.0], "task_wall_s": [3.0, 2.0, 4.0]})
     assert random_sample.scene_span(df) == 6.0
     assert df.task_wall_s.sum() == 9.0
+
+
+def test_the_committed_protocol_config_is_the_generators():
+    path = random_sample.CONFIGS / "protocol.yaml"
+    assert yaml.safe_load(path.read_text()) == random_sample.protocol_config()
+    scenes = load_config(path).scenes()
+    assert len(scenes) == random_sample.PROTOCOL_COUNT
+    assert all(s.protocol() is not None and s.model == "auto" for s in scenes)
+    # the sample spans both holds, dwells and none, both materials
+    assert {s.dwell_hold for s in scenes} == {"force", "depth"}
+    assert any(s.dwell == 0.0 for s in scenes) and any(s.dwell > 0.0 for s in scenes)
+    assert {s.material for s in scenes} == {"mpl", "sls"}
+
+
+def test_a_protocol_rows_failure_names_its_protocol_not_an_a0():
+    row = {"n": 0.5, "k": 0.1, "mu": 1.0, "a0": float("nan"), "rate": 1.0, "material": "mpl",
+           "approach_rate": 2.0, "preload": 1.0, "dwell": 0.0, "dwell_hold": "force",
+           "reason": "time budget: 20 s"}
+    failure = random_sample._failure(row)
+    assert "a0" not in failure and failure["preload"] == 1.0 and failure["reason"] == row["reason"]
+    relaxed = dict(row, a0=2.0, approach_rate=float("nan"), preload=float("nan"),
+                   dwell=float("nan"))
+    assert set(random_sample._failure(relaxed)) == {"n", "k", "mu", "a0", "rate", "material",
+                                                    "reason"}
