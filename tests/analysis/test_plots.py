@@ -19,7 +19,7 @@ from sweep.campaign.scheduler import run_sweep
 from sweep.campaign.store import load, load_trajectory
 from sweep.cli import main
 from sweep.scene import Result
-from sweep.theory import jkr_load
+from sweep.theory import jkr_contact_radius, jkr_load
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
@@ -73,11 +73,16 @@ def _ok(scene, numerics):
 def synthetic_frame(config: Path) -> pd.DataFrame:
     """A results frame with the scenes of ``config`` (its axes, as :func:`sweep.load` gives
     them) and synthetic pull-offs of the right shape: 1.5 at slow unloading, rising with the
-    rate towards 1.5/k, less for small a0; every 37th scene failed (alternately with and
-    without a pull-off)."""
+    rate towards 1.5/k, less for small a0 (a protocol's: its preload's JKR radius); every
+    37th scene failed (alternately with and without a pull-off)."""
     rows = []
     for i, (sid, sc) in enumerate(load_config(config).tasks()):
-        a0 = sc.a0 if sc.a0 is not None else 1.0 + math.sqrt(max(sc.delta0, 0.0))
+        if sc.a0 is not None:
+            a0 = sc.a0
+        elif sc.delta0 is not None:
+            a0 = 1.0 + math.sqrt(max(sc.delta0, 0.0))
+        else:
+            a0 = float(jkr_contact_radius(load=sc.preload))
         reach = 1.0 - math.exp(-(a0 / 3.0) ** 2)
         rise = sc.rate ** 0.4 / (sc.rate ** 0.4 + 10.0)
         po = 1.5 + (1.5 / sc.k - 1.5) * reach * rise * (0.7 + 0.2 * min(sc.n, 1.5))
