@@ -3,8 +3,9 @@ r"""A seeded random sample across the declared ranges, run as a user runs it: ``
 ``python -m sweep.bench.random_sample configs --count 60`` writes the sweep configurations
 ``configs/random/auto.yaml`` and ``configs/random/bem.yaml`` (the same scenes, drawn
 log-uniformly across the Scene's declared ranges, model ``auto`` and the default ``bem``;
-balanced preset, 20 s time budget a scene), and ``configs/random/protocol.yaml``: 80 scenes
-with a test protocol (approach, dwell, retract; :func:`protocol_sample`). After ``sweep run`` of each (``make
+balanced preset, 20 s time budget a scene), ``configs/random/protocol.yaml``: 80 scenes
+with a test protocol (approach, dwell, retract; :func:`protocol_sample`), and
+``configs/random/protocol_pz.yaml``: 40 with a protocol and a process zone. After ``sweep run`` of each (``make
 random-sample``), ``python -m sweep.bench.random_sample summary`` counts, per model, the
 scenes answered (``ok``), physically refused (:func:`sweep.errors.is_physical_refusal`),
 failed otherwise, and hit by an internal error, and the sweep's wall (:func:`scene_span`)
@@ -43,6 +44,12 @@ PROTOCOL_RANGES = {"k": (0.005, 0.9), "mu": (0.3, 6.0), "rate": (1e-2, 1e6),
 #: a fifth of the scenes without a dwell, the others a dwell of 0.01-1e4 tau0 (log-uniform),
 #: held at depth in three of ten; a fifth SLS
 PROTOCOL_DWELL = (0.01, 1e4)
+#: the protocol sample with a process zone (``configs/random/protocol_pz.yaml``): its size and
+#: seed, and the Gent-Schultz law's reference speed (log-uniform) and exponent (uniform)
+PROTOCOL_PZ_COUNT, PROTOCOL_PZ_SEED = 40, 77
+PROTOCOL_PZ_V0, PROTOCOL_PZ_XI = (0.3, 30.0), (0.3, 0.8)
+#: the samples ``summary`` counts: the two of :data:`MODELS`, and the protocols'
+SAMPLES = MODELS + ("protocol", "protocol_pz")
 
 
 def sample_config(count: int, seed: int, model: str) -> dict:
@@ -55,9 +62,12 @@ def sample_config(count: int, seed: int, model: str) -> dict:
             "output": f"results/random/{model}.h5"}
 
 
-def protocol_sample(count: int = PROTOCOL_COUNT, seed: int = PROTOCOL_SEED) -> list[dict]:
+def protocol_sample(count: int = PROTOCOL_COUNT, seed: int = PROTOCOL_SEED,
+                    process_zone: bool = False) -> list[dict]:
     """``count`` scenes with a test protocol (approach, dwell, retract), drawn from
-    :data:`PROTOCOL_RANGES` and :data:`PROTOCOL_DWELL`, 4 significant digits."""
+    :data:`PROTOCOL_RANGES` and :data:`PROTOCOL_DWELL`, 4 significant digits;
+    ``process_zone``: each with the Gent-Schultz process zone (:data:`PROTOCOL_PZ_V0`,
+    :data:`PROTOCOL_PZ_XI`), MPL only."""
     rng = np.random.default_rng(seed)
 
     def log_uniform(lo, hi):
@@ -69,21 +79,28 @@ def protocol_sample(count: int = PROTOCOL_COUNT, seed: int = PROTOCOL_SEED) -> l
         d.update({name: log_uniform(lo, hi) for name, (lo, hi) in PROTOCOL_RANGES.items()})
         d["dwell"] = 0.0 if rng.uniform() < 0.2 else log_uniform(*PROTOCOL_DWELL)
         d["dwell_hold"] = "depth" if rng.uniform() < 0.3 else "force"
-        d["material"] = "sls" if rng.uniform() < 0.2 else "mpl"
+        if process_zone:
+            d.update(pz_law="gent-schultz", pz_v0=log_uniform(*PROTOCOL_PZ_V0),
+                     pz_xi=float(f"{rng.uniform(*PROTOCOL_PZ_XI):.3g}"))
+        else:
+            d["material"] = "sls" if rng.uniform() < 0.2 else "mpl"
         d["model"] = "auto"
         out.append(d)
     return out
 
 
-def protocol_config() -> dict:
-    """The sweep configuration of the protocol sample (balanced, :data:`BUDGET_S`)."""
-    return {"name": "random-protocol",
-            "description": f"{PROTOCOL_COUNT} scenes with a test protocol (seed "
-                           f"{PROTOCOL_SEED}), model auto",
-            "grid": protocol_sample(),
+def protocol_config(process_zone: bool = False) -> dict:
+    """The sweep configuration of the protocol sample (balanced, :data:`BUDGET_S`), or of
+    its sample with a process zone."""
+    name, count, seed = (("protocol_pz", PROTOCOL_PZ_COUNT, PROTOCOL_PZ_SEED) if process_zone
+                         else ("protocol", PROTOCOL_COUNT, PROTOCOL_SEED))
+    what = "with a test protocol and a process zone" if process_zone else "with a test protocol"
+    return {"name": f"random-{name.replace('_', '-')}",
+            "description": f"{count} scenes {what} (seed {seed}), model auto",
+            "grid": protocol_sample(count, seed, process_zone),
             "numerics": {"preset": "balanced", "time_budget_s": BUDGET_S},
             "store": {"trajectories": False},
-            "output": "results/random/protocol.h5"}
+            "output": f"results/random/{name}.h5"}
 
 
 def write_configs(count: int = 60, seed: int = 21) -> list[Path]:
@@ -96,11 +113,13 @@ def write_configs(count: int = 60, seed: int = 21) -> list[Path]:
         path.write_text(head + yaml.safe_dump(sample_config(count, seed, model),
                                               sort_keys=False, width=100))
         paths.append(path)
-    path = CONFIGS / "protocol.yaml"
-    path.write_text("# written by `python -m sweep.bench.random_sample configs`; run by `make "
-                    "random-sample`\n" + yaml.safe_dump(protocol_config(), sort_keys=False,
-                                                        width=100))
-    paths.append(path)
+    for process_zone in (False, True):
+        path = CONFIGS / ("protocol_pz.yaml" if process_zone else "protocol.yaml")
+        path.write_text("# written by `python -m sweep.bench.random_sample configs`; run by "
+                        "`make random-sample`\n"
+                        + yaml.safe_dump(protocol_config(process_zone), sort_keys=False,
+                                         width=100))
+        paths.append(path)
     return paths
 
 
@@ -113,7 +132,7 @@ def outcome(row) -> str:
 
 def summarize(results: Path = RESULTS) -> dict:
     out = {}
-    for model in MODELS + ("protocol",):
+    for model in SAMPLES:
         path = results / f"{model}.h5"
         if not path.exists():
             continue
@@ -212,7 +231,8 @@ def _main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m sweep.bench.random_sample",
                                 description="a random sample across the declared ranges")
     sub = p.add_subparsers(dest="command", required=True)
-    c = sub.add_parser("configs", help="write configs/random/{auto,bem,protocol}.yaml")
+    c = sub.add_parser("configs",
+                       help="write configs/random/{auto,bem,protocol,protocol_pz}.yaml")
     c.add_argument("--count", type=int, default=60)
     c.add_argument("--seed", type=int, default=21)
     sub.add_parser("summary", help="count the outcomes, draw the model map")

@@ -2,6 +2,7 @@
 the generator writes, and the outcome classes of a stored row."""
 from __future__ import annotations
 
+import pytest
 import yaml
 
 from sweep.bench import random_sample
@@ -36,16 +37,21 @@ def test_the_sweep_wall_is_the_span_of_its_scenes_not_their_sum():
     assert df.task_wall_s.sum() == 9.0
 
 
-def test_the_committed_protocol_config_is_the_generators():
-    path = random_sample.CONFIGS / "protocol.yaml"
-    assert yaml.safe_load(path.read_text()) == random_sample.protocol_config()
+@pytest.mark.parametrize("process_zone", [False, True])
+def test_the_committed_protocol_configs_are_the_generators(process_zone):
+    path = random_sample.CONFIGS / ("protocol_pz.yaml" if process_zone else "protocol.yaml")
+    assert yaml.safe_load(path.read_text()) == random_sample.protocol_config(process_zone)
     scenes = load_config(path).scenes()
-    assert len(scenes) == random_sample.PROTOCOL_COUNT
+    count = random_sample.PROTOCOL_PZ_COUNT if process_zone else random_sample.PROTOCOL_COUNT
+    assert len(scenes) == count
     assert all(s.protocol() is not None and s.model == "auto" for s in scenes)
-    # the sample spans both holds, dwells and none, both materials
+    # the sample spans both holds, dwells and none; both materials, or the process zone
     assert {s.dwell_hold for s in scenes} == {"force", "depth"}
     assert any(s.dwell == 0.0 for s in scenes) and any(s.dwell > 0.0 for s in scenes)
-    assert {s.material for s in scenes} == {"mpl", "sls"}
+    if process_zone:
+        assert {s.pz_law for s in scenes} == {"gent-schultz"}
+    else:
+        assert {s.material for s in scenes} == {"mpl", "sls"}
 
 
 def test_a_protocol_rows_failure_names_its_protocol_not_an_a0():
