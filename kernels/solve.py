@@ -136,10 +136,10 @@ StepControl = namedtuple("StepControl", ["step_max", "step_min", "da_max", "step
 #: (0: a new run, record 0 is the initial state; n >= 1: continue after record n - 1, the
 #: stop rule sees all records); step (1,) the indentation step (units of h0), in/out (<= 0
 #: starts at step_max; on return the step the run would take next; step[1], where given, the
-#: time step that made h; step[2], where given, 1 during a lead-in: LEAD_GROWTH); sigma (N,) the traction of h and h_prev (N,) the state before it,
-#: in/out: read when resuming with a process zone (its traction depends on the step that made
-#: h, not on h alone, and Newton starts from the extrapolation through both), on return
-#: those of the last accepted state
+#: time step that made h; step[2], where given, 1 during a lead-in: LEAD_GROWTH); sigma (N,)
+#: the traction of h and h_prev (N,) the state before it, in/out: read when resuming with a
+#: process zone (its traction depends on the step that made h, not on h alone, and Newton
+#: starts from the extrapolation through both), on return those of the last accepted state
 RunState = namedtuple("RunState", ["h", "delta0", "q", "n", "step", "sigma", "h_prev"])
 
 #: the outputs: records t, delta, P, a, a_inner (length >= max_steps + 1: time, indentation,
