@@ -5,12 +5,12 @@ r"""A seeded random sample across the declared ranges, run as a user runs it: ``
 log-uniformly across the Scene's declared ranges, model ``auto`` and the default ``bem``;
 balanced preset, 20 s time budget a scene), ``configs/random/protocol.yaml``: 80 scenes
 with a test protocol (approach, dwell, retract; :func:`protocol_sample`), and
-``configs/random/protocol_pz.yaml``: 40 with a protocol and a process zone. After ``sweep run`` of each (``make
-random-sample``), ``python -m sweep.bench.random_sample summary`` counts, per model, the
-scenes answered (``ok``), physically refused (:func:`sweep.errors.is_physical_refusal`),
-failed otherwise, and hit by an internal error, and the sweep's wall (:func:`scene_span`)
-and its scenes' summed walls, into ``results/random/summary.json``, and
-draws ``results/random/model_map.png``: which model answered each scene, over mu and the
+``configs/random/protocol_pz.yaml``: 40 with a protocol and a process zone. After ``sweep
+run`` of each (``make random-sample``), ``python -m sweep.bench.random_sample summary``
+counts, per sample, the scenes answered (``ok``), physically refused
+(:func:`sweep.errors.is_physical_refusal`), failed otherwise, and hit by an internal error,
+and the sweep's wall (:func:`scene_span`) and its scenes' summed walls, into
+``results/random/summary.json``, and draws ``results/random/model_map.png``: which model answered each scene, over mu and the
 rate, beside the crack-front model's measured difference from the BEM
 (``sweep/engine/model_errors.json``).
 """
