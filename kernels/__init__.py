@@ -8,8 +8,10 @@ interface      the Lennard-Jones traction law, its stiffness, the contact-radius
 influence      the overlapping-triangle influence matrix of the axisymmetric half-space
 history        the Prony recursion of the hereditary integral (O(N M) per step)
 blas           BLAS/LAPACK (scipy's) called from compiled code
+clock          a monotonic clock compiled code reads: the time budget's deadline in the kernels
 jacobian       Newton's linear algebra: a kept factorization, the crack-tip zone exact
 solve          the per-step Newton solve and the unloading loop with its stop rule
+protocol       the march of a test protocol: steps held at a load, the settle at the crack tip
 =============  =================================================================================
 
 The folder sits at the top of the repository (``kernels/``); the wheel installs it inside the

@@ -60,6 +60,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .clock import deadline_after
 from .blas import gemv_cols, gemv_rows, lu_factor, lu_solve
 from .interface import traction_and_stiffness
 
@@ -103,6 +104,7 @@ CACHE_BASE_NODES = 6  # (N) int64: the nodes of B, in order (rows/columns of K)
 CACHE_PIVOTS = 7     # (N + ZONE_MAX) int32: pivots of K, then of Sigma
 CACHE_STATE = 8      # int64, indexed by STATE_*
 CACHE_CONTRACTION = 9  # (1): the chord iteration's contraction estimate (kernels.solve.newton)
+CACHE_DEADLINE = 10  # (1): the time budget's deadline on the kernels' clock (kernels.clock; inf: none)
 #: state[STATE_VALID]: 1 when the cache holds a factorization, 0 to refactorize
 STATE_VALID = 0
 #: state[STATE_SUBSET]: m, the size of the interacting prefix S = [0, m)
@@ -130,18 +132,26 @@ def new_jacobian_cache(N):
     tuple that the kernels take whole.
 
     Returns (base, zone_cols, zone_rows, coupling, schur, E, base_nodes, pivots, state,
-    contraction), positions named by the CACHE_* constants, ``state`` indexed by STATE_*.
+    contraction, deadline), positions named by the CACHE_* constants, ``state`` indexed by
+    STATE_*; no deadline (:func:`set_deadline`).
     """
     z = min(ZONE_MAX, N)
     return (np.empty(N * N, FACTOR_DTYPE), np.empty(z * N, FACTOR_DTYPE),
             np.empty(z * N, FACTOR_DTYPE), np.empty(z * z), np.empty(z * z, FACTOR_DTYPE),
             np.zeros(N), np.zeros(N, np.int64), np.zeros(N + z, np.int32),
-            np.zeros(N_STATE, np.int64), np.ones(1))
+            np.zeros(N_STATE, np.int64), np.ones(1), np.full(1, np.inf))
 
 
 def invalidate(cache):
     """Mark the factorization in ``cache`` stale: the next solve refactorizes."""
     cache[CACHE_STATE][STATE_VALID] = 0
+
+
+def set_deadline(cache, seconds: float):
+    """Give the solves that use ``cache`` a deadline ``seconds`` from now (inf: none): past
+    it, Newton gives up and the unloading kernel ends with STATUS_TIME_BUDGET
+    (:mod:`kernels.clock`; the scene's time budget, ``sweep.engine.budget``)."""
+    cache[CACHE_DEADLINE][0] = deadline_after(float(seconds))
 
 
 def use_drift_scaled(cache, on: bool):

@@ -48,7 +48,10 @@ most of a cold compile; inlined, they are compiled once, within :func:`newton` o
 Status codes returned by :func:`unload`:
 0 finished (stop criterion met), 1 no equilibrium at the minimum step, 2 step limit,
 3 contact reached the mesh edge (domain too small), 4 the crack tip left the fine band of a
-graded mesh (the driver widens it and starts again).
+graded mesh (the driver widens it and starts again), 5 the time budget's deadline passed
+(the Jacobian cache's, :func:`kernels.jacobian.set_deadline`: checked before every try of a
+step, every Newton iteration and every relaxation iteration, so that one call ends within
+about one iteration of it).
 """
 from __future__ import annotations
 
@@ -63,15 +66,17 @@ from .interface import (TIP_GAP, ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Int
                         crossing_radius, lj_traction, smoothing_rate, traction,
                         traction_and_stiffness)
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
-from .jacobian import (CACHE_CONTRACTION, CACHE_STATE, STATE_EXACT, STATE_SCALED,  # noqa: F401
-                       STATE_VALID, apply_inverse, factorize, invalidate,
-                       new_jacobian_cache, newton_direction)
+from .clock import past
+from .jacobian import (CACHE_CONTRACTION, CACHE_DEADLINE, CACHE_STATE,  # noqa: F401
+                       STATE_EXACT, STATE_SCALED, STATE_VALID, apply_inverse, factorize,
+                       invalidate, new_jacobian_cache, newton_direction, set_deadline)
 
 STATUS_DONE = 0
 STATUS_NEWTON_FAILED = 1
 STATUS_STEP_LIMIT = 2
 STATUS_DOMAIN = 3
 STATUS_LEFT_BAND = 4
+STATUS_TIME_BUDGET = 5
 #: (internal) :func:`stop_status` when the run goes on
 STATUS_RUNNING = -1
 
@@ -468,7 +473,8 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
     """Solve F(h) = 0 in place from ``h`` with the interface law ``law``
     (:data:`kernels.interface.Interface`) and a machine of compliance ``compliance`` (1/K;
     0 rigid), load weights ``wP`` (:func:`machine_residual`, :func:`machine_direction`).
-    True on convergence. The Jacobian factorization in the cache is reused, its crack-tip
+    True on convergence; False past the cache's deadline (:func:`kernels.jacobian.set_deadline`,
+    read before every iteration). The Jacobian factorization in the cache is reused, its crack-tip
     zone kept exact (:func:`kernels.jacobian.newton_direction`); it is rebuilt when the
     crack tip left the zone, when a stale one contracts the residual by less than
     SLOW_CONTRACTION, when a line search fails with a stale one, and at every iteration
@@ -482,13 +488,8 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
     state = cache[CACHE_STATE]
     theta = cache[CACHE_CONTRACTION]
     N = h.size
-    sig = np.empty(N)
-    d = np.empty(N)
-    dr = np.empty(N)
-    w = np.empty(N)
-    F = np.empty(N)
-    Ft = np.empty(N)
-    ht = np.empty(N)
+    sig, d, dr, w = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
+    F, Ft, ht = np.empty(N), np.empty(N), np.empty(N)
     norm = machine_residual(h, g, A, ceff, H, law, compliance, wP, sig, w, F)
     stats[STAT_RESIDUALS] += 1
     if norm <= tol:
@@ -498,6 +499,8 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
         _refactorize(h, A, ceff, law, cache, stats, -1)
         fresh = True
     for it in range(max_iter):
+        if past(cache[CACHE_DEADLINE][0]):
+            return False
         stats[STAT_ITER] += 1
         if state[STATE_EXACT] == 1 and not fresh:
             _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_RETRY)
@@ -549,11 +552,12 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
 @njit(cache=True, inline='always')
 def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
     """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success."""
-    return relax_machine(h, g, A, ceff, H, law, 0.0, np.zeros(h.size), tol, max_iter, stats)
+    return relax_machine(h, g, A, ceff, H, law, 0.0, np.zeros(h.size), tol, max_iter, stats,
+                         np.inf)
 
 
 @njit(cache=True, inline='always')
-def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats):
+def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats, deadline):
     """Pseudo-transient continuation to a *stable* equilibrium, in place; True on success.
 
     Integrates the relaxation dh/dtau = -F(h) with linearly implicit Euler steps,
@@ -564,7 +568,8 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats):
     snapping from one node to the next), as the physical system would. One dense
     factorization per iteration: a fallback, not the main path. A compliant machine
     (``compliance`` = 1/K, load weights ``wP``) adds -compliance 2 pi wP_j sigma'_j to every
-    row of J (:func:`machine_residual`).
+    row of J (:func:`machine_residual`). False once ``deadline`` (the kernels' clock,
+    :mod:`kernels.clock`; inf: none) has passed, read before every iteration.
     """
     N = h.size
     sig = np.empty(N)
@@ -583,6 +588,8 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats):
     for it in range(max_iter):
         if norm <= tol:
             return True
+        if past(deadline):
+            return False
         stats[STAT_ITER] += 1
         stats[STAT_FACTOR] += 1
         traction_and_stiffness(h, law.h_old, law.zone, law.h0, law.c, sig, d, w)
@@ -1056,7 +1063,7 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
         return SNAPPED
     _copy(work.h, hp)
     if relax_machine(hp, work.g, A, ceff, work.H, law, compliance, wP, tol, RELAX_MAX_ITER,
-                     stats):
+                     stats, cache[CACHE_DEADLINE][0]):
         return SNAPPED
     return FAILED
 
@@ -1185,20 +1192,17 @@ def unload(mesh, physics, control, start, records, cache, stats):
     physics : Physics (h0, c, weights, times, rate, hdot_c, xi, compliance).
     control : StepControl (step_max, step_min, da_max, step_tol, tol, max_iter, max_steps,
         stop_mode, min_travel, tip_lo, tip_hi, da_max_pulloff, pulloff_zone).
-    start : RunState (h, delta0, q, n, step, sigma, h_prev); q, step, sigma and h_prev are
-        in/out.
+    start : RunState (h, delta0, q, n, step, sigma, h_prev); q, step, sigma, h_prev in/out.
     records : Records (t, delta, P, a, a_inner, h), written.
-    cache : tuple
-        The Jacobian cache (:func:`new_jacobian_cache`); may carry the factorization of
-        the initial solve.
+    cache : the Jacobian cache (:func:`new_jacobian_cache`): the initial solve's
+        factorization, and the deadline (:func:`kernels.jacobian.set_deadline`).
     stats : int64 array of length N_STATS (incremented).
 
     Returns
     -------
     (status, n_records)
     """
-    h0 = physics.h0
-    hm = TIP_GAP * h0
+    h0, hm = physics.h0, TIP_GAP * physics.h0
     work = new_work(mesh.r, start.h, start.q)
     run = np.zeros(N_RUN)
     n, i_min = start_run(mesh, physics, start, records, work, run, hm)
@@ -1207,6 +1211,9 @@ def unload(mesh, physics, control, start, records, cache, stats):
     easy = 0
     status = STATUS_STEP_LIMIT
     while n <= control.max_steps:
+        if past(cache[CACHE_DEADLINE][0]):
+            status = STATUS_TIME_BUDGET
+            break
         da_max = control.da_max
         if control.da_max_pulloff < da_max and near_pulloff(records, n, control.pulloff_zone):
             da_max = control.da_max_pulloff
@@ -1216,8 +1223,9 @@ def unload(mesh, physics, control, start, records, cache, stats):
             easy = 0
             if outcome == HALVED:
                 continue
-            if outcome == FAILED:
-                status = STATUS_NEWTON_FAILED
+            if outcome == FAILED:        # a solve the deadline cut short is no failure
+                status = (STATUS_TIME_BUDGET if past(cache[CACHE_DEADLINE][0])
+                          else STATUS_NEWTON_FAILED)
                 break
             quadratic = False
         accepted, a_new, da = control_step(mesh, physics, control, work, run, hm, stats, da_max)

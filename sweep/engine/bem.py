@@ -30,7 +30,7 @@ import numpy as np
 
 from ..kernels.solve import (N_STATS, STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND,
                              STATUS_STEP_LIMIT, MeshArrays, Physics, Records, RunState,
-                             StepControl, invalidate, unload)
+                             StepControl, invalidate, set_deadline, unload)
 from ..errors import NUMERICAL_ERRORS, is_internal_error
 from ..kernels.interface import lj_traction
 from ..kernels.jacobian import use_drift_scaled
@@ -159,12 +159,16 @@ class UnloadingState:
                    h_prev=np.zeros(N))
 
 
-def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int:
+def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int,
+                 deadline: float = math.inf) -> int:
     """Continue the unloading ``run`` on ``pb``'s mesh by at most ``steps`` time steps (in
     place); returns the kernel's status (STATUS_STEP_LIMIT: the chunk ended, call again).
 
     ``tip_range`` (a_ref) bounds the crack tip (STATUS_LEFT_BAND when it leaves). The state
     may be carried to another mesh between calls (its arrays interpolated) and continued.
+    ``deadline`` (``time.perf_counter()`` seconds) ends the call with STATUS_TIME_BUDGET
+    within about one Newton iteration of it: the kernel reads it (a chunk on a large mesh
+    lasts minutes), and a run that meets it is not changed by it.
     """
     numerics = pb.numerics
     h_out = np.empty(pb.mesh.nodes)
@@ -184,12 +188,14 @@ def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int) -> int
                           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *tip_range,
                           da_max_pulloff * pb.mesh.spacing,
                           PULLOFF_ZONE_SPACINGS * pb.mesh.spacing)
+    set_deadline(run.cache, deadline - time.perf_counter())
     status, run.n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
                            Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, pb.scene.rate,
                                    pb.hdot_c, pb.pz_xi, pb.machine_compliance),
                            control, RunState(run.h, run.delta0, run.q, run.n, run.step,
                                              run.sigma, run.h_prev),
                            Records(*run.records, h_out), run.cache, run.stats)
+    set_deadline(run.cache, math.inf)
     run.h = h_out
     return int(status)
 
@@ -247,7 +253,7 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
 def _unload(pb: Problem, run: UnloadingState, deadline: float) -> int:
     """The unloading kernel in chunks of CHUNK_STEPS until it ends, or the deadline does."""
     while True:
-        status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS)
+        status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS, deadline)
         if status != STATUS_STEP_LIMIT or run.n > pb.numerics.max_steps:
             return status
         if time.perf_counter() > deadline:

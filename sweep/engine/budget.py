@@ -4,7 +4,8 @@
 (:func:`scene_budget`); every model, retry and stage of the scene then reads the same deadline
 (:func:`deadline`) and checks it (:func:`check`): the auto chooser's fallbacks, the error
 estimate's coarser solve, the relaxed start's Newton solves, the tip-following mesh's
-re-meshings, the unloading's kernel chunks and the crack-front integrator. A scene that runs
+re-meshings, the unloading kernel (between its chunks, and within them: it reads the
+deadline before every Newton iteration) and the crack-front integrator. A scene that runs
 past it ends as a failed row whose reason starts ``time budget:``, within the budget plus the
 longest stretch between two checks (:data:`CHECK_SLACK_S`, measured by
 ``tests/engine/test_budget.py`` on the scene that hung a sweep before).
@@ -28,13 +29,14 @@ __all__ = ["OverBudget", "scene_budget", "deadline", "remaining", "budget_second
 #: (deadline in time.perf_counter() seconds, the budget in seconds) of the scene being run
 _BUDGET: ContextVar[tuple[float, float] | None] = ContextVar("scene_budget", default=None)
 
-#: the slack a scene may run past its budget: the longest stretch between two checks, one
-#: kernel chunk of unloading steps (sweep.engine.bem.CHUNK_STEPS) or one elastic Newton solve
-#: of the relaxed start. Measured (2026-11-26, 2-core machine under a load of 3): chunks of
-#: at most 1.5 s on 1019 nodes, 3.9 s on 1035 and 4.8 s on 1175 (accurate preset, a0 8 and
-#: 11 at mu 3.24, a0 3 at mu 30); a chunk costs about nodes^2, so meshes beyond the presets'
-#: max_nodes (up to 5000 given by nodes) may run past it. tests/engine/test_budget.py asserts
-#: it on the scene of issue 33.
+#: the slack a scene may run past its budget: the longest stretch between two checks. The
+#: unloading kernel reads the deadline itself before every Newton iteration
+#: (kernels.jacobian.set_deadline): one chunk of its steps (sweep.engine.bem.CHUNK_STEPS)
+#: lasted 1.5-4.8 s on 1019-1175 nodes (2026-11-26, a 2-core machine under a load of 3) and
+#: 105 s on a process-zone scene's 2301 nodes (2026-11-27). What is left is one elastic
+#: Newton solve of the relaxed start, one chunk of a protocol's march
+#: (sweep.engine.protocol.DWELL_CHUNK_STEPS) and one re-meshing of the tip-following mesh.
+#: tests/engine/test_budget.py asserts it on the scene of issue 33 and on that scene.
 CHECK_SLACK_S = 10.0
 
 

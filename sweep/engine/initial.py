@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..kernels.interface import TIP_GAP, crossing_radius, lennard_jones
-from ..kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton
+from ..kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton, set_deadline
 
 from . import budget, diskcache
 from .problem import jkr_radius
@@ -104,12 +104,17 @@ class ElasticSolver:
         self.stats = np.zeros(N_STATS, dtype=np.int64)
 
     def solve(self, delta, guess):
+        """(converged, gap) of the elastic LJ equilibrium at ``delta`` by Newton from
+        ``guess``. Newton reads the scene's deadline (a solve on a large mesh lasts seconds):
+        one it cut short raises :class:`sweep.engine.budget.OverBudget`, not a failed solve."""
         budget.check("the relaxed start (elastic solves)")
         h = np.array(guess, dtype=float)
         g = -delta + self.h0 + 0.5 * self.r**2
+        set_deadline(self.cache, budget.remaining())
         ok = newton(h, g, self.A, 1.0, self.zero, self.law, self.tol * self.h0,
                     MAX_NEWTON_ITER_INITIAL, self.cache, self.stats)
         if not ok:
+            budget.check("the relaxed start (elastic solves)")
             invalidate(self.cache)   # refactorize next time
         return ok, h
 

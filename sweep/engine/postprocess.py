@@ -7,10 +7,10 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..kernels.solve import STATUS_DOMAIN, STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT, stop_reached
-
-#: status of a run stopped by ``Numerics.time_budget_s`` (beside the kernel's STATUS_*)
-STATUS_TIME_BUDGET = -1
+# STATUS_TIME_BUDGET: a run stopped by ``Numerics.time_budget_s``, between kernel calls or by
+# the kernel itself (its deadline, kernels.jacobian.set_deadline)
+from ..kernels.solve import (STATUS_DOMAIN, STATUS_NEWTON_FAILED, STATUS_STEP_LIMIT,
+                             STATUS_TIME_BUDGET, stop_reached)
 
 #: a compliant machine (stiffness K) holds the sphere while dP/ddelta > -K: past the load
 #: minimum the load rises until the slope reaches -K, where the sphere jumps off (the

@@ -44,7 +44,7 @@ import numpy as np
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import (crossing_radius, lennard_jones, lj_traction, smoothing_rate,
                                  zone_factor)
-from ..kernels.jacobian import use_drift_scaled
+from ..kernels.jacobian import set_deadline, use_drift_scaled
 from ..kernels.protocol import (CLOCK_A, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, CLOCK_DT_PREV2,
                                 CLOCK_GUESS, CLOCK_MADE, CLOCK_RING, CLOCK_SIZE, CLOCK_T,
                                 CLOCK_P, CLOCK_PHASE, CLOCK_TIP_SCORE, APPROACH_PASSED,
@@ -674,11 +674,24 @@ def run_phases(pb, protocol: Protocol, stats, compiled: bool = True):
     """Approach and dwell on the prepared problem ``pb``, the solver's counters into
     ``stats`` (:data:`sweep.kernels.solve.N_STATS`): the march (:class:`_March`) whose state
     and records the retraction continues. ``compiled`` False: every step in Python
-    (:func:`_approach`, :func:`_dwell`), the compiled march's reference."""
+    (:func:`_approach`, :func:`_dwell`), the compiled march's reference.
+
+    The march's solves read the scene's deadline (:mod:`sweep.engine.budget`; Newton gives up
+    past it, :func:`sweep.kernels.jacobian.set_deadline`), and a march that fails past it
+    raises :class:`sweep.engine.budget.OverBudget`, not the failure."""
     h, delta = first_contact(pb, stats)
     m = _March(pb, h, delta, stats)
-    _approach(m, protocol, compiled)
-    _dwell(m, protocol, compiled)
+    set_deadline(m.cache, budget.remaining())
+    try:
+        _approach(m, protocol, compiled)
+        _dwell(m, protocol, compiled)
+    except budget.OverBudget:
+        raise
+    except RuntimeError:
+        budget.check("the protocol's march")
+        raise
+    finally:
+        set_deadline(m.cache, np.inf)
     return m
 
 

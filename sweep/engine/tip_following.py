@@ -591,7 +591,8 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
     while True:
         probing, n_before, t_chunk = run.n <= 1, run.n, time.perf_counter()
-        status = unload_chunk(pb, run, pb.tip_range, PROBE_STEPS if probing else CHUNK_STEPS)
+        status = unload_chunk(pb, run, pb.tip_range, PROBE_STEPS if probing else CHUNK_STEPS,
+                              deadline)
         broken = _continuity(run, remeshed_at, rtol)
         if broken:
             break

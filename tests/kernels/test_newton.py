@@ -185,6 +185,30 @@ def test_newton_solves_the_discrete_equilibrium():
     assert np.max(np.abs(hs - h_start)) > 1e-3 * h0          # it did move
 
 
+def test_newton_gives_up_past_its_deadline_and_meets_it_unchanged():
+    """The cache's deadline (the scene's time budget, read before every iteration): passed,
+    Newton returns unconverged without an iteration; far off, it is the solve without one,
+    bit for bit."""
+    from sweep.engine.initial import ElasticSolver, relaxed_state
+    A, _, h0, c, _ = _problem(N=120, seed=3)
+    r = np.arange(120) * 3.0 / 119
+    h_start, _ = relaxed_state(ElasticSolver(A, r, h0, c, 1e-10), delta0=1.0)
+    g = -(1.0 - 0.2 * h0) + h0 + 0.5 * r**2
+    H = -0.05 * np.exp(-r)
+    law = lennard_jones(h0, c, 120)
+    solved = {}
+    for seconds in (np.inf, 1e6, -1.0):
+        cache, stats = ks.new_jacobian_cache(120), np.zeros(ks.N_STATS, np.int64)
+        ks.set_deadline(cache, seconds)
+        h = h_start.copy()
+        solved[seconds] = (ks.newton(h, g, A, 0.8, H, law, 1e-10 * h0, 40, cache, stats), h,
+                           stats[ks.STAT_ITER])
+    assert solved[np.inf][0] and solved[np.inf][2] > 0
+    assert solved[1e6][0] and solved[1e6][2] == solved[np.inf][2]
+    np.testing.assert_array_equal(solved[1e6][1], solved[np.inf][1])
+    assert not solved[-1.0][0] and solved[-1.0][2] == 0
+
+
 def test_solves_ended_on_the_predicted_residual_meet_the_tolerance():
     # a continuation in the indentation (linear predictor): where the residual predicted
     # after the first update (the contraction last measured times |F|) is below

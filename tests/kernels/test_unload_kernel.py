@@ -7,8 +7,9 @@ predictors are exact for polynomials in time of their order.
 import numpy as np
 import pytest
 
-from sweep.kernels.solve import (N_STATS, STATUS_DONE, STATUS_STEP_LIMIT, MeshArrays, Physics,
-                                 Records, RunState, StepControl, new_jacobian_cache, unload)
+from sweep.kernels.solve import (N_STATS, STAT_ITER, STATUS_DONE, STATUS_STEP_LIMIT,
+                                 STATUS_TIME_BUDGET, MeshArrays, Physics, Records, RunState,
+                                 StepControl, new_jacobian_cache, set_deadline, unload)
 from sweep.engine.initial import ElasticSolver, relaxed_state
 from sweep.engine.problem import prepare
 from sweep.scene import Numerics, Scene
@@ -19,7 +20,7 @@ NUMERICS = Numerics(mesh="uniform", nodes=120, domain=3.0, step=0.25, da_max=1.0
                     prony_rtol=1e-3, tol=1e-10, pull_off_rtol=0.0)
 
 
-def _run(chunk):
+def _run(chunk, deadline_s=np.inf):
     pb = prepare(SCENE, NUMERICS)
     el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, NUMERICS.tol)
     h, delta0 = relaxed_state(el, a0=SCENE.a0)
@@ -31,6 +32,7 @@ def _run(chunk):
     n, calls = 0, 0
     while True:
         h_out = np.empty(N)
+        set_deadline(cache, deadline_s)
         limit = NUMERICS.max_steps if chunk is None else min(n + chunk, NUMERICS.max_steps)
         control = StepControl(NUMERICS.step, NUMERICS.min_step, NUMERICS.da_max * pb.mesh.spacing,
                               STEP_TOL, NUMERICS.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
@@ -45,12 +47,12 @@ def _run(chunk):
         h = h_out
         if status != STATUS_STEP_LIMIT or limit >= NUMERICS.max_steps:
             break
-    return status, n, calls, [x[:n] for x in out]
+    return status, n, calls, [x[:n] for x in out], stats
 
 
 def test_unloading_resumed_in_chunks_reproduces_one_run():
-    s1, n1, c1, (t1, d1, P1, a1, _) = _run(None)
-    s2, n2, c2, (t2, d2, P2, a2, _) = _run(5)
+    s1, n1, c1, (t1, d1, P1, a1, _), _ = _run(None)
+    s2, n2, c2, (t2, d2, P2, a2, _), _ = _run(5)
     assert s1 == s2 == STATUS_DONE
     assert c1 == 1 and c2 >= 5
     # the predictor restarts at each resume, so the steps may differ slightly: compare
@@ -59,6 +61,27 @@ def test_unloading_resumed_in_chunks_reproduces_one_run():
     assert abs(d1[P1.argmin()] - d2[P2.argmin()]) < 2 * NUMERICS.step * prepare(SCENE, NUMERICS).h0
     # the records of a resumed run continue in time
     assert np.all(np.diff(t2) > 0)
+
+
+def test_a_deadline_the_run_meets_changes_nothing():
+    """The kernel reads its deadline (the scene's time budget) before every try of a step
+    and every Newton iteration; a run that ends before it is the run without one, bit for
+    bit."""
+    s1, n1, _, records1, stats1 = _run(None)
+    s2, n2, _, records2, stats2 = _run(None, deadline_s=1e6)
+    assert s1 == s2 == STATUS_DONE and n1 == n2
+    for x, y in zip(records1, records2):
+        np.testing.assert_array_equal(x, y)
+    np.testing.assert_array_equal(stats1, stats2)
+
+
+def test_a_passed_deadline_ends_the_kernel_before_its_first_step():
+    """Past its deadline the kernel takes no step and says so: one chunk of a large mesh
+    ran for minutes past the scene's budget when only the driver checked it, between
+    chunks."""
+    status, n, calls, records, stats = _run(None, deadline_s=-1.0)
+    assert status == STATUS_TIME_BUDGET and calls == 1
+    assert n == 1 and stats[STAT_ITER] == 0          # record 0, the initial state, alone
 
 
 def test_solver_in_small_chunks_gives_the_same_result(monkeypatch):
