@@ -33,10 +33,11 @@ _BUDGET: ContextVar[tuple[float, float] | None] = ContextVar("scene_budget", def
 #: unloading kernel reads the deadline itself before every Newton iteration
 #: (kernels.jacobian.set_deadline): one chunk of its steps (sweep.engine.bem.CHUNK_STEPS)
 #: lasted 1.5-4.8 s on 1019-1175 nodes (2026-11-26, a 2-core machine under a load of 3) and
-#: 105 s on a process-zone scene's 2301 nodes (2026-11-27). The relaxed start's and the
-#: protocol's march's Newton solves read it too. What is left is one Newton iteration (a
-#: factorization: a fraction of a second at 2500 nodes) and one re-meshing of the
-#: tip-following mesh (an LU of its influence matrix, a re-equilibration). Scenes asked for
+#: 105 s on a process-zone scene's 2301 nodes (2026-11-27). The Newton solves of the
+#: relaxed start, of the protocol's first contact and march, and of the tip-following
+#: mesh's re-equilibration read it too. What is left is one Newton iteration (a
+#: factorization: a fraction of a second at 2500 nodes) and the LU of a re-meshing's
+#: influence matrix. Scenes asked for
 #: 1e-3 with 5 s budgets ended 0.01-0.04 s past them on 1038-1065 nodes (docs/numerics.md).
 #: tests/engine/test_budget.py asserts it on the scene of issue 33 and on that scene.
 CHECK_SLACK_S = 10.0

@@ -662,10 +662,12 @@ def first_contact(pb, stats):
     delta = d_s * (a * a - np.sqrt(2.0 * a))
     h = d_s * jkr_gap_guess(pb.mesh.r / a_s, delta / d_s, pb.h0 / d_s)
     N = h.size
+    cache = new_jacobian_cache(N)
+    set_deadline(cache, budget.remaining())
     ok = newton(h, -delta + pb.h0 + 0.5 * pb.mesh.r ** 2, pb.A, k, np.zeros(N),
-                lennard_jones(pb.h0, pb.c, N), pb.numerics.tol * pb.h0, MAX_ITER,
-                new_jacobian_cache(N), stats)
+                lennard_jones(pb.h0, pb.c, N), pb.numerics.tol * pb.h0, MAX_ITER, cache, stats)
     if not ok:
+        budget.check("the protocol's first contact")
         raise RuntimeError(f"no glassy contact at first touch (delta = {delta:.4g})")
     return h, float(delta)
 

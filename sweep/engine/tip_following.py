@@ -41,7 +41,7 @@ from scipy.optimize import brentq
 
 from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
                            STATUS_LEFT_BAND, STATUS_STEP_LIMIT, invalidate, new_jacobian_cache,
-                           newton)
+                           newton, set_deadline)
 from ..kernels.interface import (ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Interface,
                                  lennard_jones, lj_traction, smoothing_rate, traction)
 
@@ -305,8 +305,12 @@ def _reequilibrate(run, new, h, ceff, H, law):
     g = -float(run.records[1][run.n - 1]) + new.h0 + 0.5 * new.mesh.r**2
     h_eq = h.copy()
     stats = run.stats if run.stats is not None else np.zeros(N_STATS, dtype=np.int64)
+    cache = new_jacobian_cache(h.size)
+    set_deadline(cache, budget.remaining())
     ok = newton(h_eq, g, new.A, ceff, H, law,
-                new.numerics.tol * new.h0, REEQUILIBRATE_ITER, new_jacobian_cache(h.size), stats)
+                new.numerics.tol * new.h0, REEQUILIBRATE_ITER, cache, stats)
+    if not ok:
+        budget.check("the tip-following mesh's re-equilibration")
     return h_eq if ok else None
 
 
@@ -614,10 +618,10 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                 budget.check(f"the tip-following mesh's re-meshing at a = {a[run.n - 1]:.4g}")
                 new = prepare(scene, numerics,
                               tip_window(a[run.n - 1], zone, ahead, behind, direction))
+                transfer(run, pb, new)
             except (Refused, OverBudget) as exc:
                 res.reason = f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"
                 return res
-            transfer(run, pb, new)
             remeshed_at.append(run.n)
             marks.append(run.n)
             pb, meshes, nodes = new, meshes + 1, max(nodes, new.mesh.nodes)
