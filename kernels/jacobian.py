@@ -60,8 +60,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .clock import deadline_after
 from .blas import gemv_cols, gemv_rows, lu_factor, lu_solve
+from .clock import deadline_after
 from .interface import traction_and_stiffness
 
 #: a node belongs to the factorized set S when A_ii |E_i| exceeds this (the columns left
@@ -104,7 +104,7 @@ CACHE_BASE_NODES = 6  # (N) int64: the nodes of B, in order (rows/columns of K)
 CACHE_PIVOTS = 7     # (N + ZONE_MAX) int32: pivots of K, then of Sigma
 CACHE_STATE = 8      # int64, indexed by STATE_*
 CACHE_CONTRACTION = 9  # (1): the chord iteration's contraction estimate (kernels.solve.newton)
-CACHE_DEADLINE = 10  # (1): the time budget's deadline on the kernels' clock (kernels.clock; inf: none)
+CACHE_DEADLINE = 10  # (1): the time budget's deadline, kernels.clock's time (inf: none)
 #: state[STATE_VALID]: 1 when the cache holds a factorization, 0 to refactorize
 STATE_VALID = 0
 #: state[STATE_SUBSET]: m, the size of the interacting prefix S = [0, m)

@@ -473,12 +473,12 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
     """Solve F(h) = 0 in place from ``h`` with the interface law ``law``
     (:data:`kernels.interface.Interface`) and a machine of compliance ``compliance`` (1/K;
     0 rigid), load weights ``wP`` (:func:`machine_residual`, :func:`machine_direction`).
-    True on convergence; False past the cache's deadline (:func:`kernels.jacobian.set_deadline`,
-    read before every iteration). The Jacobian factorization in the cache is reused, its crack-tip
-    zone kept exact (:func:`kernels.jacobian.newton_direction`); it is rebuilt when the
-    crack tip left the zone, when a stale one contracts the residual by less than
-    SLOW_CONTRACTION, when a line search fails with a stale one, and at every iteration
-    while ``state[STATE_EXACT]`` is set.
+    True on convergence; False past the cache's deadline (read before every iteration,
+    :func:`kernels.jacobian.set_deadline`). The cache's factorization is reused, its crack-tip
+    zone kept exact (:func:`kernels.jacobian.newton_direction`); it is rebuilt when the crack
+    tip left the zone, when a stale one contracts the residual by less than SLOW_CONTRACTION,
+    when a line search fails with a stale one, and at every iteration while
+    ``state[STATE_EXACT]`` is set.
 
     Converged means max |F| <= ``tol``: computed, or, after a first full update, predicted
     below PREDICTED_RESIDUAL ``tol`` as |F| times the contraction last measured (kept in

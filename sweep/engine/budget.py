@@ -23,8 +23,10 @@ import time
 from contextlib import contextmanager
 from contextvars import ContextVar
 
+from ..kernels.jacobian import set_deadline
+
 __all__ = ["OverBudget", "scene_budget", "deadline", "remaining", "budget_seconds", "check",
-           "CHECK_SLACK_S"]
+           "arm", "CHECK_SLACK_S"]
 
 #: (deadline in time.perf_counter() seconds, the budget in seconds) of the scene being run
 _BUDGET: ContextVar[tuple[float, float] | None] = ContextVar("scene_budget", default=None)
@@ -37,8 +39,8 @@ _BUDGET: ContextVar[tuple[float, float] | None] = ContextVar("scene_budget", def
 #: relaxed start, of the protocol's first contact and march, and of the tip-following
 #: mesh's re-equilibration read it too. What is left is one Newton iteration (a
 #: factorization: a fraction of a second at 2500 nodes) and the LU of a re-meshing's
-#: influence matrix. Scenes asked for
-#: 1e-3 with 5 s budgets ended 0.01-0.04 s past them on 1038-1065 nodes (docs/numerics.md).
+#: influence matrix. Scenes asked for 1e-3 with 5 s budgets ended 0.01-0.04 s past them on
+#: 1038-1065 nodes (docs/numerics.md).
 #: tests/engine/test_budget.py asserts it on the scene of issue 33 and on that scene.
 CHECK_SLACK_S = 10.0
 
@@ -99,3 +101,10 @@ def check(where: str) -> None:
         raise OverBudget(f"time budget: {outer[1]:g} s spent in {where}; give it more "
                          f"(numerics time_budget_s) or cheaper numerics (preset fast, lower "
                          f"band_resolution, or model crack)")
+
+
+def arm(cache) -> None:
+    """Give the Newton solves that use the Jacobian ``cache`` the running scene's deadline
+    (none outside a scene): past it they give up (:func:`sweep.kernels.jacobian.set_deadline`)
+    and the caller's :func:`check` after the failed solve raises :class:`OverBudget`."""
+    set_deadline(cache, remaining())

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..kernels.interface import TIP_GAP, crossing_radius, lennard_jones
-from ..kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton, set_deadline
+from ..kernels.solve import N_STATS, invalidate, new_jacobian_cache, newton
 
 from . import budget, diskcache
 from .problem import jkr_radius
@@ -110,7 +110,7 @@ class ElasticSolver:
         budget.check("the relaxed start (elastic solves)")
         h = np.array(guess, dtype=float)
         g = -delta + self.h0 + 0.5 * self.r**2
-        set_deadline(self.cache, budget.remaining())
+        budget.arm(self.cache)
         ok = newton(h, g, self.A, 1.0, self.zero, self.law, self.tol * self.h0,
                     MAX_NEWTON_ITER_INITIAL, self.cache, self.stats)
         if not ok:

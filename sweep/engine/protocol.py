@@ -663,7 +663,7 @@ def first_contact(pb, stats):
     h = d_s * jkr_gap_guess(pb.mesh.r / a_s, delta / d_s, pb.h0 / d_s)
     N = h.size
     cache = new_jacobian_cache(N)
-    set_deadline(cache, budget.remaining())
+    budget.arm(cache)
     ok = newton(h, -delta + pb.h0 + 0.5 * pb.mesh.r ** 2, pb.A, k, np.zeros(N),
                 lennard_jones(pb.h0, pb.c, N), pb.numerics.tol * pb.h0, MAX_ITER, cache, stats)
     if not ok:
@@ -683,7 +683,7 @@ def run_phases(pb, protocol: Protocol, stats, compiled: bool = True):
     raises :class:`sweep.engine.budget.OverBudget`, not the failure."""
     h, delta = first_contact(pb, stats)
     m = _March(pb, h, delta, stats)
-    set_deadline(m.cache, budget.remaining())
+    budget.arm(m.cache)
     try:
         _approach(m, protocol, compiled)
         _dwell(m, protocol, compiled)

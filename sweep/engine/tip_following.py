@@ -41,7 +41,7 @@ from scipy.optimize import brentq
 
 from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
                            STATUS_LEFT_BAND, STATUS_STEP_LIMIT, invalidate, new_jacobian_cache,
-                           newton, set_deadline)
+                           newton)
 from ..kernels.interface import (ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Interface,
                                  lennard_jones, lj_traction, smoothing_rate, traction)
 
@@ -306,7 +306,7 @@ def _reequilibrate(run, new, h, ceff, H, law):
     h_eq = h.copy()
     stats = run.stats if run.stats is not None else np.zeros(N_STATS, dtype=np.int64)
     cache = new_jacobian_cache(h.size)
-    set_deadline(cache, budget.remaining())
+    budget.arm(cache)
     ok = newton(h_eq, g, new.A, ceff, H, law,
                 new.numerics.tol * new.h0, REEQUILIBRATE_ITER, cache, stats)
     if not ok:
