@@ -42,7 +42,7 @@ help:
 	@echo "make pz-check - the BEM's process zone vs the crack-front model, and its cost (results/process_zone/)"
 	@echo "make protocol-cost - a protocol scene's wall time against its relaxed start (results/protocol/)"
 	@echo "make pz-map - the process zone's map from crack speed to opening rate (the table the BEM reads, ~1 min)"
-	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem, 80 with a test protocol, 40 with a protocol and a process zone (results/random/)"
+	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem, 80 with a test protocol, 40 with a protocol and a process zone, 40 with a protocol at mu 6-30 (results/random/)"
 	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
 	@echo "make extrapolation - the estimate's pair as a Richardson pair and the crossing check, on two samples' references (~1 min)"
 	@echo "make crack-speed [QUICK=1] - the crack speed at pull-off per preset against a fine reference, per fit window (results/crack_speed/, ~6 min)"
@@ -270,8 +270,8 @@ crack-speed: $(STAMP)
 # issue 21: a random sample across the declared ranges through `sweep run`, model auto and the
 # default bem (configs/random/, written by `python -m sweep.bench.random_sample configs`),
 # 24 process-zone scenes on the BEM (configs/random/process_zone.yaml, issue 35), 80 scenes
-# with a test protocol and 40 with a protocol and a process zone (configs/random/protocol*.yaml,
-# issue 36);
+# with a test protocol, 40 with a protocol and a process zone and 40 with a protocol at mu 6-30
+# (on the tip-following mesh) (configs/random/protocol*.yaml, issue 36);
 # the summary counts ok / physically refused / failed / internal errors and draws the map
 random-sample: $(STAMP)
 	-$(BIN)/sweep run configs/random/auto.yaml -j 2
@@ -279,6 +279,7 @@ random-sample: $(STAMP)
 	-$(BIN)/sweep run configs/random/process_zone.yaml -j 2
 	-$(BIN)/sweep run configs/random/protocol.yaml -j 2
 	-$(BIN)/sweep run configs/random/protocol_pz.yaml -j 2
+	-$(BIN)/sweep run configs/random/protocol_tabor.yaml -j 2
 	$(BIN)/python -m sweep.bench.random_sample summary
 
 clean:

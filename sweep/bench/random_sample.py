@@ -34,13 +34,17 @@ RESULTS = ROOT / "results" / "random"
 MODELS = ("auto", "bem")
 BUDGET_S = 20.0
 #: the protocol sample (``configs/random/protocol.yaml``): its size, seed, and ranges,
-#: log-uniform but n (uniform). mu stays at or below 6: a protocol runs on the BEM's graded
-#: mesh, whose fine band reaches in to first contact, and at the balanced preset that band
-#: exceeds max_nodes (1000) from mu of about 7 (the engine's refusal, "mesh too large"; 16
-#: of 40 scenes drawn at mu 1-20)
+#: log-uniform but n (uniform). mu stays at or below 6, where the protocol's graded mesh, whose
+#: fine band reaches in to first contact, holds it at the balanced preset (beyond, from mu of
+#: about 7, the tip-following mesh runs it: the sample below)
 PROTOCOL_COUNT, PROTOCOL_SEED = 80, 41
 PROTOCOL_RANGES = {"k": (0.005, 0.9), "mu": (0.3, 6.0), "rate": (1e-2, 1e6),
                    "approach_rate": (1e-2, 1e6), "preload": (0.05, 20.0)}
+#: the protocol sample at large Tabor parameters (``configs/random/protocol_tabor.yaml``):
+#: the same ranges but mu, drawn where the graded band exceeds max_nodes and the protocol
+#: runs on the tip-following mesh (:class:`sweep.engine.tip_following.MarchWindow`)
+PROTOCOL_TABOR_COUNT, PROTOCOL_TABOR_SEED = 40, 43
+PROTOCOL_TABOR_MU = (6.0, 30.0)
 #: a fifth of the scenes without a dwell, the others a dwell of 0.01-1e4 tau0 (log-uniform),
 #: held at depth in three of ten; a fifth SLS
 PROTOCOL_DWELL = (0.01, 1e4)
@@ -49,7 +53,7 @@ PROTOCOL_DWELL = (0.01, 1e4)
 PROTOCOL_PZ_COUNT, PROTOCOL_PZ_SEED = 40, 77
 PROTOCOL_PZ_V0, PROTOCOL_PZ_XI = (0.3, 30.0), (0.3, 0.8)
 #: the samples ``summary`` counts: the two of :data:`MODELS`, and the protocols'
-SAMPLES = MODELS + ("protocol", "protocol_pz")
+SAMPLES = MODELS + ("protocol", "protocol_pz", "protocol_tabor")
 
 
 def sample_config(count: int, seed: int, model: str) -> dict:
@@ -63,12 +67,13 @@ def sample_config(count: int, seed: int, model: str) -> dict:
 
 
 def protocol_sample(count: int = PROTOCOL_COUNT, seed: int = PROTOCOL_SEED,
-                    process_zone: bool = False) -> list[dict]:
+                    process_zone: bool = False, mu: tuple | None = None) -> list[dict]:
     """``count`` scenes with a test protocol (approach, dwell, retract), drawn from
-    :data:`PROTOCOL_RANGES` and :data:`PROTOCOL_DWELL`, 4 significant digits;
-    ``process_zone``: each with the Gent-Schultz process zone (:data:`PROTOCOL_PZ_V0`,
-    :data:`PROTOCOL_PZ_XI`), MPL only."""
+    :data:`PROTOCOL_RANGES` (mu from ``mu`` where given) and :data:`PROTOCOL_DWELL`, 4
+    significant digits; ``process_zone``: each with the Gent-Schultz process zone
+    (:data:`PROTOCOL_PZ_V0`, :data:`PROTOCOL_PZ_XI`), MPL only."""
     rng = np.random.default_rng(seed)
+    ranges = PROTOCOL_RANGES if mu is None else {**PROTOCOL_RANGES, "mu": mu}
 
     def log_uniform(lo, hi):
         return float(f"{math.exp(rng.uniform(math.log(lo), math.log(hi))):.4g}")
@@ -76,7 +81,7 @@ def protocol_sample(count: int = PROTOCOL_COUNT, seed: int = PROTOCOL_SEED,
     out = []
     for _ in range(count):
         d = {"n": float(f"{rng.uniform(0.2, 1.9):.4g}")}
-        d.update({name: log_uniform(lo, hi) for name, (lo, hi) in PROTOCOL_RANGES.items()})
+        d.update({name: log_uniform(lo, hi) for name, (lo, hi) in ranges.items()})
         d["dwell"] = 0.0 if rng.uniform() < 0.2 else log_uniform(*PROTOCOL_DWELL)
         d["dwell_hold"] = "depth" if rng.uniform() < 0.3 else "force"
         if process_zone:
@@ -89,15 +94,19 @@ def protocol_sample(count: int = PROTOCOL_COUNT, seed: int = PROTOCOL_SEED,
     return out
 
 
-def protocol_config(process_zone: bool = False) -> dict:
-    """The sweep configuration of the protocol sample (balanced, :data:`BUDGET_S`), or of
-    its sample with a process zone."""
+def protocol_config(process_zone: bool = False, tabor: bool = False) -> dict:
+    """The sweep configuration of the protocol sample (balanced, :data:`BUDGET_S`), of its
+    sample with a process zone, or (``tabor``) of its sample at large Tabor parameters."""
     name, count, seed = (("protocol_pz", PROTOCOL_PZ_COUNT, PROTOCOL_PZ_SEED) if process_zone
-                         else ("protocol", PROTOCOL_COUNT, PROTOCOL_SEED))
-    what = "with a test protocol and a process zone" if process_zone else "with a test protocol"
+                         else ("protocol_tabor", PROTOCOL_TABOR_COUNT, PROTOCOL_TABOR_SEED)
+                         if tabor else ("protocol", PROTOCOL_COUNT, PROTOCOL_SEED))
+    what = ("with a test protocol and a process zone" if process_zone
+            else f"with a test protocol at mu {PROTOCOL_TABOR_MU[0]:g}-{PROTOCOL_TABOR_MU[1]:g}"
+            if tabor else "with a test protocol")
     return {"name": f"random-{name.replace('_', '-')}",
             "description": f"{count} scenes {what} (seed {seed}), model auto",
-            "grid": protocol_sample(count, seed, process_zone),
+            "grid": protocol_sample(count, seed, process_zone,
+                                    PROTOCOL_TABOR_MU if tabor else None),
             "numerics": {"preset": "balanced", "time_budget_s": BUDGET_S},
             "store": {"trajectories": False},
             "output": f"results/random/{name}.h5"}
@@ -113,11 +122,12 @@ def write_configs(count: int = 60, seed: int = 21) -> list[Path]:
         path.write_text(head + yaml.safe_dump(sample_config(count, seed, model),
                                               sort_keys=False, width=100))
         paths.append(path)
-    for process_zone in (False, True):
-        path = CONFIGS / ("protocol_pz.yaml" if process_zone else "protocol.yaml")
+    for name, process_zone, tabor in (("protocol", False, False), ("protocol_pz", True, False),
+                                      ("protocol_tabor", False, True)):
+        path = CONFIGS / f"{name}.yaml"
         path.write_text("# written by `python -m sweep.bench.random_sample configs`; run by "
                         "`make random-sample`\n"
-                        + yaml.safe_dump(protocol_config(process_zone), sort_keys=False,
+                        + yaml.safe_dump(protocol_config(process_zone, tabor), sort_keys=False,
                                          width=100))
         paths.append(path)
     return paths
@@ -232,7 +242,7 @@ def _main(argv=None) -> int:
                                 description="a random sample across the declared ranges")
     sub = p.add_subparsers(dest="command", required=True)
     c = sub.add_parser("configs",
-                       help="write configs/random/{auto,bem,protocol,protocol_pz}.yaml")
+                       help="write configs/random/{auto,bem,protocol,protocol_pz,protocol_tabor}.yaml")
     c.add_argument("--count", type=int, default=60)
     c.add_argument("--seed", type=int, default=21)
     sub.add_parser("summary", help="count the outcomes, draw the model map")

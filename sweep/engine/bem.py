@@ -304,26 +304,40 @@ def _simulate_protocol(pb: Problem, res: Result, deadline: float):
         res.reason = (f"the contact at the preload, radius {res.a0_result:.4g}, reaches the "
                       f"mesh edge (domain {pb.mesh.domain:.4g})")
         return None
-    # the retraction is an unloading from the dwell's last state, its record 0: its stop rule
-    # and pull-off see the retraction's records only
+    run = retraction_start(pb, march, stats)
+    status = _unload(pb, run, deadline)
+    join_phases(res, march, run)
+    # the pull-off is read on the retraction only (its first record the dwell's last state):
+    # the approach passed the same radii, and a crack-speed fit over the records near the
+    # pull-off's radius took them in (0.056 against 0.051 a_ref/tau0 after a dwell long
+    # enough to relax, SLS k 0.2)
+    return _finish(pb, res, status, stats, retraction_from=n0 - 1)
+
+
+def retraction_start(pb: Problem, march, stats) -> UnloadingState:
+    """The retraction of a test protocol: an unloading from the march's (the dwell's) last
+    state on ``pb``'s mesh, its record 0, its Prony modes and traction; its stop rule and
+    pull-off see the retraction's records only."""
+    rec = march.records
     invalidate(march.cache)
     run = UnloadingState.start(pb, march.h, march.delta, march.cache, stats)
     for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):
         run.records[i][0] = rec[key][-1]
     run.n, run.q, run.sigma, run.h_prev = 1, march.q, march.sigma, march.h_prev
     run.step[0], run.step[2] = _retraction_first_step(pb, march)
-    status = _unload(pb, run, deadline)
-    n = run.n
+    return run
+
+
+def join_phases(res: Result, march, run: UnloadingState) -> None:
+    """``res``'s trajectory: the march's records, then the retraction's (``run``) from its
+    record 1, with ``phase`` (:data:`sweep.engine.protocol.PHASES`); and the hysteresis
+    energy of the whole path (:func:`sweep.engine.protocol.cycle_work`)."""
+    rec, n = march.records, run.n
     res.trajectory = {key: np.concatenate([np.asarray(rec[key][:-1], float), x[:n]])
                       for key, x in zip(("t", "delta", "P", "a", "a_inner"), run.records)}
     res.trajectory["phase"] = np.concatenate(
         [np.asarray(rec["phase"], float), np.full(n - 1, float(PHASES["retract"]))])
     res.hysteresis_energy = cycle_work(res.trajectory)
-    # the pull-off is read on the retraction only (its first record the dwell's last state):
-    # the approach passed the same radii, and a crack-speed fit over the records near the
-    # pull-off's radius took them in (0.056 against 0.051 a_ref/tau0 after a dwell long
-    # enough to relax, SLS k 0.2)
-    return _finish(pb, res, status, stats, retraction_from=n0 - 1)
 
 
 def _retraction_first_step(pb: Problem, march) -> tuple[float, float]:

@@ -36,6 +36,7 @@ the store and the analysis do not care which ran.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -51,8 +52,8 @@ from ..scene import MATERIALS, Numerics, Result, Scene, SceneTable
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem, budget
 from .crack_front import FIXED_GRIP_A_MIN, simulate_crack
-from .mesh import band_nodes, window_nodes
-from .problem import BEM_MU_RANGE, derive
+from .mesh import band_nodes, scene_mesh, window_nodes
+from .problem import BEM_MU_RANGE, derive, protocol_band
 from .resolution import refined, unresolved
 from .quasistatic import simulate_elastic
 
@@ -173,9 +174,8 @@ def _refinable(res) -> bool:
 
 
 def _bem_once(scene, numerics):
-    """One BEM solve with its error estimate, on the mesh that fits ``numerics`` (a scene
-    with a test protocol on the graded or uniform mesh: the tip-following mesh's window
-    starts at a0)."""
+    """One BEM solve with its error estimate, on the mesh that fits ``numerics``
+    (:func:`wants_tip_following`)."""
     if wants_tip_following(scene, numerics):
         from .tip_following import simulate_tip_following  # lazy: scipy.interpolate, optimize
 
@@ -199,16 +199,21 @@ def wants_tip_following(scene, numerics) -> bool:
     a graded mesh sized from the band resolution (``nodes`` unset, not ``exact``) whose
     fixed crack band would need more than ``numerics.max_nodes`` nodes (large mu or a0), or
     :data:`TIP_FOLLOWING_NODE_RATIO` times the nodes of the window that follows the tip (the
-    cheaper mesh at equal resolution). Never a scene with a test protocol (the window starts
-    at a0) or a compliant machine; a process zone is carried across the re-meshings
+    cheaper mesh at equal resolution). Never a scene with a compliant machine; a scene with
+    a test protocol only where the graded mesh, whose band reaches in to first contact, would
+    need more than ``max_nodes`` (its march follows the growing contact on the window,
+    :class:`sweep.engine.tip_following.MarchWindow`; elsewhere the graded mesh runs it, as it
+    did before the window could). A process zone is carried across the re-meshings
     (:func:`sweep.engine.tip_following.transfer`)."""
     if not (numerics.mesh == "graded" and numerics.nodes is None and not numerics.exact):
         return False
-    if scene.protocol() is not None or scene.machine_stiffness is not None:
+    if scene.machine_stiffness is not None:
         return False
     graded = bem_nodes_needed(scene, numerics)
     if graded > numerics.max_nodes:
         return True
+    if scene.protocol() is not None:
+        return False
     s = derive(scene, numerics)
     return graded >= TIP_FOLLOWING_NODE_RATIO * window_nodes(numerics, s.tip_zone,
                                                              s.a0_estimate, s.domain)
@@ -220,12 +225,17 @@ def bem_nodes_needed(scene, numerics=None) -> int:
     Uniform mesh: its automatic (or given) domain over the spacing at which the process zone
     ``l0 = 1.693/mu^2`` spans ``numerics.zone_nodes`` spacings. Graded mesh: the nodes of
     the mesh the solver would build (:func:`sweep.engine.mesh.band_nodes`, sized from the band
-    resolution).
+    resolution; with a test protocol, its band reaching in to first contact,
+    :func:`sweep.engine.problem.protocol_band`).
     """
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     s = derive(scene, numerics)
     if numerics.mesh == "uniform":
         return int(math.ceil(s.domain * numerics.zone_nodes / s.tip_zone)) + 1
+    if scene.protocol() is not None:
+        return scene_mesh(dataclasses.replace(numerics, nodes=None), s.tip_zone, s.a0_estimate,
+                          s.domain, pull_off_only=scene.stop == "pulloff",
+                          band=protocol_band(scene, numerics)).nodes
     return band_nodes(numerics, s.tip_zone, s.a0_estimate, s.domain,
                       pull_off_only=scene.stop == "pulloff")
 

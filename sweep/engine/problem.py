@@ -314,8 +314,15 @@ def protocol_band(scene: Scene, numerics: Numerics) -> tuple[float, float]:
     where that lies inside it; inside the band the mesh is graded as a relaxed start's."""
     s = derive(scene, numerics)
     lo, hi = crack_band(s.a0_estimate, s.tip_zone, pull_off_only=scene.stop == "pulloff")
-    first = scene.k ** (1.0 / 3.0) * float(jkr_contact_radius(load=0.0))
+    first = first_contact_radius(scene)
     return max(min(lo, first - BAND_MARGIN_ZONES * s.tip_zone), 0.0), hi
+
+
+def first_contact_radius(scene: Scene) -> float:
+    """The contact radius (a_ref) at which a test protocol's approach starts: the glassy JKR
+    contact at zero load, k^(1/3) times the relaxed one (:func:`sweep.engine.protocol.first_contact`
+    solves it on the mesh)."""
+    return scene.k ** (1.0 / 3.0) * float(jkr_contact_radius(load=0.0))
 
 
 def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Problem:
@@ -357,14 +364,11 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused(f"mesh too coarse: the tip zone {zone_length:.3g} a_ref spans {zone:.2g} "
                       f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
     if mesh.nodes > numerics.max_nodes:
-        if protocol:
-            other = "a test protocol runs on this mesh only"
-        else:
-            other = ("or run it on the tip-following mesh (sweep.engine.tip_following; model "
-                     "bem does so)")
         raise Refused(f"mesh too large: the crack band needs {mesh.nodes} nodes at "
                       f"band_resolution {numerics.band_resolution:g} (> max_nodes = "
-                      f"{numerics.max_nodes}); raise max_nodes or lower band_resolution; {other}")
+                      f"{numerics.max_nodes}); raise max_nodes or lower band_resolution; or run "
+                      f"it on the tip-following mesh (sweep.engine.tip_following; model bem "
+                      f"does so)")
     weights = times = np.zeros(0)
     error = 0.0
     if scene.table is not None and not numerics.exact:

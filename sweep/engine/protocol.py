@@ -178,6 +178,9 @@ class _March:
         self.records = {k: [] for k in ("t", "delta", "P", "a", "a_inner", "phase")}
         self.past, self.past_ta = np.empty((LATTICE_HISTORY, N)), np.empty((2, LATTICE_HISTORY))
         self.past_count, self.tip_score = 0, 0.0
+        #: the most tries of one compiled chunk, and what moves the march's mesh with its
+        #: crack tip between chunks (None: one mesh; :meth:`follow_tip`)
+        self.chunk_steps, self.follow = DWELL_CHUNK_STEPS, None
         self._record(0)
 
     def _record(self, phase):
@@ -312,6 +315,30 @@ class _March:
         self._record(phase)
 
 
+    def follow_tip(self):
+        """Before a chunk of steps: where the march runs on a window around its crack tip
+        (``follow``, :class:`sweep.engine.tip_following.MarchWindow`), let it bound the
+        chunk (``chunk_steps``) and move the window to the tip; else nothing."""
+        if self.follow is not None:
+            self.follow(self)
+
+    def move_to(self, pb, h, q):
+        """Go on on the mesh of the prepared problem ``pb`` from the state carried there
+        (gap ``h``, Prony modes ``q``: :func:`sweep.engine.tip_following.transfer`). The
+        records and the clock go on; the predictors start from the carried state (the last
+        states, on the old mesh, are dropped), the Jacobian cache is new."""
+        N = h.size
+        self.pb, self.h, self.q = pb, h, np.ascontiguousarray(q)
+        self.sigma = np.empty(N)
+        lj_traction(h, pb.h0, pb.c, self.sigma)
+        self.h_prev, self.h_prev2 = h.copy(), h.copy()
+        self.law = lennard_jones(pb.h0, pb.c, N)
+        self.cache = new_jacobian_cache(N)
+        use_drift_scaled(self.cache, True)
+        budget.arm(self.cache)
+        self.past, self.past_ta = np.empty((LATTICE_HISTORY, N)), np.empty((2, LATTICE_HISTORY))
+        self.past_count, self.tip_score = 0, 0.0
+
     def compiled_dwell(self, protocol: Protocol, end, dt, da_max, dt_min):
         """At most DWELL_CHUNK_STEPS tries of the dwell's steps to ``end`` from the step
         ``dt`` by the compiled march (:func:`sweep.kernels.protocol.dwell_steps`: what
@@ -324,7 +351,7 @@ class _March:
             pb.hm, protocol.hold != "depth", float(protocol.preload),
             np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * protocol.preload]), float(end),
             float(da_max), float(dt_min), DWELL_GROWTH, DWELL_GROW_BELOW, TIP_NODES, TIP_ITER,
-            MAX_ITER, DWELL_CHUNK_STEPS, *self._zone_bound(), self.clock_origin)
+            MAX_ITER, self.chunk_steps, *self._zone_bound(), self.clock_origin)
         outcome, clock, out = self._compiled(dwell_steps, control, dt, PHASES["dwell"])
         failed = None
         if outcome == DWELL_FAILED:
@@ -344,7 +371,7 @@ class _March:
         control = ApproachControl(
             pb.hm, float(protocol.preload), PRELOAD_RTOL, float(speed), float(dd_max),
             MIN_STEP_FRACTION * dd_max, float(da_max), pb.numerics.tol * pb.h0, TRIAL_ITER,
-            MAX_ITER, TIP_NODES, TIP_ITER, AHEAD_NODES, AHEAD_LEAST, DWELL_CHUNK_STEPS,
+            MAX_ITER, TIP_NODES, TIP_ITER, AHEAD_NODES, AHEAD_LEAST, self.chunk_steps,
             *self._zone_bound())
         outcome, clock, out = self._compiled(approach_steps, control, dd, PHASES["approach"])
         dd = float(clock[CLOCK_DT])
@@ -445,6 +472,7 @@ def _approach(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     dd = None
     while m.load < protocol.preload * (1.0 - PRELOAD_RTOL):
         budget.check("the approach")
+        m.follow_tip()
         if dd is None:
             dd, solved, moved = _first_step(m, speed, dd_max, da_max)
         elif compiled:
@@ -550,6 +578,7 @@ def _dwell(m: _March, protocol: Protocol, compiled: bool = True) -> None:
     m.clock_origin = m.t - DWELL_LOG_SHIFT * protocol.dwell
     while m.t < end * (1.0 - 1e-12):
         budget.check("the dwell")
+        m.follow_tip()
         if not compiled:
             dt = _dwell_step(m, protocol, min(dt, end - m.t), da_max, dt_min)
             continue
@@ -653,7 +682,7 @@ def first_contact(pb, stats):
     """(gap, indentation) at first contact: the LJ equilibrium of the glassy compliance k =
     Chat(0) at the indentation of the glassy JKR contact at zero load (the JKR solution of
     modulus 1/k: radii k^(1/3), indentations k^(2/3) times the relaxed ones), by Newton from
-    that JKR gap."""
+    that JKR gap (where Newton fails, after RELAX_ITER pseudo-transient iterations)."""
     from .initial import jkr_gap_guess     # lazy: sweep.engine.initial imports problem
 
     k = 1.0 - float(np.sum(pb.prony_weights))
@@ -664,25 +693,38 @@ def first_contact(pb, stats):
     N = h.size
     cache = new_jacobian_cache(N)
     budget.arm(cache)
-    ok = newton(h, -delta + pb.h0 + 0.5 * pb.mesh.r ** 2, pb.A, k, np.zeros(N),
-                lennard_jones(pb.h0, pb.c, N), pb.numerics.tol * pb.h0, MAX_ITER, cache, stats)
+    g = -delta + pb.h0 + 0.5 * pb.mesh.r ** 2
+    law, tol, guess = lennard_jones(pb.h0, pb.c, N), pb.numerics.tol * pb.h0, h.copy()
+    ok = newton(h, g, pb.A, k, np.zeros(N), law, tol, MAX_ITER, cache, stats)
+    if not ok:
+        # at large mu the JKR gap's crack tip lies too far off for Newton (the tip-following
+        # mesh's window at mu 21.6, k 0.83; mu 12, k 1 at the fast preset): the
+        # pseudo-transient relaxation from it first, as across a fold (_March._jump)
+        h = guess
+        invalidate(cache)
+        ok = (relax(h, g, pb.A, k, np.zeros(N), law, tol, RELAX_ITER, stats)
+              or newton(h, g, pb.A, k, np.zeros(N), law, tol, MAX_ITER, cache, stats))
     if not ok:
         budget.check("the protocol's first contact")
         raise RuntimeError(f"no glassy contact at first touch (delta = {delta:.4g})")
     return h, float(delta)
 
 
-def run_phases(pb, protocol: Protocol, stats, compiled: bool = True):
+def run_phases(pb, protocol: Protocol, stats, compiled: bool = True, follow=None):
     """Approach and dwell on the prepared problem ``pb``, the solver's counters into
     ``stats`` (:data:`sweep.kernels.solve.N_STATS`): the march (:class:`_March`) whose state
     and records the retraction continues. ``compiled`` False: every step in Python
-    (:func:`_approach`, :func:`_dwell`), the compiled march's reference.
+    (:func:`_approach`, :func:`_dwell`), the compiled march's reference. ``follow``: called
+    with the march before each chunk of its steps, it may move the march to another mesh
+    (:meth:`_March.move_to`; the tip-following mesh's window,
+    :class:`sweep.engine.tip_following.MarchWindow`); the march's ``pb`` is then the last.
 
     The march's solves read the scene's deadline (:mod:`sweep.engine.budget`; Newton gives up
     past it, :func:`sweep.kernels.jacobian.set_deadline`), and a march that fails past it
     raises :class:`sweep.engine.budget.OverBudget`, not the failure."""
     h, delta = first_contact(pb, stats)
     m = _March(pb, h, delta, stats)
+    m.follow = follow
     budget.arm(m.cache)
     try:
         _approach(m, protocol, compiled)

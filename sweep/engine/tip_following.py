@@ -33,6 +33,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+import types
 
 import numpy as np
 import scipy.linalg
@@ -48,11 +49,13 @@ from ..kernels.interface import (ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Int
 from ..scene import Numerics, Result, Scene
 from . import budget
 from .budget import OverBudget
-from .bem import CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, no_contact_reason, unload_chunk
+from .bem import (CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, join_phases,
+                  no_contact_reason, retraction_start, unload_chunk)
 from .initial import ElasticSolver, cached_state, relaxed_state
 from .mesh import WINDOW_AHEAD_ZONES, WINDOW_BEHIND_ZONES, band_nodes, tip_window
 from .postprocess import STATUS_TIME_BUDGET, finish
-from .problem import Refused, derive, jkr_radius, material_of, prepare
+from .problem import Refused, derive, first_contact_radius, jkr_radius, material_of, prepare
+from .protocol import DWELL_CHUNK_STEPS, DWELL_DA_FACTOR, run_phases
 from .quasistatic import ElasticBranch, fold_refusal, state_at
 from .resolution import estimate_error
 
@@ -76,6 +79,9 @@ MAX_MESHES = 5000
 #: fine window is too coarse for the carried state, much more.)
 REMESH_JUMP_STEPS = 5.0
 REMESH_JUMP_RTOL = 1e-3
+#: a step of a protocol's march moves the crack tip by at most this many ``da_max`` spacings
+#: (the dwell's bound; the approach's is smaller): :class:`MarchWindow` bounds its chunks by it
+MARCH_TIP_STEP = DWELL_DA_FACTOR
 #: Newton iterations of the re-equilibration after a state transfer (:func:`transfer`)
 REEQUILIBRATE_ITER = 30
 #: what to change when the tip-following mesh finds no equilibrium before the pull-off
@@ -476,6 +482,12 @@ def _probe(scene, numerics, run, delta0, a0, per_step, margin, deadline) -> str:
     if n < 3:
         return ""
     step = float(np.max(-np.diff(delta)))
+    if run.step.size > 2 and run.step[2] > 0.0:
+        # a protocol's retraction in its lead-in (kernels.solve.LEAD_GROWTH): its steps grow
+        # to numerics.step and on as the step control lets them, as the estimate before the
+        # run assumes (_attempt); a fast approach's last step had made the retraction's first
+        # steps 1e-5 of numerics.step, and "too many steps" of a scene that then took 2768
+        step = max(step, SMOOTH_STEP_FACTOR * numerics.step * derive(scene, numerics).h0)
     need = estimate_steps(scene, numerics, delta[-1], a[-1], delta0, a0, step)
     total = n - 1 + need.steps
     if total > numerics.max_steps:
@@ -515,11 +527,12 @@ def simulate_tip_following(scene: Scene, numerics: Numerics | None = None,
         ``reason`` of an ok result says how many meshes it took.
     """
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    attempt = _attempt if scene.protocol() is None else _attempt_protocol
     t_start = time.perf_counter()
     with budget.scene_budget(numerics.time_budget_s) as deadline:
-        res = _attempt(scene, numerics, ahead, behind, deadline)
+        res = attempt(scene, numerics, ahead, behind, deadline)
         estimate_error(res, derive(scene, numerics).tip_zone,
-                       lambda coarse: _attempt(scene, coarse, ahead, behind, deadline))
+                       lambda coarse: attempt(scene, coarse, ahead, behind, deadline))
     res.wall_s = time.perf_counter() - t_start
     return res
 
@@ -590,48 +603,16 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         return res
 
     run = UnloadingState.start(pb, h_init, delta0, el.cache, el.stats.copy())
-    meshes, nodes = 1, pb.mesh.nodes
-    remeshed_at, marks = [], []   # first records on new meshes: to check, and all of them
-    rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
-    while True:
-        probing, n_before, t_chunk = run.n <= 1, run.n, time.perf_counter()
-        status = unload_chunk(pb, run, pb.tip_range, PROBE_STEPS if probing else CHUNK_STEPS,
-                              deadline)
-        broken = _continuity(run, remeshed_at, rtol)
-        if broken:
-            break
-        if (status in (STATUS_LEFT_BAND, STATUS_STEP_LIMIT)
-                and (probing or run.n - n_before >= PROBE_STEPS)):
-            per_step = (time.perf_counter() - t_chunk) / max(run.n - n_before, 1)
-            refusal = _probe(scene, numerics, run, delta0, a_init, per_step,
-                             TIME_MARGIN if probing else 1.0, deadline)
-            if refusal:
-                res.reason = refusal
-                res.steps, res.nodes_used = run.n - 1, nodes
-                res.newton_iterations = int(run.stats[STAT_ITER])
-                res.factorizations = int(run.stats[STAT_FACTOR])
-                return res
-        if status == STATUS_LEFT_BAND and meshes < MAX_MESHES:
-            a = run.records[3]
-            direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1
-            try:
-                budget.check(f"the tip-following mesh's re-meshing at a = {a[run.n - 1]:.4g}")
-                new = prepare(scene, numerics,
-                              tip_window(a[run.n - 1], zone, ahead, behind, direction))
-                transfer(run, pb, new)
-            except (Refused, OverBudget) as exc:
-                res.reason = f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"
-                return res
-            remeshed_at.append(run.n)
-            marks.append(run.n)
-            pb, meshes, nodes = new, meshes + 1, max(nodes, new.mesh.nodes)
-        elif status == STATUS_STEP_LIMIT and run.n <= numerics.max_steps:
-            pass
-        else:
-            break
-        if time.perf_counter() > deadline:
-            status = STATUS_TIME_BUDGET
-            break
+    u = _unload_following(scene, numerics, pb, run, zone, ahead, behind, deadline, delta0,
+                          a_init)
+    if u.ended in ("probe", "remesh"):
+        res.reason = u.reason
+        if u.ended == "probe":
+            res.steps, res.nodes_used = run.n - 1, u.nodes
+            res.newton_iterations = int(run.stats[STAT_ITER])
+            res.factorizations = int(run.stats[STAT_FACTOR])
+        return res
+    status, pb, meshes, nodes, marks = u.status, u.pb, u.meshes, u.nodes, u.marks
     n = run.n
     t, delta, P, a, a_inner = (x[:n].copy() for x in run.records)
     res.trajectory = {"t": t, "delta": delta, "P": P, "a": a, "a_inner": a_inner}
@@ -639,8 +620,8 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     res.newton_iterations = int(run.stats[STAT_ITER])
     res.factorizations = int(run.stats[STAT_FACTOR])
     res.nodes_used = nodes
-    if broken:
-        res.reason = broken
+    if u.ended == "broken":
+        res.reason = u.reason
         return res
     if status == STATUS_LEFT_BAND:
         res.reason = f"more than {MAX_MESHES} meshes (a = {a[-1]:.4g})"
@@ -652,6 +633,167 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
         res.reason = f"{res.reason}; {note}" if res.reason else note
     return res
+
+
+class MarchWindow:
+    """The march of a test protocol (approach and dwell, :mod:`sweep.engine.protocol`) on
+    the tip-following mesh. Called with the march before each chunk of its steps
+    (:meth:`sweep.engine.protocol._March.follow_tip`), it bounds the chunk so that the crack
+    tip, which a step moves by at most MARCH_TIP_STEP ``da_max`` spacings, stays inside the
+    window's fine range (``pb.tip_range``); where the tip lies within two such steps of the
+    range's end, the window is moved to the tip (``ahead`` tip zones of room in the direction
+    the tip moves: outward while the contact grows) and the march's state carried there
+    (:func:`transfer`, as the unloading's: the gap, and the Prony modes as displacements,
+    re-equilibrated at frozen time), and the march goes on
+    (:meth:`sweep.engine.protocol._March.move_to`)."""
+
+    def __init__(self, scene, numerics, zone, ahead, behind):
+        self.scene, self.numerics, self.zone = scene, numerics, zone
+        self.ahead, self.behind = ahead, behind
+        self.meshes, self.nodes = 1, 0
+
+    def __call__(self, m) -> None:
+        a = m.records["a"]
+        self.nodes = max(self.nodes, m.pb.mesh.nodes)
+        move = MARCH_TIP_STEP * self.numerics.da_max * m.pb.mesh.spacing
+        lo, hi = m.pb.tip_range
+        room = min(hi - a[-1], a[-1] - lo)
+        if room < 2.0 * move:
+            direction = -1 if len(a) > 1 and a[-1] < a[-2] else 1
+            budget.check(f"the tip-following mesh's re-meshing at a = {a[-1]:.4g}")
+            new = prepare(self.scene, self.numerics,
+                          tip_window(a[-1], self.zone, self.ahead, self.behind, direction))
+            n = len(a)
+            run = types.SimpleNamespace(h=m.h, q=m.q, sigma=m.sigma, h_prev=m.h_prev, n=n,
+                                        records=[None, m.records["delta"]], step=np.zeros(3),
+                                        stats=m.stats, cache=None)
+            transfer(run, m.pb, new)
+            m.move_to(new, run.h, run.q)
+            self.meshes, self.nodes = self.meshes + 1, max(self.nodes, new.mesh.nodes)
+            lo, hi = new.tip_range
+            room = min(hi - a[-1], a[-1] - lo)
+        m.chunk_steps = int(min(DWELL_CHUNK_STEPS, max(1.0, room // move - 1.0)))
+
+
+def _attempt_protocol(scene, numerics, ahead, behind, deadline) -> Result:
+    """One solve of a scene with a test protocol on the tip-following mesh: the march
+    (approach and dwell, :func:`sweep.engine.protocol.run_phases`) from first contact on a
+    window that follows the growing contact (:class:`MarchWindow`), then the retraction
+    from the march's last state as an unloading on windows that follow the crack tip
+    (:func:`_unload_following`). The row is the graded mesh's protocol row
+    (:func:`sweep.engine.bem._simulate_protocol`): the pull-off read on the retraction,
+    the trajectory's phases, the hysteresis energy."""
+    if numerics.mesh != "graded" or numerics.exact:
+        numerics = dataclasses.replace(numerics, mesh="graded", exact=False)
+    res = Result(scene=scene, numerics=numerics)
+    scales = derive(scene, numerics)
+    zone = scales.tip_zone
+    window = MarchWindow(scene, numerics, zone, ahead, behind)
+    stats = np.zeros(N_STATS, dtype=np.int64)
+    try:
+        pb = prepare(scene, numerics,
+                     tip_window(first_contact_radius(scene), zone, ahead, behind, 1))
+        march = run_phases(pb, scene.protocol(), stats, follow=window)
+    except (Refused, OverBudget) as exc:
+        res.reason = str(exc)
+        return res
+    except RuntimeError as exc:
+        res.reason = f"protocol: {exc}"
+        return res
+    pb, rec = march.pb, march.records
+    n0 = len(rec["t"])
+    res.delta0_result, res.a0_result, res.a0_inner = march.delta, rec["a"][-1], rec["a_inner"][-1]
+    res.spacing, res.domain_used = pb.mesh.spacing, pb.mesh.domain
+    res.prony_terms, res.prony_error = int(pb.prony_weights.size), pb.prony_error
+    run = retraction_start(pb, march, stats)
+    u = _unload_following(scene, numerics, pb, run, zone, ahead, behind, deadline,
+                          march.delta, rec["a"][-1])
+    meshes, nodes = window.meshes + u.meshes - 1, max(window.nodes, u.nodes)
+    res.nodes_used = nodes
+    res.steps = n0 - 1 + run.n - 1
+    res.newton_iterations, res.factorizations = int(stats[STAT_ITER]), int(stats[STAT_FACTOR])
+    if u.ended in ("probe", "remesh"):
+        res.reason = u.reason
+        return res
+    join_phases(res, march, run)
+    if u.ended == "broken":
+        res.reason = u.reason
+        return res
+    if u.status == STATUS_LEFT_BAND:
+        res.reason = f"more than {MAX_MESHES} meshes (a = {run.records[3][run.n - 1]:.4g})"
+        return res
+    first = n0 - 1
+    finish(res, u.status, res.trajectory, pb.mesh.spacing,
+           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING,
+           remeshed=[first] + [first + i for i in u.marks], first=first)
+    if res.ok:
+        note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
+        res.reason = f"{res.reason}; {note}" if res.reason else note
+    return res
+
+
+@dataclasses.dataclass
+class _Unloaded:
+    """How an unloading on the tip-following mesh ended (:func:`_unload_following`): the
+    kernel's last status, the last mesh's problem, the meshes, the most nodes of one, the
+    first record on each new mesh; ``ended`` "probe" (a refusal of :func:`_probe`),
+    "remesh" (a re-meshing failed) or "broken" (a re-meshing broke the load's continuity,
+    :func:`_continuity`) with its ``reason``, else ""."""
+    status: int
+    pb: object
+    meshes: int
+    nodes: int
+    marks: list
+    ended: str = ""
+    reason: str = ""
+
+
+def _unload_following(scene, numerics, pb, run, zone, ahead, behind, deadline, delta0,
+                      a0) -> _Unloaded:
+    """Continue the unloading ``run`` from the window mesh of ``pb`` to its end: the kernel in
+    chunks (:func:`sweep.engine.bem.unload_chunk`), the window moved to the crack tip where
+    the tip leaves it (:func:`transfer`), each re-meshing's load continuity checked, the run
+    probed for what it still needs (:func:`_probe`, from the start at ``delta0``, ``a0``)."""
+    u = _Unloaded(STATUS_STEP_LIMIT, pb, 1, pb.mesh.nodes, [])
+    remeshed_at = []    # first records on new meshes, to check (u.marks: all of them)
+    rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
+    while True:
+        probing, n_before, t_chunk = run.n <= 1, run.n, time.perf_counter()
+        u.status = unload_chunk(u.pb, run, u.pb.tip_range,
+                                PROBE_STEPS if probing else CHUNK_STEPS, deadline)
+        broken = _continuity(run, remeshed_at, rtol)
+        if broken:
+            u.ended, u.reason = "broken", broken
+            return u
+        if (u.status in (STATUS_LEFT_BAND, STATUS_STEP_LIMIT)
+                and (probing or run.n - n_before >= PROBE_STEPS)):
+            per_step = (time.perf_counter() - t_chunk) / max(run.n - n_before, 1)
+            refusal = _probe(scene, numerics, run, delta0, a0, per_step,
+                             TIME_MARGIN if probing else 1.0, deadline)
+            if refusal:
+                u.ended, u.reason = "probe", refusal
+                return u
+        if u.status == STATUS_LEFT_BAND and u.meshes < MAX_MESHES:
+            a = run.records[3]
+            direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1
+            try:
+                budget.check(f"the tip-following mesh's re-meshing at a = {a[run.n - 1]:.4g}")
+                new = prepare(scene, numerics,
+                              tip_window(a[run.n - 1], zone, ahead, behind, direction))
+                transfer(run, u.pb, new)
+            except (Refused, OverBudget) as exc:
+                u.ended, u.reason = "remesh", f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"
+                return u
+            remeshed_at.append(run.n)
+            u.marks.append(run.n)
+            u.pb, u.meshes, u.nodes = new, u.meshes + 1, max(u.nodes, new.mesh.nodes)
+        elif u.status == STATUS_STEP_LIMIT and run.n <= numerics.max_steps:
+            pass
+        else:
+            return u
+        if time.perf_counter() > deadline:
+            u.status = STATUS_TIME_BUDGET
+            return u
 
 
 #: the convergence study (``python -m sweep.engine.tip_following``): a viscoelastic scene unloaded

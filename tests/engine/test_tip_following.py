@@ -387,3 +387,67 @@ def test_crack_speed_at_a_remeshing_is_read_from_both_meshes():
     assert "load minimum at a re-meshing" not in far.reason
     assert edge.pull_off == pytest.approx(far.pull_off, rel=1e-5)
     assert edge.crack_speed == pytest.approx(far.crack_speed, rel=5e-3)   # measured 3.1e-3
+
+
+#: a test protocol at mu 12: approached at its retraction's rate to the preload 2, held there
+#: for 10 tau0. Its graded mesh, whose band reaches in to first contact, needs 1265 nodes at
+#: the fast preset (max_nodes 400)
+PROTOCOL_MU12 = dict(n=0.8, k=0.1, mu=12.0, rate=316.2, approach_rate=316.2, preload=2.0,
+                     dwell=10.0)
+
+
+def test_a_protocol_beyond_max_nodes_runs_on_the_window_as_on_a_larger_graded_mesh():
+    """The graded mesh refuses it at max_nodes and names the way out; ``sweep.simulate``
+    (model bem) runs it on the tip-following mesh, its march on windows that follow the
+    growing contact. Second method: the graded mesh with max_nodes raised (1265 nodes, 4.5
+    times the window's time). Measured (2026-11-27): pull-off 8.7e-6 apart, contact radius
+    after the dwell 2.8e-5, hysteresis energy 1.3e-5, with 9 meshes; the fast preset's own
+    estimate is 4.1e-3. The tolerances are ten times the measured differences."""
+    import dataclasses
+
+    from sweep import simulate as front_door
+    scene = Scene(**PROTOCOL_MU12)
+    num = Numerics.preset("fast")
+    assert models.wants_tip_following(scene, num)
+    refused = simulate(scene, num)
+    assert refused.status == "failed" and "mesh too large" in refused.reason
+    assert "tip-following mesh" in refused.reason and "model bem" in refused.reason
+    window = front_door(Scene(**PROTOCOL_MU12, model="bem"), num)
+    graded = simulate(scene, dataclasses.replace(num, max_nodes=1400))
+    assert window.ok and graded.ok, (window.reason, graded.reason)
+    assert graded.nodes_used > 1000 and window.nodes_used < 400 and _meshes(window) >= 3
+    assert window.pull_off == pytest.approx(graded.pull_off, rel=1e-4)
+    assert window.a0_result == pytest.approx(graded.a0_result, rel=3e-4)
+    assert window.hysteresis_energy == pytest.approx(graded.hysteresis_energy, rel=1.5e-4)
+    assert window.error_estimate <= num.pull_off_rtol
+    phases = window.trajectory["phase"]
+    assert set(np.unique(phases)) == {0.0, 1.0, 2.0} and np.all(np.diff(phases) >= 0)
+
+
+def test_the_march_moves_its_window_with_the_growing_contact():
+    """A narrow window (6 tip zones ahead, 3 behind) at mu 3.24, where the graded mesh runs
+    the scene too: the approach from first contact (radius 0.56) to the preload's (about
+    1.9) crosses 8 tip zones, so the march re-meshes before the retraction does; held at
+    depth. Measured (2026-11-27): 3 meshes, pull-off 2.8e-5 and hysteresis energy 1e-6 from
+    the graded mesh's (its estimate 1.5e-2)."""
+    scene = Scene(n=0.4, k=0.1, mu=3.24, rate=3.16, approach_rate=3.16, preload=2.0,
+                  dwell=10.0, dwell_hold="depth")
+    num = Numerics.preset("fast")
+    assert not models.wants_tip_following(scene, num)      # the graded mesh, as before
+    graded = simulate(scene, num)
+    window = tf.simulate_tip_following(scene, num, ahead=6.0, behind=3.0)
+    assert window.ok and graded.ok, (window.reason, graded.reason)
+    assert _meshes(window) >= 3
+    assert window.pull_off == pytest.approx(graded.pull_off, rel=3e-4)
+    assert window.hysteresis_energy == pytest.approx(graded.hysteresis_energy, rel=1e-5)
+    # the march alone, on the same windows: it moved them
+    from sweep.engine.problem import derive, first_contact_radius, prepare
+    from sweep.engine.protocol import run_phases
+    from sweep.kernels.solve import N_STATS
+    zone = derive(scene, num).tip_zone
+    follow = tf.MarchWindow(scene, num, zone, 6.0, 3.0)
+    first = prepare(scene, num, mesh.tip_window(first_contact_radius(scene), zone, 6.0, 3.0, 1))
+    march = run_phases(first, scene.protocol(), np.zeros(N_STATS, dtype=np.int64),
+                       follow=follow)
+    assert follow.meshes >= 2 and march.pb is not first
+    assert march.records["a"][-1] == pytest.approx(window.a0_result, rel=1e-12)
