@@ -37,8 +37,8 @@ from .history import history_vector, step_coefficients, update_modes
 from .jacobian import (CACHE_STATE, STATE_SCALED, STATE_SUBSET, STATE_VALID, STATE_ZONE_HI,
                        apply_inverse, crack_tip_index, factorize, newton_direction,
                        scale_for_drift)
-from .interface import (TIP_GAP, crossing_radius, lj_traction, traction_and_stiffness,
-                        zone_factor)
+from .interface import (TIP_GAP, ZONE_RATE, crossing_radius, traction,
+                        traction_and_stiffness)
 from .solve import (LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT, STAT_FACTOR, STAT_ITER,
                     STAT_REFACTOR_SLOW, STAT_REFACTOR_ZONE, STAT_RESIDUALS, STAT_SUBSET,
                     STAT_ZONE, load, newton, positive_step, predict, predict_lattice, residual,
@@ -199,12 +199,10 @@ def factorize_ahead(h, A, ceff, law, ahead, least, cache, stats):
 #: :func:`dwell_steps`' outcomes: the dwell ended; ``max_steps`` tries made (the caller checks
 #: its time budget and calls again); the solve of a step failed where the caller's fallback
 #: takes over (the held step's secant of ordinary solves, the smallest step's relaxation of a
-#: fold); the step opened a gap too fast for the march's law (a process zone: the caller
-#: raises with the reason)
+#: fold)
 DWELL_ENDED = 0
 DWELL_CHUNK = 1
 DWELL_FAILED = 2
-DWELL_OPENED = 3
 #: the entries of :data:`MarchState`'s ``clock``: the march's time, indentation, next step
 #: (the dwell's time step, the approach's indentation step), last two time steps, tip
 #: predictor's score, states written to its ring, contact radius of the last state, (on a
@@ -235,12 +233,11 @@ RECENT_DWELL = 2
 #: contact radius (a_ref); dt_min the smallest step; growth the next step's factor after a
 #: step that moved the radius by less than grow_below da_max; tip_nodes, tip_iter the settle
 #: at the crack tip (:func:`kernels.solve.settle_tip`); max_iter Newton's iterations;
-#: max_steps the tries of one call; zone_bound the most traction a process zone may add at an
-#: opening node, zone_qs its smoothing rate (:func:`kernels.interface.zone_factor`); origin
-#: the origin of the predictors' clock (:func:`dwell_clock`)
+#: max_steps the tries of one call; origin the origin of the predictors' clock
+#: (:func:`dwell_clock`)
 DwellControl = namedtuple("DwellControl", [
     "hm", "hold_force", "force", "tols", "end", "da_max", "dt_min", "growth", "grow_below",
-    "tip_nodes", "tip_iter", "max_iter", "max_steps", "zone_bound", "zone_qs", "origin"])
+    "tip_nodes", "tip_iter", "max_iter", "max_steps", "origin"])
 #: the march's state, in/out: the gaps h, h_prev, h_prev2 (N,) of the last three states, the
 #: Prony modes q (M, N), the traction sigma (N,) of h, the tip predictor's ring past (K, N)
 #: with its times and contact radii past_ta (2, K), clock (CLOCK_SIZE,) and recent (3, 3)
@@ -248,7 +245,7 @@ MarchState = namedtuple("MarchState", ["h", "h_prev", "h_prev2", "q", "sigma", "
                                        "past_ta", "clock", "recent"])
 #: what a call writes besides the state: records (5, max_steps) the accepted steps' t, delta,
 #: P, a, a_inner; starts (2, N) the predictor's two starts; h (N,) and sigma (N,) the state
-#: of the step handed over (DWELL_OPENED, APPROACH_PASSED)
+#: of the step handed over (APPROACH_PASSED)
 DwellOut = namedtuple("DwellOut", ["records", "starts", "h", "sigma"])
 
 
@@ -326,8 +323,7 @@ def dwell_steps(mesh, physics, law, control, state, out, cache, stats):
     (DWELL_ENDED), after ``max_steps`` tries (DWELL_CHUNK), where the caller's fallback takes
     over (DWELL_FAILED: the held step's solve failed, or the smallest step's; the step, its
     guessed indentation and CLOCK_MADE in ``clock``, the starts in ``out``, the cache
-    invalidated), or where a process zone would add more than ``zone_bound`` at an opening
-    node (DWELL_OPENED, :func:`_opened`)."""
+    invalidated)."""
     N, M = state.h.size, physics.weights.size
     clock = state.clock
     e, b, H, g = np.empty(M), np.empty(M), np.empty(N), np.empty(N)
@@ -361,10 +357,6 @@ def dwell_steps(mesh, physics, law, control, state, out, cache, stats):
         if moved > control.da_max and not smallest:
             clock[CLOCK_DT] = max(0.5 * dt, control.dt_min)
             continue
-        if _opened(physics, control, state.h, hs, sig, dt):
-            for i in range(N):
-                out.h[i], out.sigma[i] = hs[i], sig[i]
-            return DWELL_OPENED, n
         _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta)
         n += 1
         grows = moved < control.grow_below * control.da_max
@@ -379,7 +371,9 @@ def _step_start(mesh, physics, law, control, state, starts, dt, delta, work, ori
     ``delta`` into ``g``; returns C_eff) and Newton's start into ``hs`` (``_March._start``:
     the quadratic extrapolation, on the dwell's clock from ``origin`` (:func:`predictor_steps`;
     nan: in time), or the tip predictor's where made and its score says so, the two in
-    ``starts``; CLOCK_MADE), settled at the last crack tip (``_March._settle``)."""
+    ``starts``; CLOCK_MADE), settled at the last crack tip (``_March._settle``). With a
+    process zone the step's law is set in ``law``: its opening rate from the last state over
+    ``dt`` (``_March._equation``)."""
     e, b, H, g, hs = work
     clock, r, N = state.clock, mesh.r, hs.size
     ceff = step_coefficients(physics.weights, physics.times, dt, e, b)
@@ -387,6 +381,10 @@ def _step_start(mesh, physics, law, control, state, starts, dt, delta, work, ori
     c0 = -delta + law.h0
     for i in range(N):
         g[i] = c0 + 0.5 * r[i] ** 2
+    if not np.isinf(physics.hdot_c):
+        law.zone[ZONE_RATE] = 1.0 / (physics.hdot_c * dt)
+        for i in range(N):
+            law.h_old[i] = state.h[i]
     x, x_prev, x_prev2 = predictor_steps(clock[CLOCK_T], dt, clock[CLOCK_DT_PREV],
                                          clock[CLOCK_DT_PREV2], origin)
     predict(state.h, state.h_prev, state.h_prev2, x, x_prev, x_prev2, starts[0])
@@ -408,25 +406,9 @@ def _step_start(mesh, physics, law, control, state, starts, dt, delta, work, ori
 def _radius_moved(mesh, law, control, clock, hs, sig):
     """The traction of the step's state ``hs`` into ``sig``; its contact radius and how far
     that moved from the last state's."""
-    lj_traction(hs, law.h0, law.c, sig)
+    traction(hs, law.h_old, law.zone, law.h0, law.c, sig)
     a = crossing_radius(hs, mesh.r, control.hm)
     return a, abs(a - clock[CLOCK_A])
-
-
-@njit(cache=True, inline='always')
-def _opened(physics, control, h, hs, sig, dt):
-    """Whether the step from ``h`` to ``hs`` (traction ``sig``) opened a node in tension fast
-    enough that the process zone would have added more than ``zone_bound`` there
-    (``_March._check_closing``; never without a process zone, ``hdot_c`` infinite)."""
-    if np.isinf(physics.hdot_c):
-        return False
-    worst = 0.0
-    for i in range(h.size):
-        rate = (hs[i] - h[i]) / (dt * physics.hdot_c)
-        if hs[i] > physics.h0 and rate > 0.0:
-            added = (zone_factor(rate, physics.xi, control.zone_qs)[0] - 1.0) * -sig[i]
-            worst = max(worst, added)
-    return worst > control.zone_bound
 
 
 @njit(cache=True, inline='always')
@@ -464,7 +446,7 @@ def _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta):
 
 #: :func:`approach_steps`' outcomes beyond DWELL_ENDED (the load reached the preload),
 #: DWELL_CHUNK, DWELL_FAILED (the smallest step's solve failed: the caller relaxes the fold)
-#: and DWELL_OPENED: the step's load passed the preload (the caller cuts it to end there)
+#: and: the step's load passed the preload (the caller cuts it to end there)
 APPROACH_PASSED = 4
 
 #: the approach's settings: hm the gap at which the contact radius is read; preload (pi dg R)
@@ -473,12 +455,11 @@ APPROACH_PASSED = 4
 #: the contact radius; tol Newton's (h0 units times h0), trial_iter its iterations on a step
 #: that may still be halved, max_iter on the smallest; tip_nodes, tip_iter the settle at the
 #: crack tip; ahead_nodes, ahead_least the factorization's zone ahead of the advancing tip
-#: (:func:`factorize_ahead`); max_steps the tries of one call; zone_bound, zone_qs as
-#: :data:`DwellControl`'s
+#: (:func:`factorize_ahead`); max_steps the tries of one call
 ApproachControl = namedtuple("ApproachControl", [
     "hm", "preload", "preload_rtol", "speed", "dd_max", "dd_min", "da_max", "tol",
     "trial_iter", "max_iter", "tip_nodes", "tip_iter", "ahead_nodes", "ahead_least",
-    "max_steps", "zone_bound", "zone_qs"])
+    "max_steps"])
 
 
 @njit(cache=True)
@@ -496,8 +477,7 @@ def approach_steps(mesh, physics, law, control, state, out, cache, stats):
     step doubles (up to ``dd_max``) where the radius moved by less than half ``da_max``. Ends
     where the load reaches the preload (DWELL_ENDED), after ``max_steps`` tries
     (DWELL_CHUNK), or hands the step over: its load passed the preload (APPROACH_PASSED:
-    its state in ``out``), the smallest step's solve failed (DWELL_FAILED), a process zone
-    would add more than ``zone_bound`` at an opening node (DWELL_OPENED)."""
+    its state in ``out``), the smallest step's solve failed (DWELL_FAILED)."""
     N, M = state.h.size, physics.weights.size
     clock = state.clock
     e, b, H, g = np.empty(M), np.empty(M), np.empty(N), np.empty(N)
@@ -526,11 +506,10 @@ def approach_steps(mesh, physics, law, control, state, out, cache, stats):
         if moved > control.da_max and not smallest:
             clock[CLOCK_DT] = max(0.5 * dd, control.dd_min)
             continue
-        passed = load(sig, mesh.wP) > control.preload
-        if passed or _opened(physics, control, state.h, hs, sig, dt):
+        if load(sig, mesh.wP) > control.preload:
             for i in range(N):
                 out.h[i], out.sigma[i] = hs[i], sig[i]
-            return (APPROACH_PASSED if passed else DWELL_OPENED), n
+            return APPROACH_PASSED, n
         _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta)
         n += 1
         clock[CLOCK_DT] = min(2.0 * dd, control.dd_max) if moved < 0.5 * control.da_max else dd

@@ -663,12 +663,14 @@ class MarchWindow:
             budget.check(f"the tip-following mesh's re-meshing at a = {a[-1]:.4g}")
             new = prepare(self.scene, self.numerics,
                           tip_window(a[-1], self.zone, self.ahead, self.behind, direction))
-            n = len(a)
-            run = types.SimpleNamespace(h=m.h, q=m.q, sigma=m.sigma, h_prev=m.h_prev, n=n,
-                                        records=[None, m.records["delta"]], step=np.zeros(3),
-                                        stats=m.stats, cache=None)
+            # the march's state as an unloading's run: with a process zone, its last step's
+            # law (the state before it, that step's length) carried too
+            run = types.SimpleNamespace(h=m.h, q=m.q, sigma=m.sigma, h_prev=m.h_prev, n=len(a),
+                                        records=[None, m.records["delta"]],
+                                        step=np.array([0.0, m.dt_prev, 0.0]), stats=m.stats,
+                                        cache=None)
             transfer(run, m.pb, new)
-            m.move_to(new, run.h, run.q)
+            m.move_to(new, run.h, run.q, run.sigma)
             self.meshes, self.nodes = self.meshes + 1, max(self.nodes, new.mesh.nodes)
             lo, hi = new.tip_range
             room = min(hi - a[-1], a[-1] - lo)
