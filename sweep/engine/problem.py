@@ -177,6 +177,9 @@ class Problem:
     prony_weights, prony_times : Prony modes of Chat (empty when elastic or exact): the
         series fitted on the scene's time window, or a table material's own Kelvin terms.
     prony_error : achieved max relative error of the series (0 when none, or a table's).
+    prony_t_max : the end of the window the series was fitted on (tau0; infinite for a
+        table's own terms or none): past it the series' compliance is not the material's
+        (:func:`sweep.engine.bem.check_prony_window`).
     """
 
     scene: Scene
@@ -188,6 +191,7 @@ class Problem:
     prony_weights: np.ndarray
     prony_times: np.ndarray
     prony_error: float
+    prony_t_max: float = math.inf
 
     @property
     def h0(self) -> float:
@@ -374,7 +378,7 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"it on the tip-following mesh (sweep.engine.tip_following; model bem "
                       f"does so)")
     weights = times = np.zeros(0)
-    error = 0.0
+    error, t_fitted = 0.0, math.inf
     if scene.table is not None and not numerics.exact:
         # the table IS the series: its Kelvin form in tau0, every term, no fit (error 0)
         weights = np.ascontiguousarray(scene.table.weights, dtype=float)
@@ -390,6 +394,7 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         prony = prony_series(scene.material, n, scene.k, t_min, t_max, numerics.prony_rtol)
         weights = np.ascontiguousarray(prony.weights, dtype=float)
         times = np.ascontiguousarray(prony.times, dtype=float)
-        error = float(prony.max_rel_error)
-    return Problem(scene=scene, numerics=numerics, scales=s, mesh=mesh, A=mesh.influence, wP=mesh.load_weights, prony_weights=weights,
-                   prony_times=times, prony_error=error)
+        error, t_fitted = float(prony.max_rel_error), float(prony.t_max)
+    return Problem(scene=scene, numerics=numerics, scales=s, mesh=mesh, A=mesh.influence,
+                   wP=mesh.load_weights, prony_weights=weights, prony_times=times,
+                   prony_error=error, prony_t_max=t_fitted)

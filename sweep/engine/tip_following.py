@@ -49,8 +49,8 @@ from ..kernels.interface import (ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Int
 from ..scene import Numerics, Result, Scene
 from . import budget
 from .budget import OverBudget
-from .bem import (CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, join_phases,
-                  no_contact_reason, retraction_start, unload_chunk)
+from .bem import (CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, check_prony_window,
+                  join_phases, no_contact_reason, retraction_start, unload_chunk)
 from .initial import ElasticSolver, cached_state, relaxed_state
 from .mesh import WINDOW_AHEAD_ZONES, WINDOW_BEHIND_ZONES, band_nodes, tip_window
 from .postprocess import STATUS_TIME_BUDGET, finish
@@ -629,6 +629,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
     finish(res, status, res.trajectory, pb.mesh.spacing,
            STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING,
            remeshed=marks)
+    check_prony_window(pb, res)
     if res.ok:
         note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
         res.reason = f"{res.reason}; {note}" if res.reason else note
@@ -728,6 +729,7 @@ def _attempt_protocol(scene, numerics, ahead, behind, deadline) -> Result:
     finish(res, u.status, res.trajectory, pb.mesh.spacing,
            STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING,
            remeshed=[first] + [first + i for i in u.marks], first=first)
+    check_prony_window(pb, res)
     if res.ok:
         note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
         res.reason = f"{res.reason}; {note}" if res.reason else note

@@ -252,3 +252,38 @@ def test_presets_and_unknown_preset():
     assert Numerics.preset("fast").band_resolution < Numerics.preset("accurate").band_resolution
     with pytest.raises(InputError, match="preset"):
         Numerics.preset("turbo")
+
+
+def test_a_run_past_its_prony_window_fails_where_the_series_is_not_the_material():
+    """``check_prony_window``: the material's closed-form creep compliance beyond the window
+    is the independent value. A series fitted to 1e-2 tau0 is 10-40 % off the MPL's at 1-10
+    tau0 (n 0.8, k 0.1), and a run that reached 10 tau0 on it fails with the reason; the
+    series fitted on the scene's own window, which the MPL has crept past at 1e6 tau0, is
+    within its tolerance there, and the row stays ok."""
+    import dataclasses
+
+    from sweep import Result
+    from sweep.engine.bem import check_prony_window
+    from sweep.engine.problem import prepare, prony_series
+
+    scene = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1.0)
+    num = Numerics.preset("balanced")
+    pb = prepare(scene, num)
+    short = prony_series("mpl", 0.8, 0.1, 1e-4, 1e-2, num.prony_rtol)
+    cut = dataclasses.replace(pb, prony_weights=short.weights, prony_times=short.times,
+                              prony_t_max=1e-2)
+
+    def row(t_end):
+        res = Result(scene=scene, numerics=num)
+        res.status, res.pull_off, res.error_estimate = "ok", 1.0, 1e-3
+        res.trajectory = {"t": np.array([0.0, t_end])}
+        return res
+
+    far = row(10.0)
+    check_prony_window(cut, far)
+    assert far.status == "failed" and "past the window its Prony series" in far.reason
+    assert math.isnan(far.error_estimate)
+    relaxed = row(1e6)
+    assert pb.prony_t_max < 1e6
+    check_prony_window(pb, relaxed)
+    assert relaxed.status == "ok" and relaxed.error_estimate == 1e-3

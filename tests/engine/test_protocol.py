@@ -409,3 +409,23 @@ def test_the_prony_series_covers_a_slow_approach():
     fitted = 1.0 - np.exp(-t[:, None] / pb.prony_times[None, :]) @ pb.prony_weights
     assert np.max(np.abs(fitted / exact - 1.0)) <= 2.0 * num.prony_rtol
     assert abs(res.pull_off / finer.pull_off - 1.0) <= res.error_estimate
+
+
+def test_a_slow_approach_past_its_prony_window_is_caught(monkeypatch):
+    """The window's old timing (every phase at the retraction's speed) put this scene's march
+    past its series; the check of the run against the window (bem.check_prony_window) fails
+    such a row with the reason rather than report a pull-off 2.8e-2 off under an estimate of
+    1e-4."""
+    from sweep.engine import problem
+
+    scene = Scene(**SLOW_APPROACH)
+    scene_rate = scene.rate
+    original = problem.time_window
+
+    def retraction_timed(rate, scales, min_step):      # t_min at the phase's rate, t_max at
+        lo, _ = original(rate, scales, min_step)       # the retraction's
+        return lo, original(scene_rate, scales, min_step)[1]
+
+    monkeypatch.setattr(problem, "time_window", retraction_timed)
+    res = simulate(scene, Numerics.preset("balanced"))
+    assert res.status == "failed" and "past the window its Prony series" in res.reason
