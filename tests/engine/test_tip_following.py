@@ -451,3 +451,20 @@ def test_the_march_moves_its_window_with_the_growing_contact():
                        follow=follow)
     assert follow.meshes >= 2 and march.pb is not first
     assert march.records["a"][-1] == pytest.approx(window.a0_result, rel=1e-12)
+
+
+def test_the_march_carries_a_process_zone_across_its_remeshings():
+    """With a process zone the march's state is carried with its last step's law (the state
+    before it, that step's length), as the unloading's is. Second method: the graded mesh.
+    Measured (balanced, a window of 6 tip zones ahead and 3 behind, 3 meshes; 2026-11-27):
+    pull-off 8.1e-7 and hysteresis energy 6.2e-5 apart (the estimate 9.5e-3); the tolerances
+    are ten times those."""
+    scene = Scene(n=0.4, k=0.1, mu=3.24, rate=3.16, approach_rate=3.16, preload=2.0,
+                  dwell=10.0, pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5)
+    num = Numerics.preset("balanced")
+    graded = simulate(scene, num)
+    window = tf.simulate_tip_following(scene, num, ahead=6.0, behind=3.0)
+    assert graded.ok and window.ok, (graded.reason, window.reason)
+    assert _meshes(window) >= 3
+    assert window.pull_off == pytest.approx(graded.pull_off, rel=1e-5)
+    assert window.hysteresis_energy == pytest.approx(graded.hysteresis_energy, rel=6e-4)
