@@ -345,6 +345,7 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
                       f"elastic or auto, large contacts the crack-front model (model crack)")
     protocol = scene.protocol()
+    window = band is not None           # a tip-following mesh's window, not the scene's band
     if protocol and numerics.exact:
         raise Refused("a protocol's approach and dwell run the hereditary BEM's time march: "
                       "not with numerics.exact")
@@ -372,11 +373,12 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
         raise Refused(f"mesh too coarse: the tip zone {zone_length:.3g} a_ref spans {zone:.2g} "
                       f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
     if mesh.nodes > numerics.max_nodes:
-        raise Refused(f"mesh too large: the crack band needs {mesh.nodes} nodes at "
-                      f"band_resolution {numerics.band_resolution:g} (> max_nodes = "
-                      f"{numerics.max_nodes}); raise max_nodes or lower band_resolution; or run "
-                      f"it on the tip-following mesh (sweep.engine.tip_following; model bem "
-                      f"does so)")
+        other = ("" if window else "; or run it on the tip-following mesh "
+                 "(sweep.engine.tip_following; model bem does so)")
+        raise Refused(f"mesh too large: the {'window' if window else 'crack band'} needs "
+                      f"{mesh.nodes} nodes at band_resolution {numerics.band_resolution:g} (> "
+                      f"max_nodes = {numerics.max_nodes}); raise max_nodes or lower "
+                      f"band_resolution{other}")
     weights = times = np.zeros(0)
     error, t_fitted = 0.0, math.inf
     if scene.table is not None and not numerics.exact:

@@ -468,3 +468,14 @@ def test_the_march_carries_a_process_zone_across_its_remeshings():
     assert _meshes(window) >= 3
     assert window.pull_off == pytest.approx(graded.pull_off, rel=1e-5)
     assert window.hysteresis_energy == pytest.approx(graded.hysteresis_energy, rel=6e-4)
+
+
+def test_a_window_beyond_max_nodes_is_refused_without_sending_the_user_to_it():
+    """At mu 100 the fast preset's window itself needs 402 nodes (max_nodes 400): the refusal
+    names the window and the two ways out, not the tip-following mesh it already is."""
+    from sweep import simulate as front_door
+    res = front_door(Scene(n=0.8, k=0.1, mu=100.0, rate=316.2, approach_rate=316.2,
+                           preload=2.0, dwell=10.0, model="bem"), Numerics.preset("fast"))
+    assert res.status == "failed" and res.reason.startswith("mesh too large: the window needs")
+    assert "raise max_nodes or lower band_resolution" in res.reason
+    assert "tip-following" not in res.reason
