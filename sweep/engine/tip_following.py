@@ -612,24 +612,32 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
             res.newton_iterations = int(run.stats[STAT_ITER])
             res.factorizations = int(run.stats[STAT_FACTOR])
         return res
-    status, pb, meshes, nodes, marks = u.status, u.pb, u.meshes, u.nodes, u.marks
     n = run.n
     t, delta, P, a, a_inner = (x[:n].copy() for x in run.records)
     res.trajectory = {"t": t, "delta": delta, "P": P, "a": a, "a_inner": a_inner}
     res.steps = n - 1
     res.newton_iterations = int(run.stats[STAT_ITER])
     res.factorizations = int(run.stats[STAT_FACTOR])
-    res.nodes_used = nodes
+    res.nodes_used = u.nodes
+    return _finish_following(res, u, scales, u.meshes, u.nodes, u.marks)
+
+
+def _finish_following(res, u, scales, meshes, nodes, remeshed, first=0) -> Result:
+    """The row of a run on the tip-following mesh whose trajectory ``res`` holds, from how
+    its unloading ended (``u``, :class:`_Unloaded`): a broken re-meshing's or the mesh
+    count's reason, else :func:`finish` on the last mesh (records from ``first`` on, the
+    first record of each new mesh in ``remeshed``), the Prony window checked, and the meshes
+    it took in the reason."""
     if u.ended == "broken":
         res.reason = u.reason
         return res
-    if status == STATUS_LEFT_BAND:
-        res.reason = f"more than {MAX_MESHES} meshes (a = {a[-1]:.4g})"
+    if u.status == STATUS_LEFT_BAND:
+        res.reason = f"more than {MAX_MESHES} meshes (a = {res.trajectory['a'][-1]:.4g})"
         return res
-    finish(res, status, res.trajectory, pb.mesh.spacing,
-           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING,
-           remeshed=marks)
-    check_prony_window(pb, res)
+    spacing = u.pb.mesh.spacing
+    finish(res, u.status, res.trajectory, spacing, STOP_TRAVEL_SPACINGS * spacing, scales,
+           advice=ADVICE_TIP_FOLLOWING, remeshed=remeshed, first=first)
+    check_prony_window(u.pb, res)
     if res.ok:
         note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
         res.reason = f"{res.reason}; {note}" if res.reason else note
@@ -719,21 +727,9 @@ def _attempt_protocol(scene, numerics, ahead, behind, deadline) -> Result:
         res.reason = u.reason
         return res
     join_phases(res, march, run)
-    if u.ended == "broken":
-        res.reason = u.reason
-        return res
-    if u.status == STATUS_LEFT_BAND:
-        res.reason = f"more than {MAX_MESHES} meshes (a = {run.records[3][run.n - 1]:.4g})"
-        return res
     first = n0 - 1
-    finish(res, u.status, res.trajectory, pb.mesh.spacing,
-           STOP_TRAVEL_SPACINGS * pb.mesh.spacing, scales, advice=ADVICE_TIP_FOLLOWING,
-           remeshed=[first] + [first + i for i in u.marks], first=first)
-    check_prony_window(pb, res)
-    if res.ok:
-        note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
-        res.reason = f"{res.reason}; {note}" if res.reason else note
-    return res
+    return _finish_following(res, u, scales, meshes, nodes,
+                             [first] + [first + i for i in u.marks], first=first)
 
 
 @dataclasses.dataclass
