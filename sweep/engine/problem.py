@@ -333,11 +333,13 @@ def first_contact_radius(scene: Scene) -> float:
     return scene.k ** (1.0 / 3.0) * float(jkr_contact_radius(load=0.0))
 
 
-def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Problem:
+def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None, *,
+            window: bool = False) -> Problem:
     """Derive a scene's numbers once. Raises :class:`Refused` when the mesh cannot do.
 
     ``band`` overrides the crack band of a graded mesh (a_ref radii, see
-    :func:`sweep.engine.mesh.crack_band`).
+    :func:`sweep.engine.mesh.crack_band`); ``window``: that band is the tip-following mesh's
+    window (:mod:`sweep.engine.tip_following`), which a refusal names.
     """
     lo, hi = BEM_MU_RANGE
     if not lo <= scene.mu <= hi:
@@ -345,7 +347,6 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None) -> Prob
                       f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
                       f"elastic or auto, large contacts the crack-front model (model crack)")
     protocol = scene.protocol()
-    window = band is not None           # a tip-following mesh's window, not the scene's band
     if protocol and numerics.exact:
         raise Refused("a protocol's approach and dwell run the hereditary BEM's time march: "
                       "not with numerics.exact")

@@ -89,6 +89,13 @@ ADVICE_TIP_FOLLOWING = ("raise band_resolution (the fine spacing is the tip zone
                         "band_resolution) or use the crack-front model (model crack)")
 
 
+def window_problem(scene, numerics, tip, zone, ahead, behind, direction=-1):
+    """The prepared problem on the mesh whose fine window is around the crack tip at ``tip``
+    (:func:`sweep.engine.mesh.tip_window`; ``direction`` the way the tip moves)."""
+    return prepare(scene, numerics, tip_window(tip, zone, ahead, behind, direction),
+                   window=True)
+
+
 def remesh_jump(P: np.ndarray, m: int, rtol: float = REMESH_JUMP_RTOL) -> float | None:
     """The load jump at record ``m`` (the first on a new mesh) when it is not continuous
     with its neighbours (see REMESH_JUMP_STEPS), else None."""
@@ -568,7 +575,7 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
         # the initial state: where the relaxed tip lies outside the first window (delta0
         # scenes, whose radius is a JKR estimate), once more with the window there
         for _ in range(2):
-            pb = prepare(scene, numerics, tip_window(a_est, zone, ahead, behind))
+            pb = window_problem(scene, numerics, a_est, zone, ahead, behind)
             el = ElasticSolver(pb.A, pb.mesh.r, pb.h0, pb.c, numerics.tol)
             direct = direct_initial_state(el, pb, scene) if not from_branch else None
             if direct is not None:
@@ -670,8 +677,8 @@ class MarchWindow:
         if room < 2.0 * move:
             direction = -1 if len(a) > 1 and a[-1] < a[-2] else 1
             budget.check(f"the tip-following mesh's re-meshing at a = {a[-1]:.4g}")
-            new = prepare(self.scene, self.numerics,
-                          tip_window(a[-1], self.zone, self.ahead, self.behind, direction))
+            new = window_problem(self.scene, self.numerics, a[-1], self.zone, self.ahead,
+                                 self.behind, direction)
             # the march's state as an unloading's run: with a process zone, its last step's
             # law (the state before it, that step's length) carried too
             run = types.SimpleNamespace(h=m.h, q=m.q, sigma=m.sigma, h_prev=m.h_prev, n=len(a),
@@ -702,8 +709,8 @@ def _attempt_protocol(scene, numerics, ahead, behind, deadline) -> Result:
     window = MarchWindow(scene, numerics, zone, ahead, behind)
     stats = np.zeros(N_STATS, dtype=np.int64)
     try:
-        pb = prepare(scene, numerics,
-                     tip_window(first_contact_radius(scene), zone, ahead, behind, 1))
+        pb = window_problem(scene, numerics, first_contact_radius(scene), zone, ahead,
+                            behind, 1)
         march = run_phases(pb, scene.protocol(), stats, follow=window)
     except (Refused, OverBudget) as exc:
         res.reason = str(exc)
@@ -778,8 +785,8 @@ def _unload_following(scene, numerics, pb, run, zone, ahead, behind, deadline, d
             direction = -1 if a[run.n - 1] < a[max(run.n - 2, 0)] else 1
             try:
                 budget.check(f"the tip-following mesh's re-meshing at a = {a[run.n - 1]:.4g}")
-                new = prepare(scene, numerics,
-                              tip_window(a[run.n - 1], zone, ahead, behind, direction))
+                new = window_problem(scene, numerics, a[run.n - 1], zone, ahead, behind,
+                                     direction)
                 transfer(run, u.pb, new)
             except (Refused, OverBudget) as exc:
                 u.ended, u.reason = "remesh", f"re-meshing at a = {a[run.n - 1]:.4g}: {exc}"

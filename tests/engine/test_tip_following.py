@@ -424,6 +424,16 @@ def test_a_protocol_beyond_max_nodes_runs_on_the_window_as_on_a_larger_graded_me
     assert set(np.unique(phases)) == {0.0, 1.0, 2.0} and np.all(np.diff(phases) >= 0)
 
 
+def _graded_and_narrow_window(scene, num):
+    """``scene`` on its graded mesh and on a window of 6 tip zones ahead and 3 behind, both
+    ok, the window's rebuilt at least twice."""
+    graded = simulate(scene, num)
+    window = tf.simulate_tip_following(scene, num, ahead=6.0, behind=3.0)
+    assert graded.ok and window.ok, (graded.reason, window.reason)
+    assert _meshes(window) >= 3
+    return graded, window
+
+
 def test_the_march_moves_its_window_with_the_growing_contact():
     """A narrow window (6 tip zones ahead, 3 behind) at mu 3.24, where the graded mesh runs
     the scene too: the approach from first contact (radius 0.56) to the preload's (about
@@ -434,19 +444,16 @@ def test_the_march_moves_its_window_with_the_growing_contact():
                   dwell=10.0, dwell_hold="depth")
     num = Numerics.preset("fast")
     assert not models.wants_tip_following(scene, num)      # the graded mesh, as before
-    graded = simulate(scene, num)
-    window = tf.simulate_tip_following(scene, num, ahead=6.0, behind=3.0)
-    assert window.ok and graded.ok, (window.reason, graded.reason)
-    assert _meshes(window) >= 3
+    graded, window = _graded_and_narrow_window(scene, num)
     assert window.pull_off == pytest.approx(graded.pull_off, rel=3e-4)
     assert window.hysteresis_energy == pytest.approx(graded.hysteresis_energy, rel=1e-5)
     # the march alone, on the same windows: it moved them
-    from sweep.engine.problem import derive, first_contact_radius, prepare
+    from sweep.engine.problem import derive, first_contact_radius
     from sweep.engine.protocol import run_phases
     from sweep.kernels.solve import N_STATS
     zone = derive(scene, num).tip_zone
     follow = tf.MarchWindow(scene, num, zone, 6.0, 3.0)
-    first = prepare(scene, num, mesh.tip_window(first_contact_radius(scene), zone, 6.0, 3.0, 1))
+    first = tf.window_problem(scene, num, first_contact_radius(scene), zone, 6.0, 3.0, 1)
     march = run_phases(first, scene.protocol(), np.zeros(N_STATS, dtype=np.int64),
                        follow=follow)
     assert follow.meshes >= 2 and march.pb is not first
@@ -461,11 +468,7 @@ def test_the_march_carries_a_process_zone_across_its_remeshings():
     are ten times those."""
     scene = Scene(n=0.4, k=0.1, mu=3.24, rate=3.16, approach_rate=3.16, preload=2.0,
                   dwell=10.0, pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5)
-    num = Numerics.preset("balanced")
-    graded = simulate(scene, num)
-    window = tf.simulate_tip_following(scene, num, ahead=6.0, behind=3.0)
-    assert graded.ok and window.ok, (graded.reason, window.reason)
-    assert _meshes(window) >= 3
+    graded, window = _graded_and_narrow_window(scene, Numerics.preset("balanced"))
     assert window.pull_off == pytest.approx(graded.pull_off, rel=1e-5)
     assert window.hysteresis_energy == pytest.approx(graded.hysteresis_energy, rel=6e-4)
 
