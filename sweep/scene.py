@@ -883,8 +883,9 @@ class Result:
         and the largest indentation step (h0). NaN for the other models.
     hysteresis_energy : float
         A scene with a test protocol: the work the machine did on the sphere over the whole
-        path, int P d delta (pi dg R d_ref; :func:`sweep.engine.protocol.cycle_work`); NaN
-        without a protocol.
+        path, int P d delta (pi dg R d_ref; :func:`sweep.engine.postprocess.cycle_work`), to
+        the pull-off where the scene stops there (``stop`` "pulloff"), to the last record
+        where it follows the curve to separation; NaN without a protocol.
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0); with
         a protocol also ``phase`` (0 approach, 1 dwell, 2 retraction).

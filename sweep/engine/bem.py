@@ -39,9 +39,9 @@ from . import budget
 from .budget import OverBudget
 from .exact import unload_exact
 from .initial import ElasticSolver, relaxed_state
-from .postprocess import STATUS_TIME_BUDGET, finish
+from .postprocess import STATUS_TIME_BUDGET, cycle_work, finish
 from .problem import Problem, Refused, derive, material_of, prepare
-from .protocol import PHASES, cycle_work, run_phases
+from .protocol import PHASES, run_phases
 from .resolution import estimate_error, refine_advice
 
 #: Newton iterations per solve: a good step converges in 2-5 (quadratic predictor); a solve
@@ -314,7 +314,8 @@ def _simulate_protocol(pb: Problem, res: Result, deadline: float):
     """A scene with a test protocol (:mod:`sweep.engine.protocol`): approach and dwell, then
     the unloading kernel from the dwell's last state, its modes and its records. The row's
     initial state (``a0_result``, ``delta0_result``, ``a0_inner``) is the dwell's last, the
-    retraction's start; ``hysteresis_energy`` the work of the whole path; the trajectory's
+    retraction's start; ``hysteresis_energy`` the work of the whole path (to the pull-off,
+    :func:`sweep.engine.postprocess.finish`); the trajectory's
     ``phase`` says which phase made each record."""
     stats = np.zeros(N_STATS, dtype=np.int64)
     try:
@@ -358,7 +359,8 @@ def retraction_start(pb: Problem, march, stats) -> UnloadingState:
 def join_phases(res: Result, march, run: UnloadingState) -> None:
     """``res``'s trajectory: the march's records, then the retraction's (``run``) from its
     record 1, with ``phase`` (:data:`sweep.engine.protocol.PHASES`); and the hysteresis
-    energy of the whole path (:func:`sweep.engine.protocol.cycle_work`)."""
+    energy of the whole recorded path (:func:`sweep.engine.postprocess.cycle_work`; a
+    pull-off row's ends at its pull-off, :func:`sweep.engine.postprocess.finish`)."""
     rec, n = march.records, run.n
     res.trajectory = {key: np.concatenate([np.asarray(rec[key][:-1], float), x[:n]])
                       for key, x in zip(("t", "delta", "P", "a", "a_inner"), run.records)}

@@ -17,10 +17,11 @@ pb       the paper's closed-form estimate (:func:`pb_estimate`): the crack speed
          from the paper's fit vhat = 2.887 rhat_PB^1.171, Gamma_PB at that speed, and the
          load-control JKR pull-off with it, P = 1.5 Gamma_PB
 elastic  the quasi-static elastic branch (:func:`sweep.engine.quasistatic.simulate_elastic`), no
-         hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100; "bem" and
-         "auto" scenes that are elastic and quasi-static run it (:func:`wants_quasistatic`)
+         hereditary machinery: k = 1 scenes over the whole Tabor range 0.01-100, from a0 or
+         with a test protocol; "bem" and "auto" scenes that are elastic and quasi-static run
+         it (:func:`wants_quasistatic`)
 auto     the cheapest model whose error meets ``numerics.pull_off_rtol`` (:func:`model_choice`):
-         the BEM for a test protocol; the crack-front model first for a scene with a
+         the BEM for a test protocol (the elastic branch at k = 1); the crack-front model first for a scene with a
          process zone (the BEM where its error, the process zone's term included, misses
          the tolerance); the elastic branch for
          elastic quasi-static scenes; the PB estimate or the crack-front model where their
@@ -315,7 +316,7 @@ def _accepts(model: str, scene) -> bool:
 
 def model_choice(scene, numerics=None) -> Choice:
     """The model "auto" runs first for ``scene``: the BEM for a test protocol (the one model
-    that runs one); the crack-front model for a scene with a process zone (``pz_law``; the
+    that runs one, but for an elastic quasi-static scene's: the elastic branch); the crack-front model for a scene with a process zone (``pz_law``; the
     elastic branch and pb refuse it); the quasi-static elastic branch
     for an elastic quasi-static scene; beyond the BEM's Tabor range the crack-front model, its
     mu -> infinity limit; else the cheapest model (:data:`BY_COST`) whose
@@ -323,6 +324,9 @@ def model_choice(scene, numerics=None) -> Choice:
     else the BEM (graded or tip-following mesh). :func:`simulate_model` checks a cheaper
     model's error again at the amplification it computed and runs the BEM where it misses."""
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    if scene.protocol() is not None and wants_quasistatic(scene, numerics):
+        return Choice("elastic", "auto: k = 1, quasi-static: the elastic branch (no memory: "
+                                 "the approach and the dwell end at the preload's equilibrium)")
     if scene.protocol() is not None:
         return Choice("bem", "auto: BEM, the one model with a test protocol (approach, dwell, "
                              "retract)")
@@ -386,8 +390,10 @@ def wants_quasistatic(scene, numerics) -> bool:
     no process zone (a rate-dependent interface is not quasi-static), a rigid machine (the
     branch prescribes the sphere's indentation), started from a0, stopped at the pull-off, on
     the engine's own mesh (an explicit ``numerics.domain`` or ``exact`` asks for the
-    hereditary BEM on that domain)."""
-    return (scene.k == 1.0 and scene.a0 is not None and scene.stop == "pulloff"
+    hereditary BEM on that domain). A test protocol too: without memory, its approach and
+    dwell end in the branch's equilibrium at the preload."""
+    return (scene.k == 1.0 and (scene.a0 is not None or scene.protocol() is not None)
+            and scene.stop == "pulloff"
             and numerics.domain is None and not numerics.exact and scene.pz_law == "none"
             and scene.machine_stiffness is None)
 
@@ -421,13 +427,12 @@ PROCESS_ZONE_REFUSALS = {
 }
 
 
-#: why each model but the BEM refuses a scene with a test protocol: a failed row with this
-#: reason (not a physical refusal: the BEM answers it; auto sends it there)
+#: why each model but the BEM and the elastic branch (k = 1 only: no memory) refuses a scene
+#: with a test protocol: a failed row with this reason (not a physical refusal: the BEM
+#: answers it; auto sends it there)
 PROTOCOL_REFUSALS = {
     "crack": "the crack-front model starts from a relaxed contact and its bulk is relaxed: a "
              "test protocol (approach, dwell, retract) runs with model bem or auto",
-    "elastic": "the elastic branch starts from a relaxed contact: a test protocol (approach, "
-               "dwell, retract) runs with model bem or auto",
     "pb": "the pb estimate has no loading history: a test protocol (approach, dwell, retract) "
           "runs with model bem or auto",
 }
@@ -502,6 +507,14 @@ def _simulate_model(scene, model: str, numerics) -> Result:
         return ran[name]
 
     res = run(choice.model)
+    if (choice.model == "elastic" and model in ("bem", "auto") and scene.protocol() is not None
+            and res.status == "failed" and budget.remaining() > 0):
+        # the branch's protocol is parametrized by the contact radius from JKR's first
+        # contact, which a DMT-like contact (mu 0.01, a small preload) need not reach: the
+        # BEM marches it
+        choice = Choice("bem", f"{model}: BEM: the elastic branch failed the test protocol "
+                               f"({res.reason[:120]})")
+        res = run("bem")
     if model == "auto" and choice.model in ("crack", "pb") and scene.mu <= BEM_MU_RANGE[1] \
             and not res.error_estimate <= numerics.pull_off_rtol:
         miss = (f"auto: BEM: the {NAMES[choice.model]}'s measured error at its amplification "

@@ -273,3 +273,22 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     res.crack_speed = speed
     res.vhat = res.crack_speed / scales.process_zone
     res.rhat_pb = scales.loading_speed
+    if "phase" in trajectory and res.scene.stop == "pulloff":
+        # a test protocol's cycle ends at its pull-off: the records past it (the stop rule's
+        # recovery, some fine spacings of travel) depend on the mesh, not on the test
+        res.hysteresis_energy = cycle_work(trajectory, until=(t_star, res.delta_pulloff, P_star))
+
+
+def cycle_work(trajectory: dict, until=None) -> float:
+    """The work the machine did on the sphere over the recorded path, int P d delta
+    (trapezoid; pi dg R d_ref): the energy the approach put in less what the retraction took
+    back, i.e. what the cycle dissipated (with the surface energy of the contact left at
+    the end, none after separation). ``until`` (t, delta, P): the path ends at that state,
+    the records from time t on replaced by it (a pull-off run's: its pull-off, read between
+    records)."""
+    P, d = np.asarray(trajectory["P"], float), np.asarray(trajectory["delta"], float)
+    if until is not None:
+        keep = np.asarray(trajectory["t"], float) < until[0]
+        P, d = np.append(P[keep], until[2]), np.append(d[keep], until[1])
+    return float(np.sum(0.5 * (P[1:] + P[:-1]) * np.diff(d)))
+

@@ -34,8 +34,8 @@ by backward Euler from the last state (:meth:`_March._equation`): the approach a
 grow the contact and mostly close its crack, where the law is the Lennard-Jones law, but a
 node may open (a glassy contact relaxing), and there the zone adds its traction as in the
 retraction (the unloading kernel). The trajectory keeps every phase (``phase``: 0 approach, 1 dwell, 2 retraction); the row adds
-the work the machine did on the sphere over the whole path, ``hysteresis_energy`` (pi dg R
-d_ref, :func:`cycle_work`).
+the work the machine did on the sphere over the whole path, to the pull-off where the scene
+stops there, ``hysteresis_energy`` (pi dg R d_ref, :func:`cycle_work`).
 """
 from __future__ import annotations
 
@@ -57,6 +57,7 @@ from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_W
                              MeshArrays, Physics, invalidate, load, new_jacobian_cache, newton,
                              predict, predict_lattice, relax, score_starts, settle_tip)
 from ..theory import jkr_contact_radius
+from .postprocess import cycle_work
 from ..scene import Protocol
 from . import budget
 
@@ -708,12 +709,3 @@ def run_phases(pb, protocol: Protocol, stats, compiled: bool = True, follow=None
     finally:
         set_deadline(m.cache, np.inf)
     return m
-
-
-def cycle_work(trajectory: dict) -> float:
-    """The work the machine did on the sphere over the recorded path, int P d delta
-    (trapezoid; pi dg R d_ref): the energy the approach put in less what the retraction took
-    back, i.e. what the cycle dissipated (with the surface energy of the contact left at
-    the end, none after separation)."""
-    P, d = np.asarray(trajectory["P"], float), np.asarray(trajectory["delta"], float)
-    return float(np.sum(0.5 * (P[1:] + P[:-1]) * np.diff(d)))

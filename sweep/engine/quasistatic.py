@@ -52,8 +52,9 @@ from ..kernels.interface import TIP_GAP, lj_traction_and_stiffness
 from .. import units
 from ..errors import check_range
 from ..scene import Numerics, Result
-from ..theory import jkr_indentation, maugis_dugdale_pull_off, maugis_lambda
+from ..theory import jkr_contact_radius, jkr_indentation, maugis_dugdale_pull_off, maugis_lambda
 from .initial import jkr_gap_guess
+from .postprocess import cycle_work
 from .problem import derive
 
 #: the branch mesh's defaults: uniform elements of l0 / ZONE_RESOLUTION at the tip, growing to
@@ -274,6 +275,21 @@ def pull_off_radius_guess(mu: float) -> float:
     return max(A_JKR, math.sqrt(2.0 * (TIP_GAP - 1.0) * h0))
 
 
+def walk(br: ElasticBranch, radii, start=None):
+    """The branch's states along ``radii``, each solve started from the last (the first from
+    ``start``, (gap, indentation), else from the branch's guess): ([(h, delta)], [load],
+    None), or the radius whose solve failed last, the lists stopping before it."""
+    h, delta = br.guess(radii[0]) if start is None else start
+    states, loads = [], []
+    for a in radii:
+        h, delta, ok = br.solve(a, h, delta)
+        if not ok:
+            return states, loads, a
+        states.append((h, delta))
+        loads.append(br.load(a, h))
+    return states, loads, None
+
+
 def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, a_start=None,
                      **mesh) -> ElasticPullOff:
     """Elastic quasi-static pull-off at Tabor parameter mu (see the module docstring).
@@ -314,14 +330,9 @@ def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, a_start=None,
         a_lo = min(a_lo, 0.5 * a_start)
         count = max(scan, int(math.ceil(scan * math.log(a_start / a_lo) / math.log(a_hi / a_lo))))
         radii = np.geomspace(a_start, a_lo, count)
-    h, delta = br.guess(radii[0])
-    states, loads = [], []
-    for a in radii:
-        h, delta, ok = br.solve(a, h, delta)
-        if not ok:
-            return _failed(br, mu, t0, f"Newton did not converge at a = {a:.4g}")
-        states.append((h, delta))
-        loads.append(br.load(a, h))
+    states, loads, failed_at = walk(br, radii)
+    if failed_at is not None:
+        return _failed(br, mu, t0, f"Newton did not converge at a = {failed_at:.4g}")
     branch = (radii, np.array(loads), np.array([d for _, d in states]))
     i = int(np.argmin(loads))
     if i == len(radii) - 1 or (i == 0 and a_start is None):
@@ -413,6 +424,11 @@ def simulate_elastic(scene, numerics=None):
     0.01 to 100: the fold lies at smaller radii). Counters:
     ``steps`` = equilibrium solves, ``factorizations`` = Newton iterations (one dense solve
     each). A numerical failure gives ``status="failed"`` with the reason, never raises.
+
+    A scene with a test protocol (approach, dwell, retract) runs on the branch too
+    (:func:`_protocol_start`): an elastic bulk has no memory, so the approach follows the
+    branch from first contact up to the preload, the dwell (held at force or at depth) changes
+    nothing, and the retraction is the branch's unloading from the preload's radius.
     """
     if numerics is None:
         numerics = Numerics.preset("balanced")
@@ -421,17 +437,31 @@ def simulate_elastic(scene, numerics=None):
     if scene.k != 1.0:
         res.reason = f"the quasi-static elastic solver needs k = 1 (got k = {scene.k})"
         return res
-    if scene.a0 is None:
+    protocol = scene.protocol()
+    if protocol is not None:
+        try:
+            a_start, approach = _protocol_start(scene, protocol)
+        except RuntimeError as err:
+            res.reason = f"protocol: {err}"
+            res.wall_s = time.perf_counter() - t0
+            return res
+    elif scene.a0 is None:
         res.reason = "the quasi-static elastic solver starts from a0 (give a0, not delta0)"
         return res
-    po = elastic_pull_off(scene.mu, a_start=scene.a0)
+    else:
+        a_start, approach = scene.a0, None
+    po = elastic_pull_off(scene.mu, a_start=a_start)
     res.nodes_used, res.steps = po.nodes, po.solves
     res.newton_iterations = res.factorizations = po.newton_iterations
+    if approach is not None:
+        res.steps += approach["solves"]
+        res.newton_iterations += approach["iterations"]
+        res.factorizations = res.newton_iterations
     if not po.converged:
         # below the fold the start exists but cannot be held: a physical refusal, as the
         # BEM's (sweep.engine.tip_following.branch_state), not a numerical failure
-        state = state_at(ElasticBranch(scene.mu, scene.a0, 0.5 * scene.a0), scene.a0)
-        res.reason = (fold_refusal(scene.mu, scene.a0) if state is not None and state[2]
+        state = state_at(ElasticBranch(scene.mu, a_start, 0.5 * a_start), a_start)
+        res.reason = (fold_refusal(scene.mu, a_start) if state is not None and state[2]
                       else po.reason)
         res.wall_s = time.perf_counter() - t0
         return res
@@ -442,27 +472,158 @@ def simulate_elastic(scene, numerics=None):
     keep = radii[:stop] >= po.a
     d0 = float(deltas[0])
     speed = scales.loading_speed
+    t_start = 0.0 if approach is None else float(approach["t"][-1])
     res.status = "ok"
     res.reason = po.reason
     res.pull_off, res.a_pulloff, res.delta_pulloff = po.pull_off, po.a, po.delta
-    res.t_pulloff = (d0 - po.delta) / speed
+    res.t_pulloff = t_start + (d0 - po.delta) / speed
     res.crack_speed = speed / po.ddelta_da
     res.vhat = res.crack_speed / scales.process_zone
     res.rhat_pb = scales.loading_speed
     res.a0_result, res.delta0_result = float(radii[0]), d0
     res.spacing, res.domain_used = po.spacing, po.domain
     res.prony_terms, res.prony_error = 0, 0.0
-    a_tr = np.append(radii[:stop][keep], po.a)
-    d_tr = np.append(deltas[:stop][keep], po.delta)
-    res.trajectory = {"t": (d0 - d_tr) / speed, "delta": d_tr,
-                      "P": np.append(loads[:stop][keep], -po.pull_off), "a": a_tr,
+    if approach is None:
+        a_tr = np.append(radii[:stop][keep], po.a)
+        d_tr = np.append(deltas[:stop][keep], po.delta)
+        P_tr = np.append(loads[:stop][keep], -po.pull_off)
+    else:
+        try:
+            a_tr, d_tr, P_tr = _retraction_records(approach, po)
+        except RuntimeError as err:
+            res.status, res.reason = "failed", f"protocol: {err}"
+            res.wall_s = time.perf_counter() - t0
+            return res
+    res.trajectory = {"t": t_start + (d0 - d_tr) / speed, "delta": d_tr, "P": P_tr, "a": a_tr,
                       "a_inner": np.full(a_tr.size, np.nan)}
-    _estimate_error(res)
+    if approach is not None:
+        _join_protocol(res, approach)
+    _estimate_error(res, a_start)
     res.wall_s = time.perf_counter() - t0
     return res
 
 
-def _estimate_error(res) -> None:
+#: an elastic protocol's approach is recorded at this many radii (geometric, from first
+#: contact to the preload's radius; the retraction passes them again, and over them the
+#: trapezoid of the cycle's work cancels) ...
+APPROACH_RECORDS = 24
+#: ... and the retraction below first contact at this many, to the pull-off: the hysteresis
+#: energy's trapezoid (measured at mu 5: 1.23860, 1.23883, 1.23889, 1.23891 with 32, 64, 128,
+#: 256 such radii, second order: 6e-5 off at 64)
+TAIL_RECORDS = 64
+def _protocol_start(scene, protocol):
+    """(the preload's radius, the approach's records) of an elastic scene with a test protocol,
+    on the branch's mesh of :func:`elastic_pull_off` (so that the retraction starts from the same
+    state). The approach starts where the BEM's does (:func:`sweep.engine.protocol.first_contact`:
+    the JKR indentation at zero load, k = 1) and follows the branch, the radius growing, up to
+    the radius whose load is the preload; its time is the indentation's travel at
+    ``approach_rate h0``. The dwell adds one record ``dwell`` later in the same state (no
+    memory: held at force or at depth, nothing moves). Raises RuntimeError where a solve
+    fails or the branch is not stable (the indentation not growing with the radius)."""
+    mu = scene.mu
+    a_g = pull_off_radius_guess(mu)
+    a_zero = float(jkr_contact_radius(load=0.0))
+    d_first = float(jkr_indentation(a_zero))
+    a_pre = float(jkr_contact_radius(load=protocol.preload))
+    br = ElasticBranch(mu, a_g, min(0.35 * a_g, 0.5 * min(a_zero, a_pre)))
+    a_first = _branch_root(br, lambda a, h, d: d, d_first, a_zero, a_g)
+    a_end = _branch_root(br, lambda a, h, d: br.load(a, h), protocol.preload, a_pre, a_g)
+    if not a_end > a_first:
+        raise RuntimeError(f"the preload {protocol.preload:g} is reached at a = {a_end:.4g}, "
+                           f"below first contact (a = {a_first:.4g})")
+    radii = np.geomspace(a_first, a_end, APPROACH_RECORDS)
+    states, loads, failed_at = walk(br, radii)
+    if failed_at is not None:
+        raise RuntimeError(f"no elastic equilibrium on the approach at a = {failed_at:.4g}")
+    deltas = np.array([d for _, d in states])
+    if np.any(np.diff(deltas) <= 0.0):
+        raise RuntimeError("the elastic branch folds on the approach (the indentation does "
+                           "not grow with the radius)")
+    h0 = units.h0_hat(mu)
+    t = (deltas - deltas[0]) / (protocol.approach_rate * h0)
+    approach = {"t": t, "delta": deltas, "P": np.array(loads), "a": radii,
+                "phase": np.zeros(radii.size), "solves": br.solves,
+                "iterations": br.iterations, "branch": br}
+    if protocol.dwell > 0.0:
+        for key in ("t", "delta", "P", "a", "phase"):
+            approach[key] = np.append(approach[key], approach[key][-1])
+        approach["t"][-1] += protocol.dwell
+        approach["phase"][-1] = 1.0
+    return float(a_end), approach
+
+
+def _retraction_records(approach, po):
+    """(radii, indentations, loads) of an elastic protocol's retraction from the preload's
+    radius to the pull-off ``po``: the approach's states passed again in reverse (no memory),
+    then the branch below first contact at TAIL_RECORDS radii, then the pull-off. Where
+    the two paths share their states the trapezoid of the cycle's work cancels exactly, so
+    the hysteresis energy is the branch's integral between first contact and the pull-off."""
+    br = approach["branch"]
+    n = int(np.sum(approach["phase"] == 0.0))
+    a_app, d_app, P_app = (approach[key][:n][::-1] for key in ("a", "delta", "P"))
+    passed = a_app > po.a
+    a_tr, d_tr, P_tr = list(a_app[passed]), list(d_app[passed]), list(P_app[passed])
+    if a_tr[-1] > po.a * (1.0 + 1e-9):
+        radii = np.geomspace(a_tr[-1], po.a, TAIL_RECORDS)[:-1]
+        states, loads, failed_at = walk(br, radii)
+        if failed_at is not None:
+            raise RuntimeError(f"no elastic equilibrium on the retraction at a = "
+                               f"{failed_at:.4g}")
+        a_tr += list(radii[1:])
+        d_tr += [d for _, d in states[1:]]
+        P_tr += loads[1:]
+    return (np.append(a_tr, po.a), np.append(d_tr, po.delta), np.append(P_tr, -po.pull_off))
+
+
+def _branch_root(br, value, target, a_guess, a_low):
+    """The radius where ``value(a, h, delta)`` (increasing in a above the branch's pull-off)
+    equals ``target`` on the branch ``br``: bracketed from ``a_guess``
+    (down to ``a_low``, the expected pull-off radius, and up by half again each try), then
+    Brent's method, each solve started from the nearest state solved. Raises RuntimeError
+    where a solve fails or no bracket is found."""
+    from scipy.optimize import brentq  # lazy: not on a relaxed scene's path
+
+    solved = {}
+
+    def f(a):
+        near = min(solved, key=lambda b: abs(b - a)) if solved else None
+        h, d = br.guess(a) if near is None else solved[near]
+        h, d, ok = br.solve(a, h, d)
+        if not ok:
+            raise RuntimeError(f"no elastic equilibrium at a = {a:.4g}")
+        solved[a] = (h, d)
+        return value(a, h, d) - target
+
+    lo, hi = min(a_guess, a_low), max(a_guess, a_low)
+    f_lo, f_hi = f(lo), f(hi)
+    for _ in range(40):
+        if f_hi > 0.0:
+            break
+        lo, f_lo, hi = hi, f_hi, 1.5 * hi
+        f_hi = f(hi)
+    if not (f_lo <= 0.0 < f_hi):
+        raise RuntimeError(f"no radius on the elastic branch between a = {lo:.4g} and "
+                           f"{hi:.4g} reaches {target:.6g}")
+    return brentq(f, lo, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps,
+                  maxiter=200) if f_lo < 0.0 else lo
+
+
+def _join_protocol(res, approach) -> None:
+    """``res``'s trajectory: the approach's (and the dwell's) records, then the retraction's
+    from its second (its first is the approach's last state), with ``phase``
+    (:data:`sweep.engine.protocol.PHASES`), and the hysteresis energy of the whole path (to
+    the pull-off: the branch's records end there)."""
+    tr = res.trajectory
+    n = tr["t"].size - 1
+    joined = {key: np.concatenate([approach[key], tr[key][1:]])
+              for key in ("t", "delta", "P", "a")}
+    joined["a_inner"] = np.full(joined["t"].size, np.nan)
+    joined["phase"] = np.concatenate([approach["phase"], np.full(n, 2.0)])
+    res.trajectory = joined
+    res.hysteresis_energy = cycle_work(joined)
+
+
+def _estimate_error(res, a_start: float) -> None:
     """The error estimate of an ok elastic result, in place: the pull-off change on the
     branch's mesh at 1/f of the resolution (f times the tip-zone and the coarse spacing)
     over f - 1, as the BEM's (:func:`sweep.engine.resolution.estimate_error`), with
@@ -472,7 +633,7 @@ def _estimate_error(res) -> None:
     tol = res.numerics.pull_off_rtol
     if tol <= 0:
         return
-    check = elastic_pull_off(res.scene.mu, a_start=res.scene.a0,
+    check = elastic_pull_off(res.scene.mu, a_start=a_start,
                              zone_resolution=ZONE_RESOLUTION / ELASTIC_CHECK_FACTOR,
                              coarse=COARSE * ELASTIC_CHECK_FACTOR)
     if not check.converged:

@@ -90,6 +90,83 @@ def test_an_elastic_bulk_gives_the_same_pull_off_for_every_protocol(protocol):
     assert res.pull_off == pytest.approx(relaxed.pull_off, rel=LATTICE["pull_off"])
 
 
+#: an elastic protocol on the quasi-static branch against the BEM's march on SAME_MESH, the
+#: three protocols above (measured 2026-11-27: pull-off 5e-5 to 8e-5 apart, contact radius
+#: after the dwell 2e-4 to 6e-4, hysteresis energy 3.2e-3 to 4.5e-3, crack speed at pull-off
+#: 9e-4 to 5.3e-3: the march's lattice, whose crack tip pins between nodes)
+BRANCH_VS_MARCH = dict(pull_off=3e-4, radius=2e-3, hysteresis=1e-2, crack_speed=2e-2)
+
+
+@pytest.mark.parametrize("protocol", [
+    dict(approach_rate=1.0, preload=2.0, dwell=5.0),
+    dict(approach_rate=100.0, preload=6.0, dwell=0.5, dwell_hold="depth")])
+def test_an_elastic_protocol_runs_on_the_branch_as_the_march_does(protocol):
+    """k = 1 without a process zone: "bem" and "auto" run the protocol on the elastic branch
+    (no memory: the approach follows the equilibria up to the preload, the dwell moves
+    nothing, the retraction is the branch's unloading); a second method, the BEM's time
+    march, gives the same row to its lattice."""
+    march = run(SAME_MESH, **BASE, k=1.0, **protocol)
+    branch = run(None, **BASE, k=1.0, **protocol)
+    assert branch.model_used == "elastic" and march.model_used == "bem"
+    assert branch.pull_off == pytest.approx(march.pull_off, rel=BRANCH_VS_MARCH["pull_off"])
+    assert branch.a0_result == pytest.approx(march.a0_result, rel=BRANCH_VS_MARCH["radius"])
+    assert branch.hysteresis_energy == pytest.approx(march.hysteresis_energy,
+                                                     rel=BRANCH_VS_MARCH["hysteresis"])
+    assert branch.crack_speed == pytest.approx(march.crack_speed,
+                                               rel=BRANCH_VS_MARCH["crack_speed"])
+    traj = branch.trajectory
+    phase = traj["phase"]
+    assert phase[0] == 0 and np.all(np.diff(phase) >= 0) and phase[-1] == 2
+    assert np.all(np.diff(traj["delta"][phase == 0]) > 0)
+    assert traj["P"][phase == 0][-1] == pytest.approx(protocol["preload"], rel=1e-9)
+    assert traj["P"][-1] == -branch.pull_off and traj["t"][-1] == branch.t_pulloff
+
+
+#: the JKR cycle (mu -> infinity): from first contact at zero load along the JKR curve to the
+#: preload and back to the load-controlled pull-off, the machine does the work
+#: W = -int_{a_po}^{a_0} P(a) d delta/da da = 1.20273 (scipy quad of theory.jkr_load and
+#: jkr_indentation's derivative, a_po = 1.0400, a_0 = 1.6510), whatever the preload and dwell;
+#: the branch at mu 100 gave 1.20290-1.20291 (1.5e-4 above: the Tabor parameter's finite
+#: tip zone) and the pull-off 1.50019 (1.3e-4)
+JKR_CYCLE_WORK = 1.2027336624567038
+JKR_LIMIT_RTOL = 1e-3
+
+
+def test_an_elastic_protocol_at_large_mu_has_the_jkr_cycle():
+    """At mu 100 (where the BEM's march of an elastic protocol had failed: the tip snaps
+    between nodes) every protocol gives the relaxed start's pull-off on the branch, the JKR
+    limit's, and the hysteresis energy of the JKR cycle, for preloads and holds alike."""
+    scene = dict(n=0.5, mu=100.0, rate=10.0, k=1.0)
+    relaxed = simulate(Scene(**scene, a0=2.5))
+    assert relaxed.ok and relaxed.model_used == "elastic"
+    rows = [simulate(Scene(**scene, **p)) for p in (
+        dict(approach_rate=1.0, preload=0.5, dwell=0.0),
+        dict(approach_rate=1e3, preload=50.0, dwell=10.0, dwell_hold="depth"))]
+    for res in rows:
+        assert res.ok and res.model_used == "elastic", res.reason
+        assert res.pull_off == pytest.approx(relaxed.pull_off, rel=1e-9)
+        assert res.pull_off == pytest.approx(1.5, rel=JKR_LIMIT_RTOL)
+        assert res.hysteresis_energy == pytest.approx(JKR_CYCLE_WORK, rel=JKR_LIMIT_RTOL)
+    assert rows[0].hysteresis_energy == pytest.approx(rows[1].hysteresis_energy, rel=1e-5)
+
+
+def test_an_elastic_protocol_the_branch_cannot_run_goes_to_the_march(monkeypatch):
+    """Where the branch fails a protocol (made to here), "bem" and "auto" march it, and the
+    reason says why; model "elastic" reports the branch's failure."""
+    from sweep.engine import quasistatic
+
+    def fails(scene, protocol):
+        raise RuntimeError("no radius on the elastic branch reaches it")
+
+    monkeypatch.setattr(quasistatic, "_protocol_start", fails)
+    scene = dict(BASE, k=1.0, **PROTOCOL)
+    branch = simulate(Scene(**scene, model="elastic"))
+    assert branch.status == "failed" and "no radius on the elastic branch" in branch.reason
+    for model in ("bem", "auto"):
+        res = simulate(Scene(**scene, model=model))
+        assert res.ok and res.model_used == "bem" and "elastic branch failed" in res.model_reason
+
+
 @pytest.mark.parametrize("hold", ["force", "depth"])
 def test_a_long_dwell_ends_in_the_relaxed_state(hold):
     """SLS k = 0.2 (retardation time tau0, relaxation time k tau0): after a dwell of 200
@@ -127,9 +204,11 @@ def test_only_the_bem_runs_a_protocol_and_auto_sends_it_there():
     sc = dict(BASE, k=0.2, **PROTOCOL)
     res = simulate(Scene(**sc, model="auto"))
     assert res.ok and res.model_used == "bem" and "test protocol" in res.model_reason
-    for model in ("crack", "pb", "elastic"):
+    for model in ("crack", "pb"):
         r = simulate(Scene(**sc, model=model))
         assert r.status == "failed" and "runs with model bem or auto" in r.reason
+    r = simulate(Scene(**sc, model="elastic"))      # a protocol of k = 1 only
+    assert r.status == "failed" and "needs k = 1" in r.reason
     # with a process zone too: the retraction runs its law, which raises the pull-off
     pz = simulate(Scene(**sc, **PZ))
     assert pz.ok and pz.model_used == "bem" and pz.pull_off > 1.05 * res.pull_off
@@ -158,16 +237,18 @@ STRONG_PZ = dict(PZ, pz_v0=1e-2)
 
 def test_the_march_carries_the_process_zone_where_a_gap_opens():
     """Every phase runs the process zone's law. Limits: a zone too slow to act (pz_v0 1e12)
-    gives the LJ protocol's row (measured 1.4e-8 apart); a strong one, whose dwell opens a
-    node, runs (it had been refused) and dissipates more over the cycle and pulls harder
-    (measured: hysteresis energy 25.5 against 6.97, pull-off 8.06 against 3.04)."""
+    gives the LJ protocol's row (measured: the pull-off 1.4e-7 apart; the loads along the path
+    up to 9e-6, and with them the hysteresis energy, whose path ends at the pull-off instant,
+    1.5e-5); a strong one, whose dwell opens a node, runs (it had been refused) and
+    dissipates more over the cycle and pulls harder (measured: hysteresis energy to the
+    pull-off 20.5 against 5.97, pull-off 8.06 against 3.04)."""
     num = Numerics.preset("balanced", pull_off_rtol=0.0)
     lj = simulate(Scene(model="bem", **SLS_PROTOCOL), num)
     faint = simulate(Scene(model="bem", **SLS_PROTOCOL, **dict(PZ, pz_v0=1e12)), num)
     strong = simulate(Scene(model="bem", **SLS_PROTOCOL, **STRONG_PZ), num)
     assert lj.ok and faint.ok and strong.ok, (lj.reason, faint.reason, strong.reason)
     assert faint.pull_off == pytest.approx(lj.pull_off, rel=1e-6)
-    assert faint.hysteresis_energy == pytest.approx(lj.hysteresis_energy, rel=1e-6)
+    assert faint.hysteresis_energy == pytest.approx(lj.hysteresis_energy, rel=5e-5)
     assert strong.hysteresis_energy > 2.0 * lj.hysteresis_energy
     assert strong.pull_off > 2.0 * lj.pull_off
 
