@@ -35,6 +35,7 @@ import os
 import time
 from pathlib import Path
 
+from ..campaign.store import provenance
 from ..scene import Numerics
 from .pdms import (PDMS_CASE, PDMS_PROTOCOL, PROTOCOL_NUMERICS, bem_case, pdms_scene,
                    protocol_key)
@@ -130,10 +131,18 @@ def protocol_point(speed_um: float, mu: float, case=None, protocol=None,
                                            + rows["protocol"]["error_estimate"])}
 
 
+def resumable(commit: str) -> bool:
+    """Whether a file written by ``commit`` (:func:`sweep.campaign.store.provenance`) may be
+    resumed: a clean commit of a git checkout, not "unknown" or "-dirty" (whose code the
+    string does not pin)."""
+    return commit != "unknown" and not commit.endswith("-dirty")
+
+
 def protocol_curve(path, mus=MUS, speeds=SPEEDS_UM_S, log=print) -> dict:
     """Every (mu, speed) point of :func:`protocol_point` and the approach check, written to the
-    JSON file ``path`` (resumed: a point already there for the same case and protocol is not
-    run again; each new one is written when done).
+    JSON file ``path`` (resumed: a point already there for the same case and protocol, written
+    by the same clean commit (:func:`resumable`), is not run again; each new one is written
+    when done; a file another commit wrote is computed again).
 
     Returns
     -------
@@ -144,11 +153,19 @@ def protocol_curve(path, mus=MUS, speeds=SPEEDS_UM_S, log=print) -> dict:
     """
     path = Path(path)
     key = protocol_key()
-    data = {**key, "points": [], "approach_check": None}
+    commit = provenance()["git_commit"]
+    data = {**key, "git_commit": commit, "points": [], "approach_check": None}
     if path.is_file():
         old = json.loads(path.read_text())
-        if all(old.get(k) == v for k, v in key.items()):
+        # resumed only by the clean commit that wrote it: another engine may compute other
+        # numbers for the same case, test and numerics
+        if (all(old.get(k) == v for k, v in key.items()) and old.get("git_commit") == commit
+                and resumable(commit)):
             data = old
+            log(f"{path}: resuming the {len(old['points'])} points commit {commit[:12]} made")
+        else:
+            log(f"{path}: made by {str(old.get('git_commit', 'an earlier version'))[:18]} "
+                f"or for another case: every point computed again")
 
     def save():
         data["summary"] = summary(data["points"])

@@ -65,3 +65,28 @@ def test_the_report_section_has_a_row_per_speed(committed):
     rows = [line for line in lines if line.startswith("| ") and line[2].isdigit()]
     assert len(rows) == len(pdms_protocol.SPEEDS_UM_S)
     assert any("The bulk's history changes the pull-off by at most" in line for line in lines)
+
+
+@pytest.mark.parametrize("writer, now, resumed", [
+    ("a" * 40, "a" * 40, True),                    # the same clean commit resumes
+    ("a" * 40, "b" * 40, False),                   # another engine computes it again
+    ("a" * 40 + "-dirty", "a" * 40 + "-dirty", False),   # a dirty tree pins no code
+    ("unknown", "unknown", False)])
+def test_a_curve_is_resumed_only_by_the_clean_commit_that_made_it(
+        tmp_path, monkeypatch, committed, writer, now, resumed):
+    point = dict(committed["points"][0])
+    calls = []
+
+    def computed(speed_um, mu, **kwargs):
+        calls.append((mu, speed_um))
+        return dict(point, mu=float(mu), speed_um_s=float(speed_um))
+
+    path = tmp_path / "protocol.json"
+    path.write_text(json.dumps(dict(committed, git_commit=writer,
+                                    points=[dict(point, mu=5.0, speed_um_s=1.0)],
+                                    approach_check=committed["approach_check"])))
+    monkeypatch.setattr(pdms_protocol, "provenance", lambda: {"git_commit": now})
+    monkeypatch.setattr(pdms_protocol, "protocol_point", computed)
+    data = pdms_protocol.protocol_curve(path, mus=(5.0,), speeds=(1.0,), log=lambda s: None)
+    assert calls == ([] if resumed else [(5.0, 1.0), (5.0, 1.0e4)])
+    assert data["git_commit"] == now
