@@ -41,6 +41,7 @@ help:
 	@echo "make model-errors - crack-front model and PB estimate vs the BEM over mu (the table auto reads)"
 	@echo "make pz-check - the BEM's process zone vs the crack-front model, and its cost (results/process_zone/)"
 	@echo "make protocol-cost - a protocol scene's wall time against its relaxed start (results/protocol/)"
+	@echo "make hysteresis-coverage - a protocol's hysteresis_error against a finer run (results/protocol/, ~5 min)"
 	@echo "make pz-map - the process zone's map from crack speed to opening rate (the table the BEM reads, ~1 min)"
 	@echo "make random-sample - 60 random scenes across the declared ranges, auto and bem, 80 with a test protocol, 40 with a protocol and a process zone, 40 with a protocol at mu 6-30 (results/random/)"
 	@echo "make error-coverage [QUICK=1] - does error_estimate cover the true error? per preset (results/error_coverage/)"
@@ -236,6 +237,11 @@ pz-check: $(STAMP)
 .PHONY: protocol-cost
 protocol-cost: $(STAMP)
 	$(BIN)/python -m sweep.bench.protocol_cost
+
+# a test protocol's hysteresis_error against a finer run (results/protocol/hysteresis_coverage.json)
+.PHONY: hysteresis-coverage
+hysteresis-coverage: $(STAMP)
+	$(BIN)/python -m sweep.bench.hysteresis_coverage
 
 .PHONY: calibrate-pz-demo
 calibrate-pz-demo: $(STAMP)

@@ -886,6 +886,11 @@ class Result:
         path, int P d delta (pi dg R d_ref; :func:`sweep.engine.postprocess.cycle_work`), to
         the pull-off where the scene stops there (``stop`` "pulloff"), to the last record
         where it follows the curve to separation; NaN without a protocol.
+    hysteresis_error : float
+        The estimated relative error of ``hysteresis_energy``: its change against the error
+        estimate's coarser solve, over the same factor as the pull-off's (the BEM's f^0.65 -
+        1, the elastic branch's sqrt 2 - 1); NaN without a protocol or an estimate. Not part
+        of ``error_estimate``, which is the pull-off's, nor of the row's status.
     trajectory : dict of arrays
         ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0); with
         a protocol also ``phase`` (0 approach, 1 dwell, 2 retraction).
@@ -922,6 +927,7 @@ class Result:
     band_resolution_used: float = math.nan
     step_used: float = math.nan
     hysteresis_energy: float = math.nan
+    hysteresis_error: float = math.nan
     trajectory: dict = field(default_factory=dict)
 
     @property

@@ -55,6 +55,7 @@ from ..scene import Numerics, Result
 from ..theory import jkr_contact_radius, jkr_indentation, maugis_dugdale_pull_off, maugis_lambda
 from .initial import jkr_gap_guess
 from .postprocess import cycle_work
+from .resolution import hysteresis_error
 from .problem import derive
 
 #: the branch mesh's defaults: uniform elements of l0 / ZONE_RESOLUTION at the tip, growing to
@@ -522,11 +523,9 @@ def _protocol_start(scene, protocol):
     fails or the branch is not stable (the indentation not growing with the radius)."""
     mu = scene.mu
     a_g = pull_off_radius_guess(mu)
-    a_zero = float(jkr_contact_radius(load=0.0))
-    d_first = float(jkr_indentation(a_zero))
+    br = _branch(mu)
+    a_first = _first_contact(br, mu)
     a_pre = float(jkr_contact_radius(load=protocol.preload))
-    br = ElasticBranch(mu, a_g, min(0.35 * a_g, 0.5 * min(a_zero, a_pre)))
-    a_first = _branch_root(br, lambda a, h, d: d, d_first, a_zero, a_g)
     a_end = _branch_root(br, lambda a, h, d: br.load(a, h), protocol.preload, a_pre, a_g)
     if not a_end > a_first:
         raise RuntimeError(f"the preload {protocol.preload:g} is reached at a = {a_end:.4g}, "
@@ -550,6 +549,40 @@ def _protocol_start(scene, protocol):
         approach["t"][-1] += protocol.dwell
         approach["phase"][-1] = 1.0
     return float(a_end), approach
+
+
+def _branch(mu, **mesh) -> ElasticBranch:
+    """The branch an elastic protocol runs on: sized for the pull-off radius, down to half the
+    JKR radius at zero load (first contact; a preload is > 0, its radius larger)."""
+    a_g = pull_off_radius_guess(mu)
+    a_low = 0.5 * float(jkr_contact_radius(load=0.0))
+    return ElasticBranch(mu, a_g, min(0.35 * a_g, a_low), **mesh)
+
+
+def _first_contact(br, mu) -> float:
+    """The radius on ``br`` of the BEM's first contact (:func:`sweep.engine.protocol.
+    first_contact`, k = 1): the JKR contact's indentation at zero load."""
+    a_zero = float(jkr_contact_radius(load=0.0))
+    return _branch_root(br, lambda a, h, d: d, float(jkr_indentation(a_zero)), a_zero,
+                        pull_off_radius_guess(mu))
+
+
+def _cycle_work(br, mu, po) -> float:
+    """An elastic protocol's hysteresis energy on the branch ``br`` with its pull-off ``po``:
+    the work along the branch from first contact to the pull-off (the trapezoid on
+    TAIL_RECORDS radii, as :func:`_retraction_records`'s; where the approach and the
+    retraction coincide, theirs cancel), NaN where a solve fails."""
+    try:
+        a_first = _first_contact(br, mu)
+    except RuntimeError:
+        return math.nan
+    if not a_first > po.a:
+        return 0.0
+    states, loads, failed_at = walk(br, np.geomspace(a_first, po.a, TAIL_RECORDS)[:-1])
+    if failed_at is not None:
+        return math.nan
+    return cycle_work({"P": np.append(loads, -po.pull_off),
+                       "delta": np.append([d for _, d in states], po.delta)})
 
 
 def _retraction_records(approach, po):
@@ -642,6 +675,11 @@ def _estimate_error(res, a_start: float) -> None:
         return
     change = abs(res.pull_off - check.pull_off) / res.pull_off
     res.error_estimate = change / (ELASTIC_CHECK_FACTOR - 1.0)
+    if res.scene.protocol() is not None:
+        coarse = _branch(res.scene.mu, zone_resolution=ZONE_RESOLUTION / ELASTIC_CHECK_FACTOR,
+                         coarse=COARSE * ELASTIC_CHECK_FACTOR)
+        res.hysteresis_error = hysteresis_error(res, _cycle_work(coarse, res.scene.mu, check),
+                                                ELASTIC_CHECK_FACTOR - 1.0)
     if res.error_estimate > tol:
         res.status = "failed"
         res.reason = (f"unresolved: the pull-off moves by {change:.2g} on the branch at "

@@ -1,8 +1,9 @@
-"""Pull-off refinement (sweep.engine.postprocess.refine_minimum) against closed forms."""
+"""Pull-off refinement (sweep.engine.postprocess.refine_minimum) and the cycle's work
+(cycle_work, work_quadrature_error) against closed forms."""
 import numpy as np
 import pytest
 
-from sweep.engine.postprocess import refine_minimum
+from sweep.engine.postprocess import cycle_work, refine_minimum, work_quadrature_error
 
 
 @pytest.mark.parametrize("vertex_t", [0.3, 0.5, 0.7, 1.2])
@@ -163,3 +164,37 @@ def test_capture_fits_gives_the_inputs_of_the_reported_crack_speed():
         == res.crack_speed
     # closed form: -da/dt = 3e4 + 2e12 t at the pull-off instant
     assert res.crack_speed == pytest.approx(3.0e4 + 2e12 * res.t_pulloff, rel=1e-9)
+
+
+def test_the_cycle_work_and_its_quadrature_error_on_a_parabola():
+    """P = delta^2 recorded at spacing h on [0, 1]: the trapezoid gives 1/3 + h^2/6, on
+    every other record 1/3 + 4 h^2/6; their difference, h^2/2, is what the quadrature error
+    reports (relative to the work); ``until`` ends the path between records."""
+    h = 1.0 / 16
+    d = np.arange(17) * h
+    traj = {"t": d.copy(), "delta": d, "P": d**2, "phase": np.zeros(d.size)}
+    assert cycle_work(traj) == pytest.approx(1 / 3 + h**2 / 6, rel=1e-13)
+    assert cycle_work(traj, halved=True) == pytest.approx(1 / 3 + 4 * h**2 / 6, rel=1e-13)
+    assert work_quadrature_error(traj) == pytest.approx((h**2 / 2) / (1 / 3 + h**2 / 6),
+                                                        rel=1e-12)
+    # the path ends at t = 0.5 + h / 2 (delta there, P its square): [0, 0.5] then one half step
+    end = 0.5 + h / 2
+    assert cycle_work(traj, until=(end, end, end**2)) == pytest.approx(
+        cycle_work({"delta": d[:9], "P": d[:9] ** 2}) + 0.5 * (0.25 + end**2) * h / 2, rel=1e-13)
+
+
+def test_halving_keeps_each_phase_and_its_ends():
+    """An approach up P = delta^2 and a retraction down the same records: the two cancel on
+    the halved records as on all of them (each phase's first and last kept), whatever the
+    phases' parities; on another retraction curve the halved path is that of the records
+    kept."""
+    up = np.arange(10) / 9.0                      # 10 records: its last, odd, is kept
+    down = up[::-1][1:]
+    traj = {"delta": np.concatenate([up, down]), "P": np.concatenate([up, down]) ** 2,
+            "phase": np.concatenate([np.zeros(10), np.full(9, 2.0)])}
+    assert cycle_work(traj) == pytest.approx(0.0, abs=1e-15)
+    assert cycle_work(traj, halved=True) == pytest.approx(0.0, abs=1e-15)
+    traj["P"] = np.concatenate([up**2, down**2 - 1.0])
+    kept = [0, 2, 4, 6, 8, 9, 10, 12, 14, 16, 18]
+    assert cycle_work(traj, halved=True) == pytest.approx(
+        cycle_work({key: traj[key][kept] for key in ("delta", "P")}), rel=1e-14)
