@@ -380,7 +380,7 @@ def scene_numerics(res, preset: str) -> tuple[str, str]:
 def scene_text(res, preset: str) -> list[str]:
     """The lines of ``sweep scene``'s text output after the scene line: the model's own
     numerics, the status, the model, the initial state, pull-off and crack speed (the fields
-    the model computes) and the cost."""
+    the model computes), a test protocol's hysteresis energy and its error, and the cost."""
     numerics, cost = scene_numerics(res, preset)
     why = f"  ({res.model_reason})" if res.model_used != res.scene.model else ""  # auto
     lines = [f"numerics   {numerics}",
@@ -395,6 +395,9 @@ def scene_text(res, preset: str) -> list[str]:
             error_estimate=res.error_estimate))
         lines.append(f"crack      v_a={res.crack_speed:.6g} (a_ref/tau0)  "
                      + _finite(vhat=res.vhat, rhat_pb=res.rhat_pb))
+        if math.isfinite(res.hysteresis_energy):      # a test protocol's cycle
+            lines.append(f"cycle      hysteresis_energy={res.hysteresis_energy:.6g} (pi dg R "
+                         f"d_ref)  " + _finite(hysteresis_error=res.hysteresis_error))
     lines.append(f"cost       {cost}")
     return lines
 

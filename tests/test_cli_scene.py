@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from sweep import Scene, simulate
 from sweep.cli import main
 
 SCENE = ["scene", "--n", "0.8", "--k", "0.1", "--mu", "3.24", "--a0", "2.0", "--rate", "10",
@@ -143,3 +144,19 @@ def test_scene_asked_for_an_accuracy(capsys):
     assert main(base + ["--pull-off-rtol", "2"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["error: pull_off_rtol must be in (0, 1] (got 2)"]
+
+
+def test_scene_text_shows_a_protocols_cycle_and_its_error(capsys):
+    """A test protocol's row: the hysteresis energy (the work to the pull-off) and its error
+    estimate, the same numbers as the Result; a relaxed start has no such line."""
+    argv = ["scene", "--n", "0.5", "--k", "1", "--mu", "5", "--rate", "10",
+            "--approach-rate", "1", "--preload", "2", "--dwell", "1"]
+    assert main(argv) == 0
+    res = simulate(Scene(n=0.5, k=1.0, mu=5.0, rate=10.0, approach_rate=1.0, preload=2.0,
+                         dwell=1.0))
+    cycle = _line(capsys.readouterr().out, "cycle").split()
+    assert float(cycle[1].split("=")[1]) == pytest.approx(res.hysteresis_energy, rel=1e-5)
+    assert float(cycle[-1].split("=")[1]) == pytest.approx(res.hysteresis_error, rel=1e-5)
+    assert main(["scene", "--n", "0.5", "--k", "1", "--mu", "5", "--rate", "10",
+                 "--a0", "2"]) == 0
+    assert "cycle" not in capsys.readouterr().out
