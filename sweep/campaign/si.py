@@ -316,7 +316,9 @@ def _si_of(si: SIScene, dimless: dict) -> dict:
             "delta_pulloff": ("delta_pulloff_m", sc.normal_physical),
             "delta0": ("delta0_m", sc.normal_physical),
             "crack_speed": ("crack_speed_m_s", lambda v: sc.crack_speed_physical(v, si.tau0)),
-            "t_pulloff": ("t_pulloff_s", lambda t: sc.time_physical(t, si.tau0))}
+            "t_pulloff": ("t_pulloff_s", lambda t: sc.time_physical(t, si.tau0)),
+            # a test protocol's work (pi dg R d_ref): load_ref times d_ref
+            "hysteresis_energy": ("hysteresis_energy_J", lambda w: w * sc.load_ref * sc.d_ref)}
     for key, (name, f) in conv.items():
         v = dimless.get(key)
         out[name] = None if v is None or (isinstance(v, float) and math.isnan(v)) else float(f(v))
@@ -342,7 +344,8 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
         ``model``, ``status``, ``reason``, the SI inputs (``si``), the dimensionless scene
         (``scene``), the dimensionless results (``pull_off``, ``a_pulloff``, ``crack_speed``,
         ``vhat``, ``a0``, ``delta0`` ...) and their SI values (``pull_off_N``, ``a_pulloff_m``,
-        ``crack_speed_m_s``, ...) with ``mu``, ``l0_m``, ``jkr_pull_off_N``.
+        ``crack_speed_m_s``, ...; a test protocol's ``hysteresis_energy_J`` with its relative
+        ``hysteresis_error``) with ``mu``, ``l0_m``, ``jkr_pull_off_N``.
     """
     model = check_choice("model", model, SI_MODELS)
     d = si.dimensionless()
@@ -369,7 +372,8 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
         dim = {"status": r.status, "reason": r.reason, "pull_off": r.pull_off,
                "a_pulloff": r.a_pulloff, "delta_pulloff": r.delta_pulloff,
                "t_pulloff": r.t_pulloff, "crack_speed": r.crack_speed, "vhat": r.vhat,
-               "a0": r.a0_result, "delta0": r.delta0_result}
+               "a0": r.a0_result, "delta0": r.delta0_result,
+               "hysteresis_energy": r.hysteresis_energy, "hysteresis_error": r.hysteresis_error}
     elif model in PROTOCOL_REFUSALS and si.has_protocol:
         dim = {"status": "failed", "reason": PROTOCOL_REFUSALS[model], "a0": None,
                "delta0": None}
@@ -409,7 +413,7 @@ def si_row(si: SIScene, row) -> dict:
     dim = {"pull_off": get("pull_off"), "a_pulloff": get("a_pulloff"),
            "delta_pulloff": get("delta_pulloff"), "crack_speed": get("crack_speed"),
            "t_pulloff": get("t_pulloff"), "a0": get("a0_result"),
-           "delta0": get("delta0_result")}
+           "delta0": get("delta0_result"), "hysteresis_energy": get("hysteresis_energy")}
     out = {f"si_{k}": v for k, v in si.to_dict().items() if v is not None}
     out.update(_si_of(si, dim))
     return out

@@ -54,6 +54,10 @@ def test_only_the_bem_runs_it():
     assert run_si(si, "crack")["status"] == "failed"
     out = run_si(si, "bem")
     assert out["status"] == "ok" and out["pull_off_N"] > 0
+    # the cycle's work in joules: pi dg R d_ref per unit (sweep.units), with its error
+    assert out["hysteresis_energy_J"] == pytest.approx(
+        out["hysteresis_energy"] * out["load_ref_N"] * out["d_ref_m"], rel=1e-12)
+    assert out["hysteresis_energy_J"] > 0 and 0 < out["hysteresis_error"] < 1
 
 
 def test_a_prony_table_config_with_a_60_s_dwell_runs_and_info_si_shows_it(tmp_path, capsys):
