@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..engine.postprocess import work_quadrature_error
+from ..engine.postprocess import cycle_end, work_quadrature_error
 from ..engine.resolution import ESTIMATE_ORDER
 from ..scene import Numerics, Scene
 from ..engine.models import simulate
@@ -64,9 +64,9 @@ def row(fields: dict) -> dict:
                  "steps": res.steps, "true_error": None, "pair": None}
         if res.ok and ref.ok and math.isfinite(res.hysteresis_error):
             entry["true_error"] = abs(res.hysteresis_energy / ref.hysteresis_energy - 1.0)
-            until = (res.t_pulloff, res.delta_pulloff, -res.pull_off)
-            entry["pair"] = res.hysteresis_error - (work_quadrature_error(res.trajectory, until)
-                                                    / (2.0 ** ESTIMATE_ORDER - 1.0))
+            entry["pair"] = res.hysteresis_error - (
+                work_quadrature_error(res.trajectory, cycle_end(res))
+                / (2.0 ** ESTIMATE_ORDER - 1.0))
         out[preset] = entry
     return out
 

@@ -21,10 +21,10 @@ elastic  the quasi-static elastic branch (:func:`sweep.engine.quasistatic.simula
          with a test protocol; "bem" and "auto" scenes that are elastic and quasi-static run
          it (:func:`wants_quasistatic`)
 auto     the cheapest model whose error meets ``numerics.pull_off_rtol`` (:func:`model_choice`):
-         the BEM for a test protocol (the elastic branch at k = 1); the crack-front model first for a scene with a
-         process zone (the BEM where its error, the process zone's term included, misses
-         the tolerance); the elastic branch for
-         elastic quasi-static scenes; the PB estimate or the crack-front model where their
+         the BEM for a test protocol (the elastic branch at k = 1); the crack-front model
+         first for a scene with a process zone (the BEM where its error, the process
+         zone's term included, misses the tolerance); the elastic branch for elastic
+         quasi-static scenes; the PB estimate or the crack-front model where their
          error against the BEM, measured over a random sample (:func:`measured_error`,
          ``make model-errors``), fits; else the BEM (graded or
          tip-following mesh), and the crack-front model where the BEM fails for a reason the
@@ -316,7 +316,8 @@ def _accepts(model: str, scene) -> bool:
 
 def model_choice(scene, numerics=None) -> Choice:
     """The model "auto" runs first for ``scene``: the BEM for a test protocol (the one model
-    that runs one, but for an elastic quasi-static scene's: the elastic branch); the crack-front model for a scene with a process zone (``pz_law``; the
+    that runs one, but for an elastic quasi-static scene's: the elastic branch); the
+    crack-front model for a scene with a process zone (``pz_law``; the
     elastic branch and pb refuse it); the quasi-static elastic branch
     for an elastic quasi-static scene; beyond the BEM's Tabor range the crack-front model, its
     mu -> infinity limit; else the cheapest model (:data:`BY_COST`) whose

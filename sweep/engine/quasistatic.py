@@ -276,11 +276,11 @@ def pull_off_radius_guess(mu: float) -> float:
     return max(A_JKR, math.sqrt(2.0 * (TIP_GAP - 1.0) * h0))
 
 
-def walk(br: ElasticBranch, radii, start=None):
+def walk(br: ElasticBranch, radii):
     """The branch's states along ``radii``, each solve started from the last (the first from
-    ``start``, (gap, indentation), else from the branch's guess): ([(h, delta)], [load],
-    None), or the radius whose solve failed last, the lists stopping before it."""
-    h, delta = br.guess(radii[0]) if start is None else start
+    the branch's guess): ([(h, delta)], [load], None), or the radius whose solve failed last,
+    the lists stopping before it."""
+    h, delta = br.guess(radii[0])
     states, loads = [], []
     for a in radii:
         h, delta, ok = br.solve(a, h, delta)
@@ -512,6 +512,8 @@ APPROACH_RECORDS = 24
 #: energy's trapezoid (measured at mu 5: 1.23860, 1.23883, 1.23889, 1.23891 with 32, 64, 128,
 #: 256 such radii, second order: 6e-5 off at 64)
 TAIL_RECORDS = 64
+
+
 def _protocol_start(scene, protocol):
     """(the preload's radius, the approach's records) of an elastic scene with a test protocol,
     on the branch's mesh of :func:`elastic_pull_off` (so that the retraction starts from the same
@@ -573,16 +575,24 @@ def _cycle_work(br, mu, po) -> float:
     TAIL_RECORDS radii, as :func:`_retraction_records`'s; where the approach and the
     retraction coincide, theirs cancel), NaN where a solve fails."""
     try:
-        a_first = _first_contact(br, mu)
+        _, deltas, loads = _tail(br, _first_contact(br, mu), po)
     except RuntimeError:
         return math.nan
-    if not a_first > po.a:
-        return 0.0
-    states, loads, failed_at = walk(br, np.geomspace(a_first, po.a, TAIL_RECORDS)[:-1])
+    return cycle_work({"P": loads, "delta": deltas})
+
+
+def _tail(br, a_from, po):
+    """(radii, indentations, loads) along the branch ``br`` from ``a_from`` down to the
+    pull-off ``po``: TAIL_RECORDS radii, the last the pull-off's state; just the pull-off
+    where ``a_from`` is not above it. Raises RuntimeError where a solve fails."""
+    if not a_from > po.a * (1.0 + 1e-9):
+        return np.array([po.a]), np.array([po.delta]), np.array([-po.pull_off])
+    radii = np.geomspace(a_from, po.a, TAIL_RECORDS)[:-1]
+    states, loads, failed_at = walk(br, radii)
     if failed_at is not None:
-        return math.nan
-    return cycle_work({"P": np.append(loads, -po.pull_off),
-                       "delta": np.append([d for _, d in states], po.delta)})
+        raise RuntimeError(f"no elastic equilibrium on the retraction at a = {failed_at:.4g}")
+    return (np.append(radii, po.a), np.append([d for _, d in states], po.delta),
+            np.append(loads, -po.pull_off))
 
 
 def _retraction_records(approach, po):
@@ -595,17 +605,10 @@ def _retraction_records(approach, po):
     n = int(np.sum(approach["phase"] == 0.0))
     a_app, d_app, P_app = (approach[key][:n][::-1] for key in ("a", "delta", "P"))
     passed = a_app > po.a
-    a_tr, d_tr, P_tr = list(a_app[passed]), list(d_app[passed]), list(P_app[passed])
-    if a_tr[-1] > po.a * (1.0 + 1e-9):
-        radii = np.geomspace(a_tr[-1], po.a, TAIL_RECORDS)[:-1]
-        states, loads, failed_at = walk(br, radii)
-        if failed_at is not None:
-            raise RuntimeError(f"no elastic equilibrium on the retraction at a = "
-                               f"{failed_at:.4g}")
-        a_tr += list(radii[1:])
-        d_tr += [d for _, d in states[1:]]
-        P_tr += loads[1:]
-    return (np.append(a_tr, po.a), np.append(d_tr, po.delta), np.append(P_tr, -po.pull_off))
+    a_tail, d_tail, P_tail = _tail(br, a_app[passed][-1], po)
+    skip = 1 if a_tail.size > 1 else 0      # the tail's first state is the approach's last
+    return (np.append(a_app[passed], a_tail[skip:]), np.append(d_app[passed], d_tail[skip:]),
+            np.append(P_app[passed], P_tail[skip:]))
 
 
 def _branch_root(br, value, target, a_guess, a_low):
