@@ -178,7 +178,8 @@ RUN_PAST = 9       # accepted states written to the tip predictor's ring (Work.p
 RUN_TIP_MADE = 10  # 1 where the step's tip predictor was made (Work.starts[1])
 RUN_TIP_SCORE = 11  # log2 of the tip predictor's error over the cubic's, averaged over the
                     # steps where both were made (:func:`score_starts`)
-N_RUN = 12
+RUN_ZONE_RAMP = 12  # 1 where a process zone's first step is to be solved by zone_ramp
+N_RUN = 13
 
 # outcomes of :func:`solve_step`
 SOLVED = 0         # Newton converged: hp is the new state
@@ -269,6 +270,19 @@ LEAD_GROWTH = 1.3
 #: crack speed; with max_iter alone that scene failed at the minimum step, and the rate-100
 #: scene of ``make pz-check`` halved its first step three times and refactorized 107 times)
 FIRST_ZONE_ITER = 4
+#: where both starts of a process zone's first step fail at the smallest step that halving
+#: reaches, the step is solved again by continuation in the zone's strength: the opening
+#: rate's scale zone[ZONE_RATE] times ZONE_RAMP_START, raised by ZONE_RAMP_FACTOR a solve
+#: (each from the last solve's state, the first from rest) to its own value; a stage that
+#: fails is retried at the geometric mean of the last good scale and its own, at most
+#: ZONE_RAMP_SOLVES solves in all. Halving the step cannot help there: the rigid opening's
+#: rate, and so the zone's factor, does not depend on the step. A strong zone at a fast
+#: unloading (q ~ 1e4: n 0.3646, k 0.8455, mu 0.3787, a0 2.29, rate 6991, pz_v0 0.4473, xi
+#: 0.638) failed its first step from both starts at every step down to the minimum
+#: (docs/design.md, "The process zone in the BEM")
+ZONE_RAMP_START = 1e-6
+ZONE_RAMP_FACTOR = 10.0
+ZONE_RAMP_SOLVES = 40
 #: with a process zone, Newton's cubic start is settled at the crack tip first
 #: (:func:`settle_tip`): the gaps of this many nodes either side of the last state's tip, by
 #: ZONE_SETTLE_ITER Newton iterations on those nodes alone. The rate term makes the gap
@@ -1018,6 +1032,42 @@ def settle_tip(h, g, A, ceff, H, law, lo, hi, iters, wall=0.0):
     return first, norm
 
 
+@njit(cache=True)
+def zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, compliance, wP):
+    """A process zone's first step by continuation in the zone's strength (ZONE_RAMP_START,
+    ZONE_RAMP_FACTOR, ZONE_RAMP_SOLVES): Newton at the opening rate's scale
+    ``work.zone[ZONE_RATE]`` times s, s rising from ZONE_RAMP_START to 1, each solve from the
+    last one's state, the first from rest (``work.h``). True with the step's state in ``hp``;
+    the scale is restored either way."""
+    full = work.zone[ZONE_RATE]
+    good = np.empty_like(hp)
+    _copy(work.h, good)
+    s_good, s = 0.0, ZONE_RAMP_START
+    ok = False
+    for _ in range(ZONE_RAMP_SOLVES):
+        work.zone[ZONE_RATE] = s * full
+        _copy(good, hp)
+        cache[CACHE_STATE][STATE_VALID] = 0
+        if newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
+                          compliance, wP):
+            if s == 1.0:
+                ok = True
+                break
+            _copy(hp, good)
+            s_good, s = s, min(s * ZONE_RAMP_FACTOR, 1.0)
+        elif s_good > 0.0 and s > s_good * 1.05:
+            s = np.sqrt(s * s_good)
+        elif s_good == 0.0 and s > 1e-12:
+            s *= 1.0 / ZONE_RAMP_FACTOR
+        else:
+            break
+        if past(cache[CACHE_DEADLINE][0]):
+            break
+    work.zone[ZONE_RATE] = full
+    cache[CACHE_STATE][STATE_VALID] = 0
+    return ok
+
+
 @njit(cache=True, inline='always')
 def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     """-- solve: Newton from ``work.hp`` (with a process zone, its cubic start settled at
@@ -1032,6 +1082,13 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     if not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0:
         max_iter *= FIRST_ZONE_ITER
     compliance, wP = physics.compliance, mesh.wP
+    if run[RUN_ZONE_RAMP] == 1.0 and not run[RUN_DT_PREV] > 0.0:
+        run[RUN_ZONE_RAMP] = 2.0
+        stats[STAT_FAILED_SOLVES] += 1
+        if zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, compliance, wP):
+            cache[CACHE_STATE][STATE_EXACT] = 0
+            return SOLVED
+        return FAILED
     if not np.isinf(physics.hdot_c) and cubic and cache[CACHE_STATE][STATE_EXACT] == 0:
         tip = np.searchsorted(mesh.r, run[RUN_A])      # the last state's crack tip
         settle_tip(hp, work.g, A, ceff, work.H, law, max(tip - ZONE_SETTLE_NODES, 0),
@@ -1065,6 +1122,14 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     if relax_machine(hp, work.g, A, ceff, work.H, law, compliance, wP, tol, RELAX_MAX_ITER,
                      stats, cache[CACHE_DEADLINE][0]):
         return SNAPPED
+    if (not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0
+            and run[RUN_ZONE_RAMP] == 0.0):
+        # a process zone's first step that halving did not bring: again at the full step, by
+        # continuation in the zone's strength (the smaller steps are the harder ones there:
+        # the law's rate term, 1/(hdot_c dt), the stiffer)
+        run[RUN_ZONE_RAMP] = 1.0
+        run[RUN_DD] = control.step_max * h0
+        return HALVED
     return FAILED
 
 

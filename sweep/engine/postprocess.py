@@ -240,6 +240,17 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         if _FIT_LOG is not None:
             _FIT_LOG.append(dict(t=t.copy(), a=a.copy(), t_star=float(t_star),
                                  spacing=float(spacing), lo=int(lo), hi=int(hi)))
+    a_star = float(np.interp(t_star, t[span], a[span]))
+    if speed <= 0 and a_star <= 0.0:
+        # a process zone strong enough to hold the surfaces after the contact's end: the load
+        # still falls there, slowly, and the crack speed has no tip to follow (a DMT-like
+        # contact that vanishes at its pull-off recedes there: speed > 0)
+        gone = float(t[span][np.argmax(a[span] <= 0.0)])
+        res.reason = (f"the contact vanished (a = 0 from t = {gone:.4g} tau0) before the load "
+                      f"minimum P = {P_star:.6g}: the interface holds the surfaces after the "
+                      f"contact's end, where the crack speed at the pull-off is not defined "
+                      f"and the stop rule does not follow the load")
+        return
     if speed < 0:
         res.reason = (f"negative crack speed at the pull-off ({speed:.4g} a_ref/tau0, the "
                       f"contact advancing at the load minimum P = {P_star:.6g}, a = "

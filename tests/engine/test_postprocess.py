@@ -112,6 +112,24 @@ def test_ok_result_never_has_a_negative_crack_speed():
     assert res.reason.startswith("negative crack speed at the pull-off (-3e+04 a_ref/tau0")
 
 
+def test_a_contact_that_vanished_before_the_load_minimum_says_so():
+    """A process zone strong enough to hold the surfaces after the contact's end: the tip
+    reaches the axis (a = 0) while the load still falls (a strong zone at a fast unloading:
+    n 0.5902, k 0.02331, mu 1.076, a0 1.31, rate 380400, pz_v0 1.201, xi 0.785 had
+    "negative crack speed at the pull-off ... a = 0"). The fit's speed there is 0 (a flat a
+    = 0), or negative where a node closes again: neither is a crack speed, and the reason
+    names the vanished contact."""
+    t = np.linspace(0.0, 1.0, 41)
+    a = np.maximum(1.0 - 1.25 * t, 0.0)                    # a = 0 from t = 0.8
+    P = -10.0 - 5.0 * t
+    P[-1] = P[-2] + 1e-9                                   # a flat minimum one record back
+    traj = {"t": t, "delta": -t, "P": P, "a": a, "a_inner": 0.0 * a}
+    res = run_finish(traj)
+    assert res.status == "failed" and np.isnan(res.pull_off)
+    assert res.reason.startswith("the contact vanished (a = 0 from t = 0.8 tau0) before the "
+                                 "load minimum P = -14.875")
+
+
 def test_a_pull_off_at_the_initial_state_reads_the_first_steps_speed():
     """A contact that starts at or beyond its pull-off (past the JKR fold at low mu): the load
     only rises from record 0. The crack speed is the first step's radius change over its
