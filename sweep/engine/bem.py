@@ -252,8 +252,10 @@ def _simulate(pb: Problem, res: Result, deadline: float = math.inf) -> str | Non
 
 def _unload(pb: Problem, run: UnloadingState, deadline: float) -> int:
     """The unloading kernel in chunks of CHUNK_STEPS until it ends, or the deadline does."""
+    start = int(run.stats[STAT_FACTOR])
     while True:
         status = unload_chunk(pb, run, pb.tip_range, CHUNK_STEPS, deadline)
+        budget.check_work(int(run.stats[STAT_FACTOR]) - start, "the unloading")
         if status != STATUS_STEP_LIMIT or run.n > pb.numerics.max_steps:
             return status
         if time.perf_counter() > deadline:

@@ -26,7 +26,7 @@ from contextvars import ContextVar
 from ..kernels.jacobian import set_deadline
 
 __all__ = ["OverBudget", "scene_budget", "deadline", "remaining", "budget_seconds", "check",
-           "arm", "CHECK_SLACK_S"]
+           "arm", "CHECK_SLACK_S", "OverWork", "work_cap", "check_work"]
 
 #: (deadline in time.perf_counter() seconds, the budget in seconds) of the scene being run
 _BUDGET: ContextVar[tuple[float, float] | None] = ContextVar("scene_budget", default=None)
@@ -108,3 +108,33 @@ def arm(cache) -> None:
     (none outside a scene): past it they give up (:func:`sweep.kernels.jacobian.set_deadline`)
     and the caller's :func:`check` after the failed solve raises :class:`OverBudget`."""
     set_deadline(cache, remaining())
+
+
+#: the factorization count a solve may reach (:func:`work_cap`), None: no cap
+_WORK_CAP: ContextVar[int | None] = ContextVar("work_cap", default=None)
+
+
+class OverWork(Exception):
+    """A solve under :func:`work_cap` did more factorizations than it was allowed; the
+    message is its reason. Not a RuntimeError: no solver's numerical-failure handler takes
+    it for its own, and it reaches the :func:`work_cap` block's caller."""
+
+
+@contextmanager
+def work_cap(factorizations: int | None):
+    """Cap the factorizations of the solves run in this block (None: no cap): past it, the
+    next :func:`check_work` raises :class:`OverWork`. Counts, not seconds: where a cap is met
+    does not depend on the machine, so a row does not either."""
+    token = _WORK_CAP.set(None if factorizations is None else int(factorizations))
+    try:
+        yield
+    finally:
+        _WORK_CAP.reset(token)
+
+
+def check_work(factorizations: int, where: str) -> None:
+    """Raise :class:`OverWork` where ``factorizations`` (a run's count so far, since the
+    stage ``where`` started) exceed the running :func:`work_cap`."""
+    cap = _WORK_CAP.get()
+    if cap is not None and factorizations > cap:
+        raise OverWork(f"{factorizations} factorizations in {where}, past the cap of {cap}")

@@ -12,6 +12,7 @@ import math
 from typing import Callable
 
 from ..scene import Numerics, Result
+from . import budget
 from .postprocess import cycle_end, work_quadrature_error
 
 #: the a-priori resolution error, K (spacing/tip zone)^2 (see :func:`resolution_error`),
@@ -156,6 +157,37 @@ def _crossing_check(res: Result, coarse: Result, change: float, how: str, solve)
                    f"resolution ({coarsest.pull_off:.5g} vs {coarse.pull_off:.5g}), over 4")
 
 
+#: the unloading of the error estimate's cheaper solves may make at most COARSE_WORK_FACTOR
+#: times the fine solve's factorizations (the whole solve's, its relaxed start's included),
+#: plus COARSE_WORK_FLOOR (counted at the unloading's chunks and re-meshings,
+#: ``sweep.engine.budget.work_cap``); past that a cheaper solve is abandoned as failed, as
+#: one that finds no equilibrium is. On 295 cheaper solves of the committed campaigns'
+#: scenes (every fourth of the balanced threshold grid, ``make vr``'s and ``make fig3``'s,
+#: and of the random samples auto, bem, protocol and process zone) the unloading made a
+#: median 7 factorizations, 0.19 times the fine solve's, at most 2644 and 12 times.
+#: Near-elastic scenes at large Tabor parameters made far more: the tip, held by the nodes,
+#: snaps from node to node at the coarser resolution, and each snap costs exact Newton (n
+#: 0.8, k 0.9, mu 12, a0 2, rate 100 at ``Numerics.for_tolerance(0.01)``: the fine solve 6 s
+#: and 1127 factorizations, the half-resolution one 37 s and 52143, failed; at k 0.99 the
+#: row spent its whole 300 s budget and fell back to the a-priori estimate; now 35 s and
+#: 53 s, the second with its sqrt-2 pair's estimate, docs/numerics.md)
+COARSE_WORK_FACTOR = 20.0
+COARSE_WORK_FLOOR = 2000
+
+
+def _capped(solve: Callable[[Numerics], Result], numerics: Numerics, fine: Result) -> Result:
+    """``solve(numerics)`` under the cheaper solves' work cap (COARSE_WORK_FACTOR), a failed
+    Result where it is passed."""
+    cap = int(COARSE_WORK_FACTOR * max(fine.factorizations, 0)) + COARSE_WORK_FLOOR
+    with budget.work_cap(cap):
+        try:
+            return solve(numerics)
+        except budget.OverWork as exc:
+            return Result(scene=fine.scene, numerics=numerics, status="failed",
+                          reason=f"abandoned, more work than {COARSE_WORK_FACTOR:g} times the "
+                                 f"fine solve's: {exc}")
+
+
 #: the order the error estimate assumes: the pair's change over f^ESTIMATE_ORDER - 1 (1.76
 #: times the change at f = 2; at order 1 it would be the change itself). The misses of the
 #: first-order rule on fresh samples (seeds 11 and 13: 87-93 % coverage at 3e-2 and 1e-2,
@@ -205,7 +237,8 @@ def estimate_error(res: Result, length: float, solve: Callable[[Numerics], Resul
     solves may lie on either side of the limit (below :data:`CROSSING_GATE` (spacing /
     ``length``)^2), a third solve at a quarter of the resolution decides: the change between
     the two coarser solves over 4, where larger, stands in (:func:`_crossing_check`). Where
-    every cheaper solve fails, the a-priori bound
+    every cheaper solve fails (or is abandoned past COARSE_WORK_FACTOR times the fine solve's
+    factorizations: :func:`_capped`), the a-priori bound
     :func:`resolution_error` of the spacing against ``length`` (a_ref) stands in, and the
     reason says so. A result whose estimate exceeds ``numerics.pull_off_rtol`` is not ``ok``
     ("unresolved: ..."). The same pair estimates a test protocol's hysteresis energy
@@ -215,6 +248,7 @@ def estimate_error(res: Result, length: float, solve: Callable[[Numerics], Resul
     if not res.ok or tol <= 0:
         return
     prony = res.prony_error if math.isfinite(res.prony_error) else 0.0
+    fine, solve = solve, lambda numerics: _capped(fine, numerics, res)
     for factor in COARSER_FACTORS:
         coarse = solve(coarser(res.numerics, factor))
         if coarse.ok:

@@ -764,10 +764,12 @@ def _unload_following(scene, numerics, pb, run, zone, ahead, behind, deadline, d
     u = _Unloaded(STATUS_STEP_LIMIT, pb, 1, pb.mesh.nodes, [])
     remeshed_at = []    # first records on new meshes, to check (u.marks: all of them)
     rtol = max(REMESH_JUMP_RTOL, 0.25 * numerics.pull_off_rtol)
+    start = int(run.stats[STAT_FACTOR])
     while True:
         probing, n_before, t_chunk = run.n <= 1, run.n, time.perf_counter()
         u.status = unload_chunk(u.pb, run, u.pb.tip_range,
                                 PROBE_STEPS if probing else CHUNK_STEPS, deadline)
+        budget.check_work(int(run.stats[STAT_FACTOR]) - start, "the unloading")
         broken = _continuity(run, remeshed_at, rtol)
         if broken:
             u.ended, u.reason = "broken", broken

@@ -11,8 +11,11 @@ import pytest
 
 from sweep import Numerics, Result, Scene
 from sweep.engine.bem import simulate
-from sweep.engine.resolution import (REFINE_MARGIN, RESOLUTION_ERROR_K, coarser,
-                                     estimate_error, refined, resolution_error)
+from sweep.engine import budget
+from sweep.engine.problem import derive
+from sweep.engine.resolution import (COARSE_WORK_FACTOR, COARSE_WORK_FLOOR, REFINE_MARGIN,
+                                     RESOLUTION_ERROR_K, coarser, estimate_error, refined,
+                                     resolution_error)
 
 SCENE = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0)
 
@@ -89,6 +92,49 @@ def test_a_priori_bound_where_the_cheaper_solve_fails():
     assert res.error_estimate == pytest.approx(RESOLUTION_ERROR_K * 0.04**2 + 1e-5)
     assert res.ok and "error estimate a priori" in res.reason and "time budget" in res.reason
     assert resolution_error(0.004, 0.1) == RESOLUTION_ERROR_K * 0.04**2
+
+
+def test_a_cheaper_solve_past_its_work_cap_is_abandoned():
+    """A cheaper solve may make at most COARSE_WORK_FACTOR times the fine solve's
+    factorizations (plus COARSE_WORK_FLOOR) in its unloading: the cap the solve runs under is
+    that, and past it the solve counts as failed (the a-priori bound stands in)."""
+    num = Numerics.preset("balanced")
+    res = _ok(num, 2.0, spacing=0.004)
+    res.factorizations = 300
+    caps = []
+
+    def solve(n):
+        caps.append(budget._WORK_CAP.get())
+        budget.check_work(caps[-1], "the unloading")           # at the cap: goes on
+        budget.check_work(caps[-1] + 1, "the unloading")       # past it: abandoned
+        pytest.fail("check_work let a solve past its cap go on")
+
+    estimate_error(res, 0.1, solve)
+    assert caps == [int(COARSE_WORK_FACTOR * 300) + COARSE_WORK_FLOOR] * 2    # f = 2, sqrt 2
+    assert budget._WORK_CAP.get() is None                      # no cap outside the block
+    assert res.ok and res.error_estimate == pytest.approx(RESOLUTION_ERROR_K * 0.04**2 + 1e-5)
+    assert "error estimate a priori" in res.reason and "abandoned" in res.reason
+
+
+@pytest.mark.parametrize("mesh", ["graded", "tip-following"])
+def test_the_unloading_checks_its_work_cap(mesh, monkeypatch):
+    """The unloading's chunk loops read the cap (sweep.engine.budget.check_work), on the fixed
+    band and on the tip-following mesh: with a cap of 0 every cheaper solve is abandoned at
+    its first chunk, and the row takes the a-priori bound; its pull-off is the fine solve's."""
+    from sweep.engine import resolution
+    from sweep.engine.tip_following import simulate_tip_following
+    run = simulate if mesh == "graded" else simulate_tip_following
+    num = Numerics.preset("fast", pull_off_rtol=0.05)     # above the a-priori bound, 0.032
+    plain = run(SCENE, num)
+    monkeypatch.setattr(resolution, "COARSE_WORK_FACTOR", 0.0)
+    monkeypatch.setattr(resolution, "COARSE_WORK_FLOOR", 0)
+    capped = run(SCENE, num)
+    assert plain.ok and "a priori" not in plain.reason
+    assert capped.pull_off == plain.pull_off
+    assert "error estimate a priori" in capped.reason
+    assert "abandoned, more work than 0 times the fine solve's" in capped.reason
+    assert capped.error_estimate == pytest.approx(
+        resolution_error(capped.spacing, derive(SCENE, num).tip_zone) + capped.prony_error)
 
 
 def test_no_estimate_without_a_tolerance():
