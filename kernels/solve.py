@@ -178,7 +178,7 @@ RUN_PAST = 9       # accepted states written to the tip predictor's ring (Work.p
 RUN_TIP_MADE = 10  # 1 where the step's tip predictor was made (Work.starts[1])
 RUN_TIP_SCORE = 11  # log2 of the tip predictor's error over the cubic's, averaged over the
                     # steps where both were made (:func:`score_starts`)
-RUN_ZONE_RAMP = 12  # 1 where a process zone's first step is to be solved by zone_ramp
+RUN_ZONE_RAMP = 12  # a process zone's first step by zone_ramp: 1 to be tried, 2 tried
 N_RUN = 13
 
 # outcomes of :func:`solve_step`
@@ -1074,7 +1074,9 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     the crack tip first: ZONE_SETTLE_NODES), again from the quadratic start where the cubic
     one failed; after a failure the step is halved, down to SNAP_STEP_FRACTION step_max, and
     the next solves are exact Newton; below it the path folds and the snapped state is
-    looked for. Returns SOLVED, HALVED, SNAPPED or FAILED (the state, if any, in hp)."""
+    looked for. A process zone's first step that finds none is tried once more at the full
+    step by :func:`zone_ramp`. Returns SOLVED, HALVED, SNAPPED or FAILED (the state, if any,
+    in hp)."""
     A, h0, hp = mesh.A, physics.h0, work.hp
     law = Interface(h0, physics.c, work.ref, work.zone)
     ceff, tol = run[RUN_CEFF], control.tol * h0
