@@ -179,7 +179,8 @@ RUN_TIP_MADE = 10  # 1 where the step's tip predictor was made (Work.starts[1])
 RUN_TIP_SCORE = 11  # log2 of the tip predictor's error over the cubic's, averaged over the
                     # steps where both were made (:func:`score_starts`)
 RUN_ZONE_RAMP = 12  # a process zone's first step by zone_ramp: 1 to be tried, 2 tried
-N_RUN = 13
+RUN_LEAD_STEP = 13  # a lead-in's step as tried first (0: no lead-in), the floor of its halving
+N_RUN = 14
 
 # outcomes of :func:`solve_step`
 SOLVED = 0         # Newton converged: hp is the new state
@@ -1132,6 +1133,12 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
         run[RUN_ZONE_RAMP] = 1.0
         run[RUN_DD] = control.step_max * h0
         return HALVED
+    if run[RUN_LEAD_STEP] > 0.0 and dd > max(dd_min, SNAP_STEP_FRACTION
+                                             * run[RUN_LEAD_STEP]) * (1.0 + STEP_RTOL):
+        # a lead-in's step, already below the halving's floor (SNAP_STEP_FRACTION step_max):
+        # halved, down to that fraction of the lead-in's own step
+        run[RUN_DD] = max(0.5 * dd, dd_min)
+        return HALVED
     return FAILED
 
 
@@ -1244,6 +1251,18 @@ def stop_status(mesh, control, records, n, i_min):
     return STATUS_RUNNING
 
 
+@njit(cache=True, inline='always')
+def lead_step(run, step_max, da, da_max):
+    """The next step of a lead-in (LEAD_GROWTH while the crack tip moved by less than
+    EASY_DA_FRACTION ``da_max``), at most ``step_max`` (d_ref), into ``run[RUN_DD]`` and the
+    halving's reference ``run[RUN_LEAD_STEP]``; whether the lead-in goes on."""
+    dd = run[RUN_DD] * (LEAD_GROWTH if da < EASY_DA_FRACTION * da_max else 1.0)
+    run[RUN_DD] = min(dd, step_max)
+    lead = run[RUN_DD] < step_max
+    run[RUN_LEAD_STEP] = run[RUN_DD] if lead else 0.0
+    return lead
+
+
 @njit(cache=True)
 def unload(mesh, physics, control, start, records, cache, stats):
     """Unload at constant rate from the state ``start.h`` with the Prony recursion.
@@ -1275,6 +1294,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
     n, i_min = start_run(mesh, physics, start, records, work, run, hm)
     run[RUN_DD] = start.step[0] * h0 if start.step[0] > 0.0 else control.step_max * h0
     lead = start.step.size > 2 and start.step[2] > 0.0
+    run[RUN_LEAD_STEP] = run[RUN_DD] if lead else 0.0
     easy = 0
     status = STATUS_STEP_LIMIT
     while n <= control.max_steps:
@@ -1310,9 +1330,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
             status = stop
             break
         if lead:
-            dd = run[RUN_DD] * (LEAD_GROWTH if da < EASY_DA_FRACTION * da_max else 1.0)
-            run[RUN_DD] = min(dd, control.step_max * h0)
-            lead = run[RUN_DD] < control.step_max * h0
+            lead = lead_step(run, control.step_max * h0, da, da_max)
         else:
             run[RUN_DD], easy = next_step(run[RUN_DD], easy, da, da_max, err,
                                           control.step_max * h0, control.step_tol * h0)

@@ -465,6 +465,29 @@ def test_a_retraction_after_a_fast_approach_starts_at_the_approachs_time_step():
     assert res.pull_off == pytest.approx(reference.pull_off, rel=CONVERGED_RTOL)
 
 
+#: a fast approach, no dwell and a retraction 3000 times slower, with a process zone (from
+#: configs/random/protocol_pz.yaml): a lead-in step of the retraction, already below the
+#: halving's floor of SNAP_STEP_FRACTION step_max, found no equilibrium and the row failed
+#: ("no equilibrium found at the minimum step before pull-off (delta=5.28302, a=2.708)")
+LEAD_IN_ZONE = dict(n=0.2284, k=0.5046, mu=0.5411, rate=0.0323, approach_rate=100.8,
+                    preload=19.94, dwell=0.0, pz_law="gent-schultz", pz_v0=0.4572, pz_xi=0.34)
+
+
+def test_a_lead_in_step_halves_below_the_floor_of_the_ordinary_steps():
+    """The lead-in's step is halved down to a fraction of its own size. Independent value:
+    a retraction this slow after so fast an approach forgets the approach, so the pull-off
+    is the relaxed start's at the retraction's starting radius (measured 1.8e-5 apart), within
+    the two rows' estimates."""
+    res = simulate(Scene(**LEAD_IN_ZONE), Numerics.preset("balanced"))
+    assert res.ok, res.reason
+    fields = {k: v for k, v in LEAD_IN_ZONE.items()
+              if k not in ("approach_rate", "preload", "dwell")}
+    relaxed = simulate(Scene(**fields, a0=res.a0_result), Numerics.preset("balanced"))
+    assert relaxed.ok, relaxed.reason
+    assert res.pull_off == pytest.approx(
+        relaxed.pull_off, rel=res.error_estimate + relaxed.error_estimate)
+
+
 #: a slow approach before a fast retraction (the random sample at mu 6-30 had it at mu 6.87)
 SLOW_APPROACH = dict(n=1.48, k=0.009283, mu=5.0, rate=62490.0, approach_rate=30.2,
                      preload=5.21, dwell=0.0)
