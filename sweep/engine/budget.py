@@ -15,6 +15,11 @@ function that reads the deadline starts a budget of its own, as before.
 
 The budget ends computations, never changes one: where a check passes, the solve goes on
 exactly as without it, so a scene's numbers do not depend on the machine's speed.
+
+A solve may also be held to a count of factorizations (:func:`work_cap`, read by
+:func:`check_work` at the unloading's chunks and re-meshings): the error estimate's cheaper
+solves are (``sweep.engine.resolution.COARSE_WORK_FACTOR``). Counts, unlike seconds, stop a
+solve at the same place on every machine.
 """
 from __future__ import annotations
 

@@ -164,7 +164,8 @@ def _crossing_check(res: Result, coarse: Result, change: float, how: str, solve)
 #: one that finds no equilibrium is. On 295 cheaper solves of the committed campaigns'
 #: scenes (every fourth of the balanced threshold grid, ``make vr``'s and ``make fig3``'s,
 #: and of the random samples auto, bem, protocol and process zone) the unloading made a
-#: median 7 factorizations, 0.19 times the fine solve's, at most 2644 and 12 times.
+#: median 7 factorizations, 0.19 times the fine solve's, at most 2644 and 12 times (a
+#: session-45 study; the committed campaigns' check holds their rows under the cap).
 #: Near-elastic scenes at large Tabor parameters made far more: the tip, held by the nodes,
 #: snaps from node to node at the coarser resolution, and each snap costs exact Newton (n
 #: 0.8, k 0.9, mu 12, a0 2, rate 100 at ``Numerics.for_tolerance(0.01)``: the fine solve 6 s
