@@ -1075,9 +1075,9 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     the crack tip first: ZONE_SETTLE_NODES), again from the quadratic start where the cubic
     one failed; after a failure the step is halved, down to SNAP_STEP_FRACTION step_max, and
     the next solves are exact Newton; below it the path folds and the snapped state is
-    looked for. A process zone's first step that finds none is tried once more at the full
-    step by :func:`zone_ramp`. Returns SOLVED, HALVED, SNAPPED or FAILED (the state, if any,
-    in hp)."""
+    looked for. A process zone's first step that finds none is tried once more at the step
+    first tried by :func:`zone_ramp`. Returns SOLVED, HALVED, SNAPPED or FAILED (the state,
+    if any, in hp)."""
     A, h0, hp = mesh.A, physics.h0, work.hp
     law = Interface(h0, physics.c, work.ref, work.zone)
     ceff, tol = run[RUN_CEFF], control.tol * h0
@@ -1127,11 +1127,13 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
         return SNAPPED
     if (not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0
             and run[RUN_ZONE_RAMP] == 0.0):
-        # a process zone's first step that halving did not bring: again at the full step, by
-        # continuation in the zone's strength (the smaller steps are the harder ones there:
-        # the law's rate term, 1/(hdot_c dt), the stiffer)
+        # a process zone's first step that halving did not bring: again at the step first
+        # tried (a lead-in's own, else the largest), by continuation in the zone's strength
+        # (the smaller steps are the harder ones there: the law's rate term, 1/(hdot_c dt),
+        # the stiffer)
         run[RUN_ZONE_RAMP] = 1.0
-        run[RUN_DD] = control.step_max * h0
+        run[RUN_DD] = (run[RUN_LEAD_STEP] if run[RUN_LEAD_STEP] > 0.0
+                       else control.step_max * h0)
         return HALVED
     if run[RUN_LEAD_STEP] > 0.0 and dd > max(dd_min, SNAP_STEP_FRACTION
                                              * run[RUN_LEAD_STEP]) * (1.0 + STEP_RTOL):
