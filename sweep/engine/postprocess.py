@@ -35,6 +35,10 @@ def machine_fold(P, delta, i_min: int, stiffness) -> float:
 #: a parabola refinement lowering the sampled minimum by more than this fraction must
 #: also predict the neighbouring samples (see :func:`refine_minimum`)
 VERTEX_RTOL = 1e-3
+#: how the reason of a row whose unloading found no equilibrium at its smallest step before
+#: the pull-off begins (the discrete path folds; an accuracy request refines it once,
+#: ``sweep.engine.models``)
+FOLD_REASON = "no equilibrium found at the minimum step before pull-off"
 
 
 #: where :func:`capture_fits` collects the crack-speed fits' inputs (None: not collecting)
@@ -221,9 +225,8 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         res.reason = f"step limit ({res.numerics.max_steps}) reached before pull-off"
         return
     if status == STATUS_NEWTON_FAILED and not passed:
-        res.reason = (f"no equilibrium found at the minimum step before pull-off (delta="
-                      f"{delta[-1]:.6g}, a={a[-1]:.4g}): the discrete path folds where the "
-                      f"crack tip is under-resolved; {advice}")
+        res.reason = (f"{FOLD_REASON} (delta={delta[-1]:.6g}, a={a[-1]:.4g}): the discrete "
+                      f"path folds where the crack tip is under-resolved; {advice}")
         return
     if P_star >= 0:
         res.reason = "no tensile load reached"

@@ -293,3 +293,87 @@ def test_for_tolerance_starts_from_the_cheapest_preset_that_meets_it():
     from sweep.errors import InputError
     with pytest.raises(InputError, match=r"pull_off_rtol must be in \(0"):
         Numerics.for_tolerance(0.0)
+
+
+def _fold_then(outcomes, monkeypatch):
+    """Replace the BEM's one solve (``sweep.engine.models``' ``_bem_once``) by rows that fail
+    where the discrete path folds, then ``outcomes`` (status, reason) in turn; returns the
+    list of band resolutions it was called with."""
+    from sweep.engine import models
+    from sweep.engine.postprocess import FOLD_REASON
+
+    seq = [("failed", f"{FOLD_REASON} (delta=0.1, a=1): the discrete path folds")] + outcomes
+    calls = []
+
+    def one_solve(scene, numerics):
+        status, reason = seq[min(len(calls), len(seq) - 1)]
+        calls.append(numerics.band_resolution)
+        row = Result(scene=scene, numerics=numerics, status=status, reason=reason)
+        row.pull_off = 1.0 if status == "ok" else math.nan
+        return row
+
+    monkeypatch.setattr(models, "_bem_once", one_solve)
+    return calls
+
+
+FOLD_SCENE = Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=10 ** 2.5, model="bem")
+
+
+def test_a_fold_is_refined_once_and_not_again_where_the_finer_mesh_folds_too(monkeypatch):
+    """A row whose path folds before the pull-off (its advice: a finer band) is solved once
+    more at the refinement's largest factor; where that folds too it stops there, with the
+    finer solve's reason and why it stopped, whatever refinements remain."""
+    from sweep import simulate as front_door
+    from sweep.engine.postprocess import FOLD_REASON
+
+    calls = _fold_then([], monkeypatch)
+    res = front_door(FOLD_SCENE, Numerics.preset("balanced", refinements=3))
+    assert calls == [16.0, 32.0]
+    assert res.status == "failed" and res.reason.startswith(FOLD_REASON)
+    assert "not refined further: the finer mesh folds too" in res.reason
+    assert res.refinements == 1 and res.band_resolution_used == 32.0
+    calls = _fold_then([], monkeypatch)
+    res = front_door(FOLD_SCENE, Numerics.preset("balanced"))      # a preset: no refinement
+    assert calls == [16.0] and res.refinements == 0
+
+
+def test_a_fold_a_finer_mesh_carries_through_is_answered_and_refined_on(monkeypatch):
+    """The finer solve's row is the answer where it is ok; where it is unresolved instead,
+    the ordinary refinements go on from it."""
+    from sweep import simulate as front_door
+
+    calls = _fold_then([("ok", "")], monkeypatch)
+    res = front_door(FOLD_SCENE, Numerics.preset("balanced", refinements=3))
+    assert calls == [16.0, 32.0] and res.ok and res.refinements == 1
+    calls = _fold_then([("failed", "unresolved: the pull-off moves by 0.05"), ("ok", "")],
+                       monkeypatch)
+    res = front_door(FOLD_SCENE, Numerics.preset("balanced", refinements=3))
+    assert calls == [16.0, 32.0, 64.0] and res.ok and res.refinements == 2
+
+
+#: a scene of the random protocol sample at large Tabor parameters (configs/random/
+#: protocol_tabor.yaml, seed 43) whose path folds at the balanced resolution (tip-following
+#: mesh; at delta -0.0451, a 0.7556) and not at band resolution 32 or at fast's 9
+TABOR_FOLD = Scene(n=1.425, k=0.0825, mu=17.97, rate=560.1, approach_rate=36.88, preload=0.9929,
+                   dwell=0.0)
+
+
+def test_a_fold_at_the_requested_accuracy_is_answered_by_a_finer_mesh():
+    """The balanced preset fails where the path folds; asked for 1e-2 (balanced's resolution
+    and refinements) the same scene is ok after one refinement (band resolution 32), its
+    pull-off within the two estimates of the fast preset's (band resolution 9, a second
+    resolution on the other side of the fold: 5.77955, estimate 1.9e-3 measured; the
+    accurate preset gave 5.77894, estimate 2.1e-4, in 30 s)."""
+    from sweep import simulate as front_door
+    from sweep.engine.postprocess import FOLD_REASON
+
+    plain = front_door(TABOR_FOLD, Numerics.preset("balanced"))
+    assert plain.status == "failed" and plain.reason.startswith(FOLD_REASON), plain.reason
+    num = Numerics.for_tolerance(0.01)
+    res = front_door(TABOR_FOLD, num)
+    assert res.ok and res.refinements == 1 and res.band_resolution_used == 32.0, res.reason
+    assert res.error_estimate <= num.pull_off_rtol
+    other = front_door(TABOR_FOLD, Numerics.preset("fast"))
+    assert other.ok and other.error_estimate < 0.5 * num.pull_off_rtol, other.reason
+    err = abs(res.pull_off - other.pull_off) / other.pull_off
+    assert err <= res.error_estimate + other.error_estimate, (res.pull_off, other.pull_off)
