@@ -121,7 +121,8 @@ Physics = namedtuple("Physics", ["h0", "c", "weights", "times", "rate", "hdot_c"
 #:     step_max;
 #: tol: Newton tolerance on max |F| (units of h0); max_iter: Newton iterations per solve;
 #: max_steps: the run ends with STATUS_STEP_LIMIT when the records reach max_steps + 1;
-#: stop_mode: 0 stop after pull-off and load recovery, 1 follow to separation;
+#: stop_mode: 0 stop after pull-off and load recovery, 1 follow to separation, 2 as 0
+#:     with a process zone (a contact that vanished before the load minimum followed on);
 #: min_travel: crack-tip recession after the minimum required to stop (a_ref, see
 #:     :func:`stop_reached`);
 #: tip_lo, tip_hi: radii the crack tip must stay within (the well-resolved band of a graded
@@ -349,16 +350,22 @@ def stop_reached(P, a, n, i_min, stop_mode, min_travel):
     recovered by max(RECOVERY |P_min|, RECOVERY_FLOOR) and the tip receded by
     ``min_travel`` (a_ref); or the contact is lost after the minimum.
     stop_mode 1 (separation): contact lost and the load back to SEPARATION_LOAD |P_min|.
+    stop_mode 2 (pull-off with a process zone): as 0, but where the contact had vanished by
+    the minimum (a = 0 there) the load recovered as in 0 (with no tip to recede): the zone
+    may hold the surfaces after the contact's end while the load still falls, and a rise of
+    one step is not yet the pull-off.
     """
     P_min = P[i_min]
     P_now = P[n - 1]
     a_now = a[n - 1]
-    if stop_mode == 0:
-        if (P_min < 0.0 and n - 1 - i_min >= RECOVERY_STEPS
-                and P_now - P_min > max(RECOVERY * abs(P_min), RECOVERY_FLOOR)
-                and a[i_min] - a_now >= min_travel):
+    if stop_mode != 1:
+        recovered = (P_min < 0.0 and n - 1 - i_min >= RECOVERY_STEPS
+                     and P_now - P_min > max(RECOVERY * abs(P_min), RECOVERY_FLOOR))
+        if recovered and a[i_min] - a_now >= min_travel:
             return True
-        return a_now == 0.0 and n - 1 - i_min >= 1
+        if a_now == 0.0 and n - 1 - i_min >= 1:
+            return stop_mode == 0 or a[i_min] > 0.0 or recovered
+        return False
     return a_now == 0.0 and P_now > P_min and abs(P_now) < SEPARATION_LOAD * abs(P_min)
 
 

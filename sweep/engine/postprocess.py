@@ -41,6 +41,16 @@ VERTEX_RTOL = 1e-3
 FOLD_REASON = "no equilibrium found at the minimum step before pull-off"
 
 
+def stop_mode(scene) -> int:
+    """The stop rule's mode of ``scene`` (:func:`sweep.kernels.solve.stop_reached`): 1
+    following the curve to separation; 2 stopping after the pull-off with a process zone,
+    which may hold the surfaces after the contact's end while the load still falls; else 0,
+    stopping after the pull-off."""
+    if scene.stop != "pulloff":
+        return 1
+    return 2 if scene.pz_law != "none" else 0
+
+
 #: where :func:`capture_fits` collects the crack-speed fits' inputs (None: not collecting)
 _FIT_LOG: list | None = None
 
@@ -206,7 +216,10 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     lo, hi = one_mesh_span(i, len(P), remeshed)
     i, t_star, P_star = refine_minimum(t[lo:hi], P[lo:hi])
     i += lo
-    passed = stop_reached(P, a, len(P), i, 0, min_travel)
+    # past the pull-off by the pull-off rule (a run that follows the curve to separation
+    # may fail after it, as one that stops there)
+    passed = stop_reached(P, a, len(P), i, 2 if stop_mode(res.scene) == 2 else 0,
+                          min_travel)
     fold = machine_fold(P, delta, i, machine_stiffness) if status == STATUS_NEWTON_FAILED \
         else math.nan
     passed = passed or math.isfinite(fold)
@@ -244,16 +257,23 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
             _FIT_LOG.append(dict(t=t.copy(), a=a.copy(), t_star=float(t_star),
                                  spacing=float(spacing), lo=int(lo), hi=int(hi)))
     a_star = float(np.interp(t_star, t[span], a[span]))
-    if speed <= 0 and a_star <= 0.0:
+    held, mode = "", stop_mode(res.scene)
+    # the contact gone at the record before the minimum already (a DMT-like contact that
+    # vanishes at its pull-off is there up to it)
+    gone_before = mode == 2 and a_star <= 0.0 and i > first and a[i - 1] <= 0.0
+    if (speed <= 0 and a_star <= 0.0) or gone_before:
         # a process zone strong enough to hold the surfaces after the contact's end: the load
         # still falls there, slowly, and the crack speed has no tip to follow (a DMT-like
         # contact that vanishes at its pull-off recedes there: speed > 0)
         gone = float(t[span][np.argmax(a[span] <= 0.0)])
-        res.reason = (f"the contact vanished (a = 0 from t = {gone:.4g} tau0) before the load "
-                      f"minimum P = {P_star:.6g}: the interface holds the surfaces after the "
-                      f"contact's end, where the crack speed at the pull-off is not defined "
-                      f"and the stop rule does not follow the load")
-        return
+        held = (f"the contact vanished (a = 0 from t = {gone:.4g} tau0) before the load "
+                f"minimum P = {P_star:.6g}: the interface held the surfaces after the contact's "
+                f"end")
+        if not (passed and mode == 2):
+            res.reason = (f"{held}, where the crack speed at the pull-off is not defined and "
+                          f"the stop rule does not follow the load")
+            return
+        speed = math.nan       # no crack tip at the pull-off; the stop rule followed the load
     if speed < 0:
         res.reason = (f"negative crack speed at the pull-off ({speed:.4g} a_ref/tau0, the "
                       f"contact advancing at the load minimum P = {P_star:.6g}, a = "
@@ -266,6 +286,8 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     if at_start:
         notes.append("load minimum at the initial state (the contact starts at or beyond its "
                      "pull-off): crack speed from the first step")
+    if held:
+        notes.append(f"{held}: no crack speed at the pull-off")
     if status == STATUS_NEWTON_FAILED and math.isfinite(fold):
         notes.append(f"stopped at the compliant machine's jump-off after pull-off (dP/ddelta "
                      f"= {fold:.3g} against -K = {-machine_stiffness:.3g})")

@@ -24,6 +24,7 @@ from ..scene import Numerics, Scene, SceneTable
 from ..theory import jkr_contact_radius
 from . import diskcache, process_zone
 from .mesh import BAND_MARGIN_ZONES, Mesh, crack_band, scene_mesh
+from .postprocess import stop_mode
 
 #: the Prony window spans [min_step/rate, WINDOW_SAFETY * estimated unloading time] ...
 WINDOW_SAFETY = 10.0
@@ -242,8 +243,8 @@ class Problem:
 
     @property
     def stop_mode(self) -> int:
-        """0: stop after the pull-off, 1: follow to separation (``kernels.solve.stop_reached``)."""
-        return 0 if self.scene.stop == "pulloff" else 1
+        """The stop rule's mode (:func:`sweep.engine.postprocess.stop_mode`)."""
+        return stop_mode(self.scene)
 
 
 @dataclass(frozen=True)

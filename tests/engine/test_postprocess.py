@@ -60,8 +60,8 @@ def remeshed_trajectory(m=40, n=80, dP=-0.11, da=0.0029, speed=3.0e4, dt=4.8e-9)
     return {"t": t, "delta": -t, "P": P, "a": a, "a_inner": a - 0.1}
 
 
-def run_finish(traj, remeshed=()):
-    res = Result(scene=Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0),
+def run_finish(traj, remeshed=(), **scene):
+    res = Result(scene=Scene(**{**dict(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0), **scene}),
                  numerics=Numerics.preset("balanced"))
     finish(res, STATUS_DONE, traj, SPACING, 0.0, SCALES, advice="refine", remeshed=remeshed)
     return res
@@ -128,6 +128,45 @@ def test_a_contact_that_vanished_before_the_load_minimum_says_so():
     assert res.status == "failed" and np.isnan(res.pull_off)
     assert res.reason.startswith("the contact vanished (a = 0 from t = 0.8 tau0) before the "
                                  "load minimum P = -14.875")
+
+
+ZONE = dict(pz_law="gent-schultz", pz_v0=1.0, pz_xi=0.5)
+
+
+def test_a_process_zone_that_held_the_surfaces_gives_the_pull_off_without_a_crack_speed():
+    """With a process zone the stop rule follows the load past a contact that vanished
+    before its minimum (stop mode 2) until it recovers; the row is then ok: the pull-off is
+    the load minimum, read as every pull-off is (the parabola through the records around
+    it, here exactly the synthetic parabola's vertex), and the crack speed is NaN, for there
+    is no crack tip at the pull-off, the reason says why. Without a process zone, or with
+    a load that has not recovered, the row fails as before."""
+    from sweep.engine.postprocess import stop_mode
+    from sweep.kernels.solve import stop_reached
+
+    t = np.linspace(0.0, 1.0, 81)
+    a = np.maximum(1.0 - 2.5 * t, 0.0)                     # a = 0 from t = 0.4
+    P = 40.0 * (t - 0.6) ** 2 - 20.0                       # the minimum -20 at t = 0.6
+    traj = {"t": t, "delta": -t, "P": P, "a": a, "a_inner": 0.0 * a}
+    assert stop_mode(Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0, **ZONE)) == 2
+    res = run_finish(traj, **ZONE)
+    assert res.ok, res.reason
+    assert res.pull_off == pytest.approx(20.0, rel=1e-12)
+    assert res.t_pulloff == pytest.approx(0.6, rel=1e-9)
+    assert np.isnan(res.crack_speed) and res.a_pulloff == 0.0
+    assert res.reason.startswith("the contact vanished (a = 0 from t = 0.4 tau0) before the "
+                                 "load minimum P = -20")
+    assert res.reason.endswith("no crack speed at the pull-off")
+    plain = run_finish(traj)                               # no process zone: stop mode 0
+    assert plain.status == "failed" and plain.reason.startswith("the contact vanished")
+    # the stop rule itself: at the first rise after the minimum mode 0 stops (contact lost),
+    # mode 2 goes on until the load has recovered by RECOVERY over RECOVERY_STEPS steps
+    i_min, first_rise = 48, 50
+    assert stop_reached(P, a, first_rise, i_min, 0, 0.01)
+    assert not stop_reached(P, a, first_rise, i_min, 2, 0.01)
+    assert stop_reached(P, a, 81, i_min, 2, 0.01)
+    # where the contact was there at the minimum, mode 2 stops as mode 0 does
+    b = (np.arange(t.size) <= i_min).astype(float)
+    assert stop_reached(P, b, first_rise, i_min, 2, 0.01)
 
 
 def test_a_pull_off_at_the_initial_state_reads_the_first_steps_speed():
