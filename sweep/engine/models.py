@@ -136,21 +136,22 @@ def _bem(scene, numerics=None):
     the mesh that fits it (graded, or tip-following beyond ``max_nodes``), within the scene's
     time budget. The row keeps the requested numerics (its id) and records the resolution
     behind it (``refinements``, ``band_resolution_used``, ``step_used``); a refinement that
-    fails for another reason (the mesh too large, the budget spent) leaves the finest
-    unresolved row, its reason saying so."""
+    fails for another reason (the mesh too large, the budget spent, a fold) leaves the finest
+    unresolved row, its reason saying so. A row whose first solve folds is solved once more,
+    finer (:func:`_folded`)."""
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t_start = time.perf_counter()
-    res, used, count, folded = _bem_once(scene, numerics), numerics, 0, False
+    res, used, count = _bem_once(scene, numerics), numerics, 0
     while _refinable(res) and count < numerics.refinements and budget.remaining() > 0:
-        if folded and _folded(res):
-            res.reason += "; not refined further: the finer mesh folds too"
-            break
-        folded = folded or _folded(res)
         finer = refined(used, res)
         if finer is None:
             break
         attempt = _bem_once(scene, finer)
-        if not (attempt.ok or _refinable(attempt)):
+        if _folded(attempt) and _folded(res):       # a fold is refined once (_folded)
+            res, used, count = attempt, finer, count + 1
+            res.reason += "; not refined further: the finer mesh folds too"
+            break
+        if not (attempt.ok or (_refinable(attempt) and not _folded(attempt))):
             res.reason += (f"; refined to band_resolution {finer.band_resolution:.4g}, step "
                            f"{finer.step:.3g}: {attempt.reason[:160]}")
             break

@@ -12,6 +12,7 @@ import pytest
 from sweep import Numerics, Result, Scene
 from sweep.engine.bem import simulate
 from sweep.engine import budget
+from sweep.engine.postprocess import FOLD_REASON
 from sweep.engine.problem import derive
 from sweep.engine.resolution import (COARSE_WORK_FACTOR, COARSE_WORK_FLOOR, REFINE_MARGIN,
                                      RESOLUTION_ERROR_K, coarser, estimate_error, refined,
@@ -295,14 +296,13 @@ def test_for_tolerance_starts_from_the_cheapest_preset_that_meets_it():
         Numerics.for_tolerance(0.0)
 
 
-def _fold_then(outcomes, monkeypatch):
-    """Replace the BEM's one solve (``sweep.engine.models``' ``_bem_once``) by rows that fail
-    where the discrete path folds, then ``outcomes`` (status, reason) in turn; returns the
-    list of band resolutions it was called with."""
+def _fold_then(outcomes, monkeypatch, first=None):
+    """Replace the BEM's one solve (``sweep.engine.models``' ``_bem_once``) by a row that
+    fails where the discrete path folds (or ``first``), then ``outcomes`` (status, reason)
+    in turn, the last repeated; returns the list of band resolutions it was called with."""
     from sweep.engine import models
-    from sweep.engine.postprocess import FOLD_REASON
 
-    seq = [("failed", f"{FOLD_REASON} (delta=0.1, a=1): the discrete path folds")] + outcomes
+    seq = [first or FOLDED] + outcomes
     calls = []
 
     def one_solve(scene, numerics):
@@ -317,6 +317,8 @@ def _fold_then(outcomes, monkeypatch):
 
 
 FOLD_SCENE = Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=10 ** 2.5, model="bem")
+FOLDED = ("failed", f"{FOLD_REASON} (delta=0.1, a=1): the discrete path folds")
+UNRESOLVED = ("failed", "unresolved: the pull-off moves by 0.05")
 
 
 def test_a_fold_is_refined_once_and_not_again_where_the_finer_mesh_folds_too(monkeypatch):
@@ -324,7 +326,6 @@ def test_a_fold_is_refined_once_and_not_again_where_the_finer_mesh_folds_too(mon
     more at the refinement's largest factor; where that folds too it stops there, with the
     finer solve's reason and why it stopped, whatever refinements remain."""
     from sweep import simulate as front_door
-    from sweep.engine.postprocess import FOLD_REASON
 
     calls = _fold_then([], monkeypatch)
     res = front_door(FOLD_SCENE, Numerics.preset("balanced", refinements=3))
@@ -345,10 +346,22 @@ def test_a_fold_a_finer_mesh_carries_through_is_answered_and_refined_on(monkeypa
     calls = _fold_then([("ok", "")], monkeypatch)
     res = front_door(FOLD_SCENE, Numerics.preset("balanced", refinements=3))
     assert calls == [16.0, 32.0] and res.ok and res.refinements == 1
-    calls = _fold_then([("failed", "unresolved: the pull-off moves by 0.05"), ("ok", "")],
-                       monkeypatch)
+    calls = _fold_then([UNRESOLVED, ("ok", "")], monkeypatch)
     res = front_door(FOLD_SCENE, Numerics.preset("balanced", refinements=3))
     assert calls == [16.0, 32.0, 64.0] and res.ok and res.refinements == 2
+
+
+def test_an_unresolved_row_whose_refinement_folds_is_kept(monkeypatch):
+    """Only a first solve's fold is refined: where a refinement of an unresolved row folds,
+    the row stays the unresolved one (its pull-off and estimate), its reason saying what
+    the finer solve met."""
+    from sweep import simulate as front_door
+
+    calls = _fold_then([FOLDED], monkeypatch, first=UNRESOLVED)
+    res = front_door(FOLD_SCENE, Numerics.preset("balanced", refinements=3))
+    assert calls == [16.0, 32.0] and res.refinements == 0
+    assert res.reason.startswith("unresolved") and "refined to band_resolution 32" in res.reason
+    assert "no equilibrium found" in res.reason
 
 
 #: a scene of the random protocol sample at large Tabor parameters (configs/random/
@@ -365,7 +378,6 @@ def test_a_fold_at_the_requested_accuracy_is_answered_by_a_finer_mesh():
     resolution on the other side of the fold: 5.77955, estimate 1.9e-3 measured; the
     accurate preset gave 5.77894, estimate 2.1e-4, in 30 s)."""
     from sweep import simulate as front_door
-    from sweep.engine.postprocess import FOLD_REASON
 
     plain = front_door(TABOR_FOLD, Numerics.preset("balanced"))
     assert plain.status == "failed" and plain.reason.startswith(FOLD_REASON), plain.reason
