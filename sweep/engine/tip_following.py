@@ -40,7 +40,7 @@ import scipy.linalg
 from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
-from ..kernels.solve import (N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
+from ..kernels.solve import (EASY_STEPS, N_STATS, SMOOTH_STEP_FACTOR, STAT_FACTOR, STAT_ITER,
                            STATUS_LEFT_BAND, STATUS_STEP_LIMIT, invalidate, new_jacobian_cache,
                            newton)
 from ..kernels.interface import (ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Interface,
@@ -167,14 +167,16 @@ class StepEstimate:
         return (f"the crack tip recedes at least {self.tip_travel:.3g} a_ref at most "
                 f"{self.tip_step:.2g} per step "
                 f"({self.tip_steps} steps), the indentation falls at least {self.travel:.4g} "
-                f"d_ref by at most {self.step:.3g} per step ({self.travel_steps} steps)")
+                f"d_ref in steps from {self.step:.3g}, doubling at most every {EASY_STEPS} "
+                f"({self.travel_steps} steps)")
 
 
 def estimate_steps(scene: Scene, numerics: Numerics, delta: float, a: float,
                    delta_start: float, a_start: float, step: float) -> StepEstimate:
     """Least number of further time steps of a run now at indentation ``delta`` and
     contact radius ``a`` that started at (``delta_start``, ``a_start``), with indentation
-    steps of at most ``step`` (d_ref): the indentation must fall to delta_start -
+    steps from ``step`` (d_ref) on, growing no faster than the kernel's step control lets
+    them (:func:`least_steps`): the indentation must fall to delta_start -
     :func:`indentation_travel`, and the crack tip at least to the relaxed JKR radius there
     (a frozen contact keeps its radius, a relaxed one follows JKR), at most ``da_max``
     fine spacings per step."""
@@ -184,9 +186,29 @@ def estimate_steps(scene: Scene, numerics: Numerics, delta: float, a: float,
     tip = max(a - a_end, 0.0)
     da = numerics.da_max * scales.tip_zone / numerics.band_resolution
     rest = max(delta - (delta_start - D), 0.0)
-    tip_steps, travel_steps = int(math.ceil(tip / da)), int(math.ceil(rest / step))
+    largest = SMOOTH_STEP_FACTOR * numerics.step * scales.h0
+    tip_steps, travel_steps = int(math.ceil(tip / da)), least_steps(rest, step, largest)
     return StepEstimate(steps=max(tip_steps, travel_steps), tip_travel=tip, tip_step=da,
                         tip_steps=tip_steps, travel=rest, step=step, travel_steps=travel_steps)
+
+
+def least_steps(travel: float, step: float, largest: float) -> int:
+    """The fewest indentation steps that cover ``travel`` (d_ref) starting at ``step``: the
+    kernel's step control (:func:`sweep.kernels.solve.next_step`) doubles a step after
+    EASY_STEPS steps in a row at most, up to ``largest`` (SMOOTH_STEP_FACTOR times
+    ``numerics.step``). A run's largest step so far is no bound of its later ones: a
+    retraction right after a fast approach takes steps of 1e-6 of its largest while the load
+    relaxes on the approach's time scale, then grows them (a protocol at mu 14.6, rate 0.025
+    after an approach at 40.5, was refused as needing 338208 steps and ran in 5296)."""
+    if travel <= 0.0:
+        return 0
+    step = max(min(step, largest), 1e-300)
+    steps = 0
+    while step < largest and travel > EASY_STEPS * step:
+        travel -= EASY_STEPS * step
+        steps += EASY_STEPS
+        step = min(2.0 * step, largest)
+    return steps + int(math.ceil(travel / step))
 
 
 def transfer(run, old, new, form: str = "auto") -> None:
@@ -481,8 +503,8 @@ def direct_initial_state(el: ElasticSolver, pb, scene: Scene):
 def _probe(scene, numerics, run, delta0, a0, per_step, margin, deadline) -> str:
     """After a chunk of a run (the probe of PROBE_STEPS steps, then each chunk of at least
     as many; ``per_step`` its wall time per step): the reason to end the run now when the
-    least number of steps it still needs (:func:`estimate_steps`, with indentation steps no
-    larger than the largest so far) exceeds max_steps or, at ``per_step``, takes more than
+    least number of steps it still needs (:func:`estimate_steps`, with indentation steps
+    growing from the largest so far) exceeds max_steps or, at ``per_step``, takes more than
     ``margin`` times the time left before ``deadline``; else ""."""
     n = run.n
     delta, a = run.records[1][:n], run.records[3][:n]

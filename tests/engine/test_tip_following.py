@@ -325,6 +325,42 @@ def test_a_scene_beyond_its_budget_is_refused_after_the_probe_with_what_it_needs
     assert need > 10000
 
 
+def test_the_least_steps_let_the_step_double_as_the_kernel_does():
+    """From step 1 to the largest 8, doubling after EASY_STEPS (8) steps: 8 steps of 1, of
+    2 and of 4 cover 56, then steps of 8; below 8 steps' travel, steps of the first size."""
+    assert tf.EASY_STEPS == 8
+    assert tf.least_steps(56.0 + 5 * 8.0, 1.0, 8.0) == 24 + 5
+    assert tf.least_steps(56.0 + 5 * 8.0 + 1e-9, 1.0, 8.0) == 24 + 6
+    assert tf.least_steps(7.5, 1.0, 8.0) == 8
+    assert tf.least_steps(100.0, 8.0, 8.0) == 13 == math.ceil(100.0 / 8.0)
+    assert tf.least_steps(0.0, 1.0, 8.0) == 0
+    # a step above the largest counts as the largest; tiny steps grow in log2 of the ratio
+    assert tf.least_steps(100.0, 50.0, 8.0) == 13
+    assert tf.least_steps(1.0, 1e-6, 0.016) < 8 * 15 + 63
+
+
+#: a protocol of the random sample at large Tabor parameters (configs/random/
+#: protocol_tabor.yaml, seed 43): its retraction, 1600 times slower than the approach and
+#: without a dwell, starts with indentation steps of 2e-6 d_ref while the load relaxes, then
+#: grows them; the probe, which took the largest step so far for all the steps to come, had
+#: refused it as needing 338208 steps (> max_steps); it takes 5296
+SLOW_AFTER_FAST = Scene(n=0.7811, k=0.02375, mu=14.57, rate=0.02541, approach_rate=40.53,
+                        preload=1.394, dwell=0.0)
+
+
+def test_a_retraction_whose_first_steps_are_tiny_is_not_refused_by_the_probe():
+    """The row runs (balanced, the sample's 20 s budget), its pull-off within the two
+    estimates of the fast preset's (a second resolution; measured 1.72562, estimate 4.3e-3,
+    against 1.71638, 3.2e-3)."""
+    res = models.simulate(SLOW_AFTER_FAST, Numerics.preset("balanced", time_budget_s=20.0))
+    assert res.ok and res.model_used == "bem", res.reason
+    assert res.steps > 2000 and "tip-following mesh" in res.reason
+    other = models.simulate(SLOW_AFTER_FAST, Numerics.preset("fast", time_budget_s=20.0))
+    assert other.ok, other.reason
+    err = abs(res.pull_off / other.pull_off - 1.0)
+    assert err <= res.error_estimate + other.error_estimate
+
+
 def test_a_scene_beyond_max_steps_is_refused_before_it_starts():
     res = tf.simulate_tip_following(Scene(n=0.2, k=0.5, mu=100.0, a0=15.0, rate=1e9),
                                     Numerics.preset("balanced"))
