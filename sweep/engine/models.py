@@ -142,7 +142,7 @@ def _bem(scene, numerics=None):
     numerics = Numerics.preset("balanced") if numerics is None else numerics
     t_start = time.perf_counter()
     res, used, count = _bem_once(scene, numerics), numerics, 0
-    while _refinable(res) and count < numerics.refinements and budget.remaining() > 0:
+    while _refinable(res, scene) and count < numerics.refinements and budget.remaining() > 0:
         finer = refined(used, res)
         if finer is None:
             break
@@ -151,12 +151,12 @@ def _bem(scene, numerics=None):
             res, used, count = attempt, finer, count + 1
             res.reason += "; not refined further: the finer mesh folds too"
             break
-        if not (attempt.ok or (_refinable(attempt) and not _folded(attempt))):
+        if not (attempt.ok or (_refinable(attempt, scene) and not _folded(attempt))):
             res.reason += (f"; refined to band_resolution {finer.band_resolution:.4g}, step "
                            f"{finer.step:.3g}: {attempt.reason[:160]}")
             break
         res, used, count = attempt, finer, count + 1
-    if _refinable(res) and count < numerics.refinements and budget.remaining() <= 0:
+    if _refinable(res, scene) and count < numerics.refinements and budget.remaining() <= 0:
         res.reason += "; not refined further: the time budget is spent"
     if count:
         note = (f"refined {count} time{'s' if count > 1 else ''} to band_resolution "
@@ -170,24 +170,30 @@ def _bem(scene, numerics=None):
     return res
 
 
-def _refinable(res) -> bool:
-    """Whether a finer resolution may answer the failed BEM row ``res``: its estimate exceeds
-    ``pull_off_rtol`` (unresolved), or its relaxed start failed on the mesh ("initial
-    state: ...", e.g. a contact of a few spacings whose indentation the coarse mesh cannot
-    bracket: measured at the fast resolution on n 0.3724, k 0.001749, mu 9.684, a0 0.6012,
-    rate 0.0012, which the balanced one solves), or its unloading found no equilibrium where
-    the discrete path folds (:func:`_folded`). :func:`sweep.engine.resolution.refined`
-    then takes the largest factor, the failure having no estimate."""
-    return (unresolved(res) or _folded(res)
-            or (res.status == "failed" and res.reason.startswith("initial state:")))
+def _refinable(res, scene) -> bool:
+    """Whether a finer resolution may answer the failed BEM row ``res`` of ``scene``: its
+    estimate exceeds ``pull_off_rtol`` (unresolved), or its relaxed start failed on the mesh
+    ("initial state: ...", e.g. a contact of a few spacings whose indentation the coarse mesh
+    cannot bracket: measured at the fast resolution on n 0.3724, k 0.001749, mu 9.684, a0
+    0.6012, rate 0.0012, which the balanced one solves), or its unloading found no
+    equilibrium where the discrete path folds (:func:`_folded`) and no other model can
+    answer the scene (a test protocol: :func:`_fallback`; a relaxed start's fold is the
+    crack-front model's under "auto", which a refinement would leave no time for: n 0.1787,
+    mu 98.55, rate 1.5e8 spent its 20 s budget refining and failed, where the crack-front
+    model answers it in 0.1 s). :func:`sweep.engine.resolution.refined` then takes the
+    largest factor, the failure having no estimate."""
+    return (unresolved(res)
+            or (res.status == "failed" and res.reason.startswith("initial state:"))
+            or (_folded(res) and _fallback(scene, res, "bem") is None))
 
 
 def _folded(res) -> bool:
     """Whether ``res`` failed where its discrete path folds before the pull-off, the crack tip
     under-resolved: a finer band may carry the path through (:func:`_bem` tries one finer
-    solve, not more: of the five such rows of the random samples one was answered, at mu 18;
-    on the other four the fold moved and stayed, also at up to three refinements, each
-    costing four to eight times the last; docs/numerics.md, "Asking for an accuracy")."""
+    solve, not more: of the four such protocols of the random samples one was answered, at
+    mu 18; on the other three the fold moved and stayed, also at up to three refinements,
+    each costing four to eight times the last; docs/numerics.md, "Asking for an
+    accuracy")."""
     return res.status == "failed" and res.reason.startswith(FOLD_REASON)
 
 

@@ -316,7 +316,9 @@ def _fold_then(outcomes, monkeypatch, first=None):
     return calls
 
 
-FOLD_SCENE = Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=10 ** 2.5, model="bem")
+#: a test protocol: no other model answers it, so a fold is the BEM's to refine
+FOLD_SCENE = Scene(n=0.8, k=0.1, mu=3.24, rate=10 ** 2.5, approach_rate=10 ** 2.5, preload=2.0,
+                   dwell=10.0, model="bem")
 FOLDED = ("failed", f"{FOLD_REASON} (delta=0.1, a=1): the discrete path folds")
 UNRESOLVED = ("failed", "unresolved: the pull-off moves by 0.05")
 
@@ -336,6 +338,22 @@ def test_a_fold_is_refined_once_and_not_again_where_the_finer_mesh_folds_too(mon
     calls = _fold_then([], monkeypatch)
     res = front_door(FOLD_SCENE, Numerics.preset("balanced"))      # a preset: no refinement
     assert calls == [16.0] and res.refinements == 0
+
+
+def test_a_relaxed_starts_fold_is_left_to_the_crack_front_model(monkeypatch):
+    """A relaxed start that folds is not refined: "auto" answers it with the crack-front
+    model (:func:`sweep.engine.models._fallback`), which a refinement would leave no time
+    for; with the BEM asked for, the row fails as the fold's advice says."""
+    from sweep import simulate as front_door
+
+    relaxed = Scene(n=0.8, k=0.1, mu=3.24, a0=3.61, rate=10 ** 2.5, model="bem")
+    calls = _fold_then([("ok", "")], monkeypatch)
+    res = front_door(relaxed, Numerics.preset("balanced", refinements=3))
+    assert calls == [16.0] and res.status == "failed" and res.refinements == 0
+    calls.clear()
+    res = front_door(Scene(**{**relaxed.to_dict(), "model": "auto"}),
+                     Numerics.preset("balanced", refinements=3))
+    assert calls == [16.0] and res.ok and res.model_used == "crack", res.reason
 
 
 def test_a_fold_a_finer_mesh_carries_through_is_answered_and_refined_on(monkeypatch):
