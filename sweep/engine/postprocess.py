@@ -216,10 +216,10 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     lo, hi = one_mesh_span(i, len(P), remeshed)
     i, t_star, P_star = refine_minimum(t[lo:hi], P[lo:hi])
     i += lo
-    # past the pull-off by the pull-off rule (a run that follows the curve to separation
-    # may fail after it, as one that stops there)
-    passed = stop_reached(P, a, len(P), i, 2 if stop_mode(res.scene) == 2 else 0,
-                          min_travel)
+    # past the pull-off by the pull-off rule, a process zone's where it has one (a run that
+    # follows the curve to separation may fail after it, as one that stops there)
+    zone = stop_mode(res.scene) == 2
+    passed = stop_reached(P, a, len(P), i, 2 if zone else 0, min_travel)
     fold = machine_fold(P, delta, i, machine_stiffness) if status == STATUS_NEWTON_FAILED \
         else math.nan
     passed = passed or math.isfinite(fold)
@@ -257,10 +257,10 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
             _FIT_LOG.append(dict(t=t.copy(), a=a.copy(), t_star=float(t_star),
                                  spacing=float(spacing), lo=int(lo), hi=int(hi)))
     a_star = float(np.interp(t_star, t[span], a[span]))
-    held, mode = "", stop_mode(res.scene)
+    held = ""
     # the contact gone at the record before the minimum already (a DMT-like contact that
     # vanishes at its pull-off is there up to it)
-    gone_before = mode == 2 and a_star <= 0.0 and i > first and a[i - 1] <= 0.0
+    gone_before = zone and a_star <= 0.0 and i > first and a[i - 1] <= 0.0
     if (speed <= 0 and a_star <= 0.0) or gone_before:
         # a process zone strong enough to hold the surfaces after the contact's end: the load
         # still falls there, slowly, and the crack speed has no tip to follow (a DMT-like
@@ -269,7 +269,7 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         held = (f"the contact vanished (a = 0 from t = {gone:.4g} tau0) before the load "
                 f"minimum P = {P_star:.6g}: the interface held the surfaces after the contact's "
                 f"end")
-        if not (passed and mode == 2):
+        if not (passed and zone):
             res.reason = (f"{held}, where the crack speed at the pull-off is not defined and "
                           f"the stop rule does not follow the load")
             return
