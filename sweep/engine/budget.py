@@ -105,7 +105,7 @@ def check(where: str) -> None:
     if outer is not None and time.perf_counter() > outer[0]:
         raise OverBudget(f"time budget: {outer[1]:g} s spent in {where}; give it more "
                          f"(numerics time_budget_s) or cheaper numerics (preset fast, lower "
-                         f"band_resolution, or model crack)")
+                         f"band_resolution)")
 
 
 def arm(cache) -> None:

@@ -110,7 +110,7 @@ from ..theory import (A_PULL_OFF_FORCE, jkr_contact_radius, jkr_indentation, pb_
 
 __all__ = ["GentSchultzLaw", "PerssonBrenerLaw", "ProcessZoneLaw", "CrackFrontSolution",
            "unload", "energy_release_rate", "crack_front_load", "pb_law_for_scene", "scene_law",
-           "simulate_crack", "constant_gamma_pull_off", "FIXED_GRIP_A_MIN"]
+           "simulate_crack", "constant_gamma_pull_off", "answers", "FIXED_GRIP_A_MIN"]
 
 #: 1/k - 1 at or below which the crack-front model is the elastic JKR contact at the constant
 #: Gamma = dg / sqrt(k), the geometric middle of Gamma(v) in [dg, dg/k]: its pull-off is then
@@ -784,6 +784,22 @@ def _load_minimum(pieces, delta_of):
         for s in (lo, float(res.x), hi):
             best = min(best, (load(s), s, float(dense(s)[0])))
     return best[1], best[2]
+
+
+def answers(scene) -> bool:
+    """Whether the crack-front model runs ``scene``: a relaxed start (no test protocol) on a
+    rigid machine (no ``machine_stiffness``) from a contact that is stable under fixed grip
+    (``a0`` at least :data:`FIXED_GRIP_A_MIN`, or a start given by ``delta0``). A failure's
+    advice names the model only where it does (:mod:`sweep.engine.models` refuses the rest,
+    each with its reason)."""
+    return (scene.protocol() is None and scene.machine_stiffness is None
+            and (scene.a0 is None or scene.a0 >= FIXED_GRIP_A_MIN))
+
+
+def crack_front_advice(scene) -> str:
+    """", or use the crack-front model (model crack)" where that model runs ``scene``
+    (:func:`answers`), else "": the end of a BEM failure's advice."""
+    return ", or use the crack-front model (model crack)" if answers(scene) else ""
 
 
 def simulate_crack(scene, numerics=None):

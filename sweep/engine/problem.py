@@ -343,6 +343,10 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None, *,
     window (:mod:`sweep.engine.tip_following`), which a refusal names.
     """
     lo, hi = BEM_MU_RANGE
+    if not lo <= scene.mu <= hi and (scene.protocol() is not None
+                                     or scene.machine_stiffness is not None):
+        raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
+                      f", the one model that runs a test protocol or a compliant machine")
     if not lo <= scene.mu <= hi:
         raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
                       f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "

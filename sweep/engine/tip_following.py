@@ -49,6 +49,7 @@ from ..kernels.interface import (ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Int
 from ..scene import Numerics, Result, Scene
 from . import budget
 from .budget import OverBudget
+from .crack_front import crack_front_advice
 from .bem import (CHUNK_STEPS, STOP_TRAVEL_SPACINGS, UnloadingState, check_prony_window,
                   join_phases, no_contact_reason, retraction_start, unload_chunk)
 from .initial import ElasticSolver, cached_state, relaxed_state
@@ -84,9 +85,13 @@ REMESH_JUMP_RTOL = 1e-3
 MARCH_TIP_STEP = DWELL_DA_FACTOR
 #: Newton iterations of the re-equilibration after a state transfer (:func:`transfer`)
 REEQUILIBRATE_ITER = 30
-#: what to change when the tip-following mesh finds no equilibrium before the pull-off
-ADVICE_TIP_FOLLOWING = ("raise band_resolution (the fine spacing is the tip zone / "
-                        "band_resolution) or use the crack-front model (model crack)")
+
+
+def fold_advice(scene) -> str:
+    """What to change when the tip-following mesh finds no equilibrium before the pull-off of
+    ``scene``: the band resolution, and the crack-front model where it runs the scene."""
+    return ("raise band_resolution (the fine spacing is the tip zone / band_resolution)"
+            + crack_front_advice(scene))
 
 
 def window_problem(scene, numerics, tip, zone, ahead, behind, direction=-1):
@@ -108,7 +113,7 @@ def remesh_jump(P: np.ndarray, m: int, rtol: float = REMESH_JUMP_RTOL) -> float 
     return None
 
 
-def _continuity(run, remeshed_at: list, rtol: float) -> str:
+def _continuity(scene, run, remeshed_at: list, rtol: float) -> str:
     """Check (and drop from ``remeshed_at``) the re-meshings whose neighbouring records now
     exist; the reason of a failure when one up to the load minimum so far made the load
     jump (:func:`remesh_jump`), else ""."""
@@ -122,8 +127,8 @@ def _continuity(run, remeshed_at: list, rtol: float) -> str:
         if jump is not None:
             return (f"re-meshing at a = {a[m - 1]:.4g} made the load jump by {jump:.3g} (from "
                     f"{P[m - 1]:.4g}; tolerance {rtol:g} |P|): the mesh outside the fine window "
-                    f"cannot carry the state; use the fixed crack band (raise max_nodes) or "
-                    f"model crack")
+                    f"cannot carry the state; use the fixed crack band (raise max_nodes)"
+                    f"{crack_front_advice(scene)}")
     return ""
 
 
@@ -522,15 +527,14 @@ def _probe(scene, numerics, run, delta0, a0, per_step, margin, deadline) -> str:
     if total > numerics.max_steps:
         return (f"too many steps: {need.describe()}, as the first {n - 1} steps took: about "
                 f"{total} steps > max_steps = {numerics.max_steps}; raise max_steps, or lower "
-                f"band_resolution, or use the crack-front model (model crack)")
+                f"band_resolution{crack_front_advice(scene)}")
     left = deadline - time.perf_counter()
     if need.steps * per_step > margin * left:
         return (f"time budget: needs at least {total} steps ({need.describe()}, as the first "
                 f"{n - 1} steps took) at {1e3 * per_step:.2g} ms per step on {run.h.size} "
                 f"nodes: about {need.steps * per_step:.0f} s more, > {margin:g} x the "
                 f"{left:.0f} s left of time_budget_s = {numerics.time_budget_s:g}; raise "
-                f"time_budget_s, or lower band_resolution, or use the crack-front model "
-                f"(model crack)")
+                f"time_budget_s, or lower band_resolution{crack_front_advice(scene)}")
     return ""
 
 
@@ -579,8 +583,8 @@ def _attempt(scene, numerics, ahead, behind, deadline) -> Result:
                           SMOOTH_STEP_FACTOR * numerics.step * scales.h0)
     if need.steps > numerics.max_steps:
         res.reason = (f"too many steps: {need.describe()}: > {need.steps} steps (max_steps = "
-                      f"{numerics.max_steps}); raise max_steps, or lower band_resolution, or use "
-                      f"the crack-front model (model crack)")
+                      f"{numerics.max_steps}); raise max_steps, or lower band_resolution"
+                      f"{crack_front_advice(scene)}")
         return res
     try:
         branch, from_branch = None, False
@@ -665,7 +669,7 @@ def _finish_following(res, u, scales, meshes, nodes, remeshed, first=0) -> Resul
         return res
     spacing = u.pb.mesh.spacing
     finish(res, u.status, res.trajectory, spacing, STOP_TRAVEL_SPACINGS * spacing, scales,
-           advice=ADVICE_TIP_FOLLOWING, remeshed=remeshed, first=first)
+           advice=fold_advice(res.scene), remeshed=remeshed, first=first)
     check_prony_window(u.pb, res)
     if res.ok:
         note = f"tip-following mesh: {meshes} meshes of at most {nodes} nodes"
@@ -792,7 +796,7 @@ def _unload_following(scene, numerics, pb, run, zone, ahead, behind, deadline, d
         u.status = unload_chunk(u.pb, run, u.pb.tip_range,
                                 PROBE_STEPS if probing else CHUNK_STEPS, deadline)
         budget.check_work(int(run.stats[STAT_FACTOR]) - start, "the unloading")
-        broken = _continuity(run, remeshed_at, rtol)
+        broken = _continuity(scene, run, remeshed_at, rtol)
         if broken:
             u.ended, u.reason = "broken", broken
             return u

@@ -2,7 +2,10 @@
 from __future__ import annotations
 
 from sweep.engine.bem import no_contact_reason
+from sweep.engine.crack_front import answers
+from sweep.engine.models import simulate_model
 from sweep.engine.resolution import estimate_error, refine_advice
+from sweep.engine.tip_following import fold_advice
 from sweep.scene import Numerics, Result, Scene
 
 SCENE = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0)
@@ -34,3 +37,37 @@ def test_no_contact_reason_fits_the_initial_state_given():
     assert "a0 = 2" in by_a0 and "delta0" not in by_a0
     by_delta0 = no_contact_reason(Scene(n=0.8, k=0.1, mu=3.24, delta0=-0.5, rate=10.0), 0.0)
     assert "delta0 = -0.5 is below the jump-in" in by_delta0
+
+
+def _crack_refuses(scene) -> bool:
+    """Whether the crack-front model, run through the models' front door, refuses ``scene``
+    (a failed row without a pull-off)."""
+    res = simulate_model(scene, "crack", Numerics.preset("fast"))
+    return not res.ok
+
+
+def test_advice_names_the_crack_front_model_only_where_it_runs_the_scene():
+    relaxed = dict(n=0.8, k=0.1, mu=18.0, rate=10.0)
+    scenes = {
+        "relaxed start": Scene(a0=2.0, **relaxed),
+        "from an indentation": Scene(delta0=1.0, **relaxed),
+        "a contact below fixed grip's stability": Scene(a0=0.4, **relaxed),
+        "a test protocol": Scene(approach_rate=10.0, preload=2.0, dwell=1.0, **relaxed),
+        "a compliant machine": Scene(a0=2.0, machine_stiffness=10.0, **relaxed),
+    }
+    runs = {name: not _crack_refuses(scene) for name, scene in scenes.items()}
+    assert runs == {"relaxed start": True, "from an indentation": True,
+                    "a contact below fixed grip's stability": False, "a test protocol": False,
+                    "a compliant machine": False}
+    for name, scene in scenes.items():
+        assert answers(scene) == runs[name], name
+        assert ("model crack" in fold_advice(scene)) == runs[name], name
+        assert fold_advice(scene).startswith("raise band_resolution")
+
+
+def test_a_protocol_beyond_the_bem_range_is_not_sent_to_the_crack_front_model():
+    scene = Scene(n=0.8, k=0.1, mu=150.0, rate=10.0, approach_rate=10.0, preload=2.0,
+                  dwell=1.0, model="auto")
+    res = simulate_model(scene, "auto", Numerics.preset("fast"))
+    assert not res.ok and "outside the hereditary BEM's range" in res.reason
+    assert "crack" not in res.reason
