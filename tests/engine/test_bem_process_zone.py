@@ -137,17 +137,29 @@ STRONG = dict(n=1.254, k=0.09968, mu=0.6347, a0=1.62, rate=122500.0, pz_law="gen
               pz_v0=0.7448, pz_xi=0.494, model="bem")
 
 
+#: the finer meshes of the strong zone's check (band resolutions; the row's is 36). Each
+#: may fold at its first step on one processor and not on another (band 48 did on an AMD EPYC,
+#: 2026-11-28, and not on the machine the test was written on), so the check takes three
+#: and asks two of them to answer
+STRONG_FINER = (40.0, 48.0, 56.0)
+
+
 def test_a_strong_zones_first_step_is_solved_by_continuation():
-    """Independent value: the same scene on a finer mesh (band resolution 48 against 36, 323
-    nodes against 121), whose pull-off the row's error estimate must cover (measured: 3.6e-5
-    apart, estimate 1.2e-3; an amplification of about 120 over the LJ scene's)."""
+    """Independent value: the same scene on finer meshes (band resolutions 40-56 against 36;
+    323 nodes at 48 against 121), whose pull-offs the row's error estimate must cover
+    (measured: band 48 3.6e-5 from the row on the first machine; on the second 246.783 at
+    40 and at 56, band 48 folded; the row's estimate 1.2e-3; an amplification of about 120
+    over the LJ scene's)."""
     row = simulate(Scene(**STRONG), Numerics.preset("balanced"))
     assert row.ok, row.reason
     assert row.steps > 20 and row.pull_off > 100.0
-    fine = simulate(Scene(**STRONG), Numerics.preset("balanced", band_resolution=48,
-                                                     pull_off_rtol=0.0))
-    assert fine.ok, fine.reason
-    assert abs(row.pull_off - fine.pull_off) / fine.pull_off <= row.error_estimate
+    finer = [simulate(Scene(**STRONG), Numerics.preset("balanced", band_resolution=band,
+                                                       pull_off_rtol=0.0))
+             for band in STRONG_FINER]
+    answered = [fine for fine in finer if fine.ok]
+    assert len(answered) >= 2, [fine.reason for fine in finer]
+    for fine in answered:
+        assert abs(row.pull_off - fine.pull_off) / fine.pull_off <= row.error_estimate
 
 
 #: a protocol of the random process-zone sample (configs/random/protocol_pz.yaml, seed 77)
@@ -172,3 +184,4 @@ def test_a_zone_that_holds_the_surfaces_after_the_contact_gives_a_converging_pul
         assert res.pull_off > 50.0
     coarse, fine = rows
     assert abs(coarse.pull_off / fine.pull_off - 1.0) <= coarse.error_estimate + fine.error_estimate
+
