@@ -255,3 +255,53 @@ def test_halving_keeps_each_phase_and_its_ends():
     kept = [0, 2, 4, 6, 8, 9, 10, 12, 14, 16, 18]
     assert cycle_work(traj, halved=True) == pytest.approx(
         cycle_work({key: traj[key][kept] for key in ("delta", "P")}), rel=1e-14)
+
+
+# -- a path that folds past its load minimum ------------------------------------------------
+from sweep.engine.postprocess import FOLD_REASON  # noqa: E402
+from sweep.kernels.solve import STATUS_NEWTON_FAILED  # noqa: E402
+
+
+def folded_trajectory(n_after: int, rise: float, n=120, i_min=80, dt=1e-3):
+    """A retraction whose load reaches its minimum P = -10 at record ``i_min`` (a parabola in
+    time), its crack tip receding one fine spacing a record throughout, and whose solve
+    failed (the discrete path folds) ``n_after`` records past the minimum, where the load
+    has risen by ``rise`` of |P_min|."""
+    k = np.arange(i_min + n_after + 1)
+    t = k * dt
+    curvature = rise * 10.0 / max(n_after, 1) ** 2
+    P = -10.0 + curvature * (k - i_min) ** 2
+    a = 2.0 - SPACING * k
+    return {"t": t, "delta": -t, "P": P, "a": a, "a_inner": a - 0.1}
+
+
+def run_folded(traj):
+    res = Result(scene=Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1.0), numerics=Numerics())
+    finish(res, STATUS_NEWTON_FAILED, traj, SPACING, 3.0 * SPACING, SCALES, advice="refine")
+    return res
+
+
+def test_a_fold_past_the_load_minimum_gives_the_minimum_as_the_pull_off():
+    """The fold 10 records (10 spacings of crack travel) past the minimum, the load risen by
+    1e-3 of it, short of the stop rule's 5 % recovery: the minimum is the pull-off (the
+    parabola's vertex exactly), the reason says where the path folded."""
+    res = run_folded(folded_trajectory(n_after=10, rise=1e-3))
+    assert res.ok, res.reason
+    assert res.pull_off == pytest.approx(10.0, rel=1e-12)
+    assert res.a_pulloff == pytest.approx(2.0 - 80 * SPACING, rel=1e-12)
+    assert res.crack_speed == pytest.approx(SPACING / 1e-3, rel=1e-6)
+    assert "folds past the load minimum (10 records later" in res.reason
+    assert "receded 10 spacings" in res.reason
+
+
+@pytest.mark.parametrize("n_after, rise", [(0, 0.0), (2, 1e-3)])
+def test_a_fold_at_or_near_the_minimum_is_no_pull_off(n_after, rise):
+    """A fold at the minimum (the load still falling), or within the stop rule's crack travel
+    past it (3 spacings: a dip of the load as the tip crosses a node), stays a failure with
+    the fold's advice."""
+    traj = folded_trajectory(n_after=n_after, rise=rise)
+    if n_after == 0:
+        traj["P"] = traj["P"] - 1e-3 * np.arange(traj["P"].size)   # still falling at the end
+    res = run_folded(traj)
+    assert res.status == "failed" and res.reason.startswith(FOLD_REASON), res.reason
+    assert res.reason.endswith("refine")
