@@ -57,6 +57,14 @@ VERTEX_RTOL = 1e-3
 FOLD_REASON = "no equilibrium found at the minimum step before pull-off"
 
 
+#: what a row whose load overflowed advises: its time steps grew past what the solve's
+#: arithmetic holds (rates below about 1e-100 at the balanced preset: steps of 1e103 tau0 and
+#: more), far past the relaxed limit (`sweep scene --a0 2 --rate 1e-90` and `1e-100` give the
+#: same pull-off, 1.5459365576, to 1e-12)
+OVERFLOW_ADVICE = ("A slower unloading than the material's longest retardation time is its "
+                   "relaxed limit: a larger rate gives the same pull-off")
+
+
 def stop_mode(scene) -> int:
     """The stop rule's mode of ``scene`` (:func:`sweep.kernels.solve.stop_reached`): 1
     following the curve to separation; 2 stopping after the pull-off with a process zone,
@@ -228,6 +236,13 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         parameter's, where both are near the DMT value 2).
     """
     t, delta, P, a, a_inner = (trajectory[k] for k in ("t", "delta", "P", "a", "a_inner"))
+    overflow = ~np.isfinite(P[first:])
+    if overflow.any():
+        k = first + int(np.argmax(overflow))
+        step = t[k] - t[k - 1] if k > 0 else math.nan
+        res.reason = (f"the load is not finite from record {k} on (t = {t[k]:.4g} tau0, steps "
+                      f"of {step:.3g} tau0): the solve overflowed. {OVERFLOW_ADVICE}")
+        return
     i = first + int(np.argmin(P[first:]))
     lo, hi = one_mesh_span(i, len(P), remeshed)
     i, t_star, P_star = refine_minimum(t[lo:hi], P[lo:hi])

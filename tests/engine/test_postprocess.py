@@ -305,3 +305,29 @@ def test_a_fold_at_or_near_the_minimum_is_no_pull_off(n_after, rise):
     res = run_folded(traj)
     assert res.status == "failed" and res.reason.startswith(FOLD_REASON), res.reason
     assert res.reason.endswith("refine")
+
+
+def test_a_load_that_overflowed_is_no_pull_off():
+    """A run whose load is NaN from some record on (time steps past the arithmetic's range)
+    is a failure saying so, never an ok row with a NaN pull-off (np.argmin takes a NaN for
+    the minimum)."""
+    traj = folded_trajectory(n_after=30, rise=0.06)
+    traj["P"][90:] = np.nan
+    res = Result(scene=Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1.0), numerics=Numerics())
+    finish(res, STATUS_DONE, traj, SPACING, 3.0 * SPACING, SCALES, advice="refine")
+    assert res.status == "failed" and "not finite from record 90 on" in res.reason
+
+
+def test_an_unloading_too_slow_for_the_arithmetic_fails_with_the_reason():
+    """Independent value: the relaxed limit. At rate 1e-120 the time steps (1e116 tau0 and
+    more) overflow Newton's start, and the row fails saying so; at 1e-90 and 1e-100 the
+    pull-offs agree to 1e-10 (measured 1e-12), the material relaxed long before."""
+    from sweep import simulate
+
+    scene = dict(n=0.8, k=0.1, mu=3.24, a0=2.0)
+    num = Numerics.preset("fast", pull_off_rtol=0.0)
+    slow, slower = (simulate(Scene(rate=rate, **scene), num) for rate in (1e-90, 1e-100))
+    assert slow.ok and slower.ok
+    assert slower.pull_off == pytest.approx(slow.pull_off, rel=1e-10)
+    res = simulate(Scene(rate=1e-120, **scene), num)
+    assert res.status == "failed" and "the solve overflowed" in res.reason, res.reason
