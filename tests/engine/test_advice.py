@@ -71,3 +71,17 @@ def test_a_protocol_beyond_the_bem_range_is_not_sent_to_the_crack_front_model():
     res = simulate_model(scene, "auto", Numerics.preset("fast"))
     assert not res.ok and "outside the hereditary BEM's range" in res.reason
     assert "crack" not in res.reason
+
+
+def test_an_unresolved_row_quotes_the_estimate_it_compared():
+    """The reason quotes the pair's change and the estimate compared with pull_off_rtol (the
+    change over 2^ESTIMATE_ORDER - 1): a change below the tolerance whose estimate is above
+    it read as a contradiction ("moves by 0.0061 ..., above pull_off_rtol = 0.01")."""
+    numerics = Numerics.preset("balanced")
+    res = Result(scene=SCENE, numerics=numerics, status="ok", pull_off=1.0, spacing=0.01)
+    coarse = Result(scene=SCENE, numerics=numerics, status="ok", pull_off=1.0061)
+    estimate_error(res, 0.1, lambda num: coarse)
+    assert res.status == "failed" and 0.0061 < numerics.pull_off_rtol < res.error_estimate
+    assert "the pull-off moves by 0.0061 on a mesh of 1/2" in res.reason
+    assert f"an error estimate of {res.error_estimate:.2g} (the change over 2^0.65 - 1)" \
+        in res.reason
