@@ -674,12 +674,18 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     p_prev2, p_prev = math.inf, float(crack_front_load(a0, delta_of(t1)))
     dense_prev = None
     pulloff = None                      # (t, a) of the first tensile load minimum
+    runaway = None                      # past the pull-off, where the edge ran away
     try:
         solver = Radau(rhs, t1, [a0], t1 + span, rtol=rtol, atol=atol, jac=jac,
                        first_step=min(1e-6 * span, 1e-3 / max(rate, 1.0)))
         solver.lu, solver.solve_lu = _lapack_lu, _lapack_solve
         while True:
             message = solver.step()
+            if solver.status == "failed" and pulloff is not None:
+                # following to separation past the pull-off: the edge runs away (g beyond
+                # what any crack speed balances), the contact separates at once
+                runaway = float(solver.y[0])
+                break
             if solver.status == "failed":
                 sol.reason = f"integrator: {message}"
                 break
@@ -753,8 +759,17 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     sol.crack_speed, sol.gamma_pulloff = -ap * ddot / (ap * ap - dp), gp
     sol.capped = bool(getattr(law, "v_cap", math.inf) <= float(law.speed(gp)[0]) * (1.0 + 1e-12))
     sol.status = "ok"
+    notes = []
     if sol.capped:
-        sol.reason = "crack speed at the end of the Persson-Brener table (Gamma ~ 1/k)"
+        notes.append("crack speed at the end of the Persson-Brener table (Gamma ~ 1/k)")
+    if runaway is not None:
+        g_end = float(energy_release_rate(a[-1], d[-1]))
+        bound = (f" against the law's largest Gamma/dg, {g_max:.6g}" if math.isfinite(g_max)
+                 and hasattr(law, "g_max") else "")
+        notes.append(f"followed to a = {runaway:.4g}, where the integrator finds no step (g = "
+                     f"{g_end:.6g}{bound}): the edge runs away and the contact separates at "
+                     f"once")
+    sol.reason = "; ".join(notes)
     return sol
 
 

@@ -10,6 +10,7 @@ from sweep.engine.crack_front import (
     GentSchultzLaw, constant_gamma_pull_off, crack_front_load, energy_release_rate,
     pb_law_for_scene, simulate_crack, unload,
 )
+from sweep.engine.models import simulate_model
 from sweep.errors import InputError
 from sweep.theory import jkr_indentation, jkr_load, jkr_pull_off_point, pb_gamma_eff
 
@@ -205,3 +206,22 @@ def test_the_lapack_lu_refuses_what_scipy_refuses():
     assert _lapack_solve(factors, np.array([2.0]))[0] == 0.5
     z = _lapack_solve(_lapack_lu(np.array([[2.0 + 2.0j]])), np.array([4.0 + 0.0j]))
     assert z[0] == pytest.approx(1.0 - 1.0j, rel=1e-15)
+
+
+@pytest.mark.parametrize("a0, rate", [(2.0, 10.0), (1.0, 0.01), (2.0, 1e4)])
+def test_a_run_to_separation_ends_where_the_edge_runs_away(a0, rate):
+    """Past the pull-off under fixed grip, g grows as the contact shrinks; the Persson-Brener
+    law's Gamma(v)/dg is bounded by the glassy 1/k, and beyond it no crack speed balances g:
+    the integrator finds no step (it failed the row with SciPy's message). The row is the
+    pull-off run's, followed to where g reaches 1/k (independent value: the law's bound)."""
+    scene = dict(n=0.8, k=0.1, mu=3.24, a0=a0, rate=rate, model="crack")
+    pulloff = simulate_model(Scene(**scene), "crack")
+    res = simulate_model(Scene(**scene, stop="separation"), "crack")
+    assert pulloff.ok and res.ok, res.reason
+    assert res.pull_off == pulloff.pull_off
+    a, d = res.trajectory["a"], res.trajectory["delta"]
+    assert a[-1] < res.a_pulloff
+    if "runs away" in res.reason:
+        assert energy_release_rate(a[-1], d[-1]) == pytest.approx(1.0 / 0.1, rel=1e-3)
+    else:                                   # followed to the run's end, a = 0.02 a0
+        assert a[-1] == pytest.approx(0.02 * a0, rel=1e-9)
