@@ -908,5 +908,29 @@ def _elastic_crack(scene, res, t_start):
     res.rhat_pb = float(units.rhat_pb(scene.rate, scene.mu))
     res.prony_terms, res.prony_error = 0, 0.0
     res.error_estimate = c - 1.0            # Gamma(v) within [dg, dg/k]: |c k^(-1/2) - 1|
+    if scene.stop == "separation":
+        res.trajectory = _elastic_separation(a0, res.delta0_result, c, speed)
+        res.reason = (f"followed under fixed grip to its instability, a = "
+                      f"{res.trajectory['a'][-1]:.4g} (d delta/d a = 0 at g = {c:.4g}), where "
+                      f"the contact separates at once")
     res.wall_s = time.perf_counter() - t_start
     return res
+
+
+#: points of a nearly elastic contact's path to separation (:func:`_elastic_separation`)
+SEPARATION_POINTS = 200
+
+
+def _elastic_separation(a0, delta0, c, speed) -> dict:
+    """The path of a JKR contact opened at the constant Gamma = c dg under fixed grip, from
+    the relaxed contact of radius ``a0`` at ``delta0`` (its edge pinned until g reaches c) to
+    the fixed-grip instability, d delta/d a = 0 at a = (c/32)^(1/5) (1/2 and P = -5/6 at c =
+    1), where it separates: records ``t, delta, P, a, a_inner`` (``a_inner`` NaN) at the
+    indentation ``speed`` (d_ref/tau0)."""
+    a_end = (c / 32.0) ** 0.2
+    a = np.linspace(a0, a_end, SEPARATION_POINTS) if a0 > a_end else np.array([a0])
+    delta = a * a - np.sqrt(2.0 * c * a)
+    a, delta = np.append(a0, a), np.append(delta0, delta)        # the pinned start
+    t = (delta0 - delta) / speed
+    return {"t": t, "delta": delta, "P": crack_front_load(a, delta), "a": a,
+            "a_inner": np.full(a.size, np.nan)}

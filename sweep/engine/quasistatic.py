@@ -438,6 +438,11 @@ def simulate_elastic(scene, numerics=None):
     if scene.k != 1.0:
         res.reason = f"the quasi-static elastic solver needs k = 1 (got k = {scene.k})"
         return res
+    if scene.stop != "pulloff":
+        res.reason = ("the quasi-static elastic branch ends at its displacement-controlled "
+                      "fold past the pull-off: a run to separation (stop separation) runs "
+                      "with model bem or auto")
+        return res
     protocol = scene.protocol()
     if protocol is not None:
         try:

@@ -225,3 +225,18 @@ def test_a_run_to_separation_ends_where_the_edge_runs_away(a0, rate):
         assert energy_release_rate(a[-1], d[-1]) == pytest.approx(1.0 / 0.1, rel=1e-3)
     else:                                   # followed to the run's end, a = 0.02 a0
         assert a[-1] == pytest.approx(0.02 * a0, rel=1e-9)
+
+
+def test_a_nearly_elastic_run_to_separation_ends_at_the_fixed_grip_instability():
+    """k = 1 (the closed form at the constant Gamma = dg): a run to separation had no
+    trajectory at all. Independent value: JKR under fixed grip jumps off at a = 1/2, P = -5/6
+    (Maugis), past the largest tension, the load-control pull-off 3/2."""
+    res = simulate_model(Scene(n=0.8, k=1.0, mu=3.24, a0=2.0, rate=10.0, stop="separation"),
+                         "crack")
+    assert res.ok, res.reason
+    tr = res.trajectory
+    assert tr["a"][-1] == pytest.approx(0.5, rel=1e-12)
+    assert tr["P"][-1] == pytest.approx(-5.0 / 6.0, rel=1e-12)
+    assert -tr["P"].min() == pytest.approx(res.pull_off, rel=1e-4)   # sampled near 3/2
+    assert res.pull_off == pytest.approx(1.5, rel=1e-12)
+    assert np.all(np.diff(tr["t"]) >= 0.0) and tr["a"][0] == 2.0

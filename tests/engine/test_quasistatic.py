@@ -201,3 +201,18 @@ def test_an_elastic_protocols_hysteresis_error_covers_a_finer_branch(monkeypatch
     monkeypatch.setattr(qs, "TAIL_RECORDS", 128)
     finer = qs._cycle_work(qs._branch(5.0, **fine), 5.0, po_fine)
     assert 0.0 < abs(res.hysteresis_energy / finer - 1.0) <= res.hysteresis_error < 1e-2
+
+
+def test_the_elastic_branch_refuses_a_run_to_separation():
+    """The branch ends at its displacement-controlled fold past the pull-off, so a run to
+    separation is refused with the models that run one (it was ok, its trajectory ending at
+    the pull-off, with ``stop`` recorded as separation); the BEM follows the contact past
+    the fold."""
+    from sweep.engine.models import simulate_model
+
+    scene = Scene(n=0.8, k=1.0, mu=3.24, a0=2.0, rate=10.0, stop="separation")
+    res = simulate_model(scene, "elastic", Numerics.preset("fast"))
+    assert res.status == "failed" and "model bem or auto" in res.reason
+    bem = simulate_model(scene, "bem", Numerics.preset("balanced"))
+    assert bem.ok and bem.model_used == "bem", bem.reason
+    assert bem.trajectory["a"][-1] < bem.a_pulloff
