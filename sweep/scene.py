@@ -418,6 +418,10 @@ class Scene:
                 continue
             object.__setattr__(self, f.name, info[f.name].check(getattr(self, f.name)))
         check_process_zone(self.pz_law, self.pz_v0, self.pz_xi, "a_ref/tau0")
+        if protocol and self.machine_stiffness is not None:
+            raise InputError("machine_stiffness: a compliant machine runs the unloading from a "
+                             "relaxed contact (a0 or delta0), not a test protocol (approach_rate, "
+                             "preload, dwell); leave one of them unset")
 
     def protocol(self) -> "Protocol | None":
         """The test protocol (:class:`Protocol`), or None for the relaxed start."""

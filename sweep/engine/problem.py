@@ -357,10 +357,9 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None, *,
                       "not with numerics.exact")
     if protocol and band is None:
         band = protocol_band(scene, numerics)
-    if scene.machine_stiffness is not None and (protocol or numerics.exact):
+    if scene.machine_stiffness is not None and numerics.exact:   # a protocol: Scene refuses
         raise Refused("a compliant machine (machine_stiffness) runs on the BEM's unloading "
-                      "from a relaxed contact: not with " + ("a test protocol (approach, "
-                      "dwell, retract)" if protocol else "numerics.exact"))
+                      "from a relaxed contact: not with numerics.exact")
     if numerics.exact and scene.pz_law != "none":
         raise Refused(f"numerics.exact: the exact hereditary reference has the Lennard-Jones "
                       f"interface only, not the process zone (pz_law {scene.pz_law}); leave "

@@ -430,3 +430,15 @@ def test_si_grid_with_a_table_needs_no_moduli_and_refuses_other_ones():
     with pytest.raises(InputError, match="E0, Einf, n, tau0: required for material mpl"):
         config_from_dict({"name": "s", "units": "si",
                           "grid": {**grid, "material": ["mpl", grid["material"]]}})
+
+
+def test_a_compliant_machine_with_a_protocol_is_refused_when_the_config_loads():
+    """Every such scene failed at run time, auto included ("a compliant machine ... not a test
+    protocol"), where other impossible combinations are refused at load: one line naming the
+    parameter."""
+    text = msg(grid={"n": 0.8, "k": 0.1, "mu": 3.24, "rate": 10.0, "approach_rate": 10.0,
+                     "preload": 2.0, "dwell": 1.0, "machine_stiffness": 1.0})
+    assert "machine_stiffness: a compliant machine runs the unloading from a relaxed" in text
+    with pytest.raises(InputError, match="machine_stiffness"):
+        Scene(n=0.8, k=0.1, mu=3.24, rate=10.0, approach_rate=10.0, preload=2.0, dwell=1.0,
+              machine_stiffness=1.0)
