@@ -49,15 +49,19 @@ def check_range(name: str, value, lo=None, hi=None, lo_open=False, hi_open=False
         hi is not None and (x > hi or (hi_open and x == hi))
     )
     if bad:
+        # the value in full where six digits would print it as the bound it crosses
+        got = _fmt(x)
+        if got in (_fmt(lo), _fmt(hi)) and x not in (lo, hi):
+            got = repr(x)
         if hi is None:
             allowed = f"{'>' if lo_open else '>='} {_fmt(lo)}"
-            raise InputError(f"{name} must be {allowed} (got {_fmt(x)})")
+            raise InputError(f"{name} must be {allowed} (got {got})")
         if lo is None:
             allowed = f"{'<' if hi_open else '<='} {_fmt(hi)}"
-            raise InputError(f"{name} must be {allowed} (got {_fmt(x)})")
+            raise InputError(f"{name} must be {allowed} (got {got})")
         left = "(" if lo_open else "["
         right = ")" if hi_open else "]"
-        raise InputError(f"{name} must be in {left}{_fmt(lo)}, {_fmt(hi)}{right} (got {_fmt(x)})")
+        raise InputError(f"{name} must be in {left}{_fmt(lo)}, {_fmt(hi)}{right} (got {got})")
     return x
 
 

@@ -69,3 +69,15 @@ def test_docs_table_matches_the_metadata():
                                               if a.numeric else a.default)
         assert default.strip() == want, name
         assert allowed.strip() == a.allowed(), name
+
+
+def test_a_value_just_past_a_bound_is_printed_in_full():
+    """Six digits printed k = 1.0000001 as 1, the bound it crosses: "k must be in (0, 1] (got
+    1)". The value is printed in full there; elsewhere (and at the bound itself) as before."""
+    from sweep.errors import InputError
+
+    cases = {1.0000001: "(got 1.0000001)", 0.0: "(got 0)", 1.5: "(got 1.5)"}
+    for k, got in cases.items():
+        with pytest.raises(InputError) as info:
+            Scene(n=0.8, k=k, mu=3.24, a0=2.0, rate=10.0)
+        assert str(info.value) == f"k must be in (0, 1] {got}"
