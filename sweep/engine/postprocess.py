@@ -65,6 +65,32 @@ OVERFLOW_ADVICE = ("A slower unloading than the material's longest retardation t
                    "relaxed limit: a larger rate gives the same pull-off")
 
 
+#: a test protocol's records keep the absolute time. Where its float spacing at the
+#: retraction's start exceeds this fraction of the retraction's mean step, the pull-off's
+#: instant and the crack speed are read on the retraction's own clock, from its indentation
+#: (:func:`retraction_clock`): after a dwell of 1e13 tau0 the crack speed at a retraction at
+#: rate 10 read 0.840 on the absolute clock, 0.630 after 1e14, and a dwell of 1e15 failed the
+#: row (its fit's times all equal), where shorter dwells converge to 0.7879
+CLOCK_RESOLUTION = 1e-4
+
+
+def retraction_clock(t, delta, first: int, loading_speed: float):
+    """(the records' times, the offset to add back): ``t`` itself with offset 0, or where a
+    test protocol's absolute clock no longer resolves its retraction's steps
+    (:data:`CLOCK_RESOLUTION`), the time since the retraction's start, from the retraction's
+    records on as (delta[first] - delta) / ``loading_speed`` (a rigid machine lowers the
+    indentation at that constant speed, d_ref/tau0), with offset t[first]."""
+    n = len(t)
+    if first <= 0 or n - first < 2:
+        return t, 0.0
+    mean_step = (t[-1] - t[first]) / (n - 1 - first)
+    if np.spacing(t[first]) <= CLOCK_RESOLUTION * mean_step:
+        return t, 0.0
+    local = np.asarray(t, float) - t[first]
+    local[first:] = (delta[first] - np.asarray(delta[first:], float)) / loading_speed
+    return local, float(t[first])
+
+
 def stop_mode(scene) -> int:
     """The stop rule's mode of ``scene`` (:func:`sweep.kernels.solve.stop_reached`): 1
     following the curve to separation; 2 stopping after the pull-off with a process zone,
@@ -243,6 +269,7 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         res.reason = (f"the load is not finite from record {k} on (t = {t[k]:.4g} tau0, steps "
                       f"of {step:.3g} tau0): the solve overflowed. {OVERFLOW_ADVICE}")
         return
+    t, clock_offset = retraction_clock(t, delta, first, scales.loading_speed)
     i = first + int(np.argmin(P[first:]))
     lo, hi = one_mesh_span(i, len(P), remeshed)
     i, t_star, P_star = refine_minimum(t[lo:hi], P[lo:hi])
@@ -298,7 +325,7 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         # a process zone strong enough to hold the surfaces after the contact's end: the load
         # still falls there, slowly, and the crack speed has no tip to follow (a DMT-like
         # contact that vanishes at its pull-off recedes there: speed > 0)
-        gone = float(t[span][np.argmax(a[span] <= 0.0)])
+        gone = float(t[span][np.argmax(a[span] <= 0.0)]) + clock_offset
         held = (f"the contact vanished (a = 0 from t = {gone:.4g} tau0) before the load "
                 f"minimum P = {P_star:.6g}: the interface held the surfaces after the contact's "
                 f"end")
@@ -340,7 +367,7 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
     if notes:
         res.reason = "; ".join(notes)
     res.pull_off = -P_star
-    res.t_pulloff = t_star
+    res.t_pulloff = t_star + clock_offset
     res.delta_pulloff = float(np.interp(t_star, t[span], delta[span]))
     res.a_pulloff = float(np.interp(t_star, t[span], a[span]))
     res.a_inner_pulloff = float(np.interp(t_star, t[span], a_inner[span]))

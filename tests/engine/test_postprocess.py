@@ -331,3 +331,22 @@ def test_an_unloading_too_slow_for_the_arithmetic_fails_with_the_reason():
     assert slower.pull_off == pytest.approx(slow.pull_off, rel=1e-10)
     res = simulate(Scene(rate=1e-120, **scene), num)
     assert res.status == "failed" and "the solve overflowed" in res.reason, res.reason
+
+
+def test_the_retraction_clock_is_its_indentation_where_the_absolute_one_is_too_coarse():
+    """After 1e15 tau0 the float spacing of the records' absolute time (0.125) exceeds the
+    retraction's steps (1e-3): the local clock is (delta[first] - delta) / speed, exact for a
+    rigid machine; after 1e3 tau0 the records' own times are kept."""
+    from sweep.engine.postprocess import retraction_clock
+
+    first, speed, dt = 5, 2.0, 1e-3
+    local = np.concatenate([np.linspace(-1.0, 0.0, first + 1)[:-1], dt * np.arange(50)])
+    delta = np.where(np.arange(local.size) < first, 0.0, -speed * local) + 1.0
+    for start, kept in ((1e3, True), (1e15, False)):
+        t = start + local
+        clock, offset = retraction_clock(t, delta, first, speed)
+        if kept:
+            assert clock is t and offset == 0.0
+        else:
+            assert offset == t[first]
+            np.testing.assert_allclose(clock[first:], local[first:], rtol=0, atol=1e-15)

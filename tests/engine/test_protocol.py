@@ -561,3 +561,22 @@ def test_the_hysteresis_error_covers_the_work_against_a_finer_run():
     assert math.isnan(simulate(Scene(**LOW_MU_PROTOCOL),
                                Numerics.preset("balanced", pull_off_rtol=0.0)).hysteresis_error)
     assert math.isnan(simulate(Scene(**BASE, k=0.2, a0=2.0)).hysteresis_error)
+
+
+def test_a_retraction_after_a_dwell_of_1e15_is_read_on_its_own_clock():
+    """A dwell of 1e13-1e15 tau0 (the declared range reaches 1e15): in double precision the
+    absolute clock's spacing there (0.002-0.125 tau0) is the size of the retraction's steps,
+    so the crack speed read on it was 0.840 and 0.630 after 1e13 and 1e14, and the row at
+    1e15 failed (LinAlgError: its fit's times all equal). Independent value: a fully relaxed
+    contact forgets how long it dwelt, so the rows after 1e10 (the absolute clock still
+    resolving the steps) and after 1e15 agree (measured 4.2335637 / 4.2335963 in pull-off,
+    0.787894 / 0.787949 in crack speed)."""
+    fields = dict(n=0.8, k=0.1, mu=3.24, rate=10.0, approach_rate=1.0, preload=1.0)
+    num = Numerics.preset("fast")
+    rows = [simulate(Scene(dwell=dwell, **fields), num) for dwell in (1e10, 1e15)]
+    for res in rows:
+        assert res.ok, res.reason
+    short, long = rows
+    assert long.pull_off == pytest.approx(short.pull_off, rel=1e-5)
+    assert long.crack_speed == pytest.approx(short.crack_speed, rel=1e-3)
+    assert long.t_pulloff == pytest.approx(1e15, rel=1e-12)
