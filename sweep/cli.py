@@ -26,7 +26,7 @@ import numpy as np  # loaded anyway by sweep.scene
 from click.core import ParameterSource
 
 from .errors import (InputError, as_float, check_array, check_choice, check_int, check_positive,
-                     check_range)
+                     check_range, writing)
 from ._version import __version__
 from .scene import AXES, PRESETS, REFINEMENTS_ON_REQUEST, Numerics, Scene
 
@@ -527,7 +527,9 @@ def info_cmd(results, slowest, as_si, csv_out):
     if as_si:
         df = si_table(results)
         if csv_out:
-            df.to_csv(csv_out, index=False)
+            # opened here, not by pandas: the operating system's reason in the error
+            with writing("csv", csv_out), open(csv_out, "w", newline="") as fh:
+                df.to_csv(fh, index=False)
         # the SI inputs that vary over the file (besides the speed) get a column each
         varied = [c for c in df.columns if c.startswith("si_") and c != "si_speed"
                   and df[c].nunique(dropna=True) > 1]
@@ -603,13 +605,17 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
         n_arms = check_int("maxwell", int(arms.strip()), 0, 200)
     except ValueError:
         raise InputError(f"maxwell must be an integer in [0, 200] (got {arms!r})") from None
+    if plot_out is not None:                # its format, before the fits
+        from .analysis.plots import figure_path
+
+        figure_path("plot", plot_out)
     data = read_dma_csv(csv_file, T_ref=as_float("tref", tref), wlf=tuple(c))
     mpl = fit_mpl(data)
     mx = fit_maxwell(data, n_arms) if n_arms > 0 else None
     kk = kramers_kronig_check(data, noise=check_range("noise", as_float("noise", noise),
                                                       0.0, 0.5))
     if plot_out is not None:
-        plot_dma(data, mpl, mx, plot_out)
+        plot_dma(data, mpl, mx, plot_out, "plot")
     out = {"source": csv_file, "kind": data.kind, "points": int(data.omega.size),
            "omega_min_rad_s": float(data.omega.min()),
            "omega_max_rad_s": float(data.omega.max()),
@@ -618,11 +624,8 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
            "mpl": mpl.to_dict(), "maxwell": None if mx is None else mx.to_dict(),
            "kramers_kronig": kk.to_dict(), "plot": plot_out}
     if json_out is not None:
-        try:
-            with open(json_out, "w") as fh:   # numpy scalars as Python numbers
-                fh.write(json.dumps(out, indent=1, default=lambda x: x.item()) + "\n")
-        except OSError as exc:
-            raise InputError(f"out: cannot write {json_out} ({exc.strerror})") from None
+        with writing("out", json_out), open(json_out, "w") as fh:   # numpy scalars as numbers
+            fh.write(json.dumps(out, indent=1, default=lambda x: x.item()) + "\n")
     if as_json:
         echo_json(out)
         return
@@ -833,12 +836,9 @@ def calibrate_cmd(config, as_json, out_dir, jobs, quiet):
     if jobs is not None:
         check_int("jobs", jobs, 1, 4096)
     cal = load_calibration(config)
-    if out_dir is not None:
-        try:
+    if out_dir is not None:                 # before the fit: a bad DIR fails at once
+        with writing("out", out_dir, "create"):
             Path(out_dir).mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise InputError(f"out: cannot create {out_dir!r} ({exc.strerror or exc})") \
-                from None
     progress = None if quiet else (lambda line: click.echo(line, err=True))
     result = calibrate(cal, jobs=jobs, progress=progress)
     paths = write_outputs(result, out_dir) if out_dir is not None else []

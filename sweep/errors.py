@@ -10,6 +10,7 @@ The CLI turns an ``InputError`` into that line on stderr and exit code 2.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from typing import Iterable
 
 import numpy as np
@@ -97,6 +98,42 @@ def check_array(name: str, values, lo=None, hi=None, lo_open=False, hi_open=Fals
     for x in arr.ravel():
         check_range(name, x, lo, hi, lo_open, hi_open)
     return arr
+
+
+@contextmanager
+def writing(name: str, path, verb: str = "write"):
+    """Turn an ``OSError`` raised while writing ``path`` into a one-line :class:`InputError`.
+
+    Parameters
+    ----------
+    name : str
+        The parameter (option) that gave the path, e.g. ``"out"``.
+    path : str or os.PathLike
+        The file (or directory) being written.
+    verb : str, optional
+        What is done to it: ``"write"`` (default) or ``"create"`` (a directory).
+
+    Raises
+    ------
+    InputError
+        ``<name>: cannot <verb> <path> (<reason>)``, the reason the operating system gives
+        (and the path it names when that is another one, e.g. a parent that is a file).
+
+    Examples
+    --------
+    >>> with writing("csv", "/proc/nope/x.csv"):           # doctest: +SKIP
+    ...     open("/proc/nope/x.csv", "w")
+    """
+    try:
+        yield
+    except OSError as exc:
+        if isinstance(exc, FileExistsError):     # a parent directory to create is a file
+            reason = f"{exc.filename} is a file, not a directory"
+        else:
+            reason = exc.strerror or str(exc)
+            if exc.filename is not None and str(exc.filename) != str(path):
+                reason += f": {exc.filename}"
+        raise InputError(f"{name}: cannot {verb} {path} ({reason})") from None
 
 
 #: exceptions that are numerical or physical failures of a scene (a singular matrix, an

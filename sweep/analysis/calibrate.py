@@ -87,10 +87,10 @@ from ..campaign.config import UniqueKeyLoader
 from ..campaign.si import SI_AXES, SIScene, run_si
 from ..campaign.store import to_jsonable
 from ..engine import bem
-from ..errors import InputError, check_choice, check_int, check_range
+from ..errors import InputError, check_choice, check_int, check_range, writing
 from ..scene import PZ_LAWS, PZ_PARAMETERS, Numerics
 from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
-from .plots import pyplot
+from .plots import pyplot, save_figure
 
 __all__ = ["Parameter", "Calibration", "load_calibration", "calibration_from_dict",
            "calibrate", "synthesize", "write_outputs", "SceneEvaluator", "FIT_FIELDS"]
@@ -899,12 +899,11 @@ def write_outputs(result: dict, out_dir) -> list:
     """Write ``calibration.json``, ``fit.png`` (data, fitted curve, band; log axes) and
     ``profile_<name>.png`` per parameter into ``out_dir``; returns the paths."""
     out = Path(out_dir)
-    try:
+    with writing("out", out, "create"):
         out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"out: cannot create {str(out)!r} ({exc.strerror or exc})") from None
     paths = [out / "calibration.json"]
-    paths[0].write_text(to_json(result) + "\n")
+    with writing("out", paths[0]):
+        paths[0].write_text(to_json(result) + "\n")
     plt = pyplot()
     d, c = result["data"], result["curve"]
     fig, ax = plt.subplots(figsize=(6.0, 4.5))
@@ -926,9 +925,7 @@ def write_outputs(result: dict, out_dir) -> list:
     ax.set_title(f"{result['name']} ({result['model']}): {est}", fontsize=8)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "fit.png", dpi=120)
-    plt.close(fig)
-    paths.append(out / "fit.png")
+    paths.append(save_figure(fig, out / "fit.png"))
     thr = result["fit"]["threshold"]
     for name, pr in result["profiles"].items():
         prm = result["parameters"][name]
@@ -950,10 +947,7 @@ def write_outputs(result: dict, out_dir) -> list:
         ax.set_title(f"{name}: {prm['status']}", fontsize=9)
         ax.legend(fontsize=7)
         fig.tight_layout()
-        p = out / f"profile_{name}.png"
-        fig.savefig(p, dpi=110)
-        plt.close(fig)
-        paths.append(p)
+        paths.append(save_figure(fig, out / f"profile_{name}.png", dpi=110))
     return paths
 
 
