@@ -450,7 +450,10 @@ def _scene_si(axes, as_json, values):
 
 @cli.command("plot")
 @click.argument("results")
-@click.option("--out", default=None, help="Output PNG (default: RESULTS with suffix .png).")
+@click.option("--out", default=None,
+              help="Output figure, its format the suffix (.png, .svg, .pdf, ...; .png added "
+                   "when there is none); default: RESULTS with suffix .png. Prints the path "
+                   "written.")
 def plot_command(results, out):
     """Plot pull-off vs rate (and P(a) trajectories, if stored) of a results file."""
     from .analysis.plots import plot_sweep
@@ -615,7 +618,7 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
     kk = kramers_kronig_check(data, noise=check_range("noise", as_float("noise", noise),
                                                       0.0, 0.5))
     if plot_out is not None:
-        plot_dma(data, mpl, mx, plot_out, "plot")
+        plot_out = str(plot_dma(data, mpl, mx, plot_out, "plot"))    # the path written
     out = {"source": csv_file, "kind": data.kind, "points": int(data.omega.size),
            "omega_min_rad_s": float(data.omega.min()),
            "omega_max_rad_s": float(data.omega.max()),

@@ -4,6 +4,7 @@ one line naming the option, exit 2, no traceback, nothing written (sweep.errors.
 sweep.analysis.plots.save_figure, the one helper every figure and file goes through)."""
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -127,3 +128,17 @@ def test_fit_dma_outputs_that_cannot_be_written(places, capsys, option, ext, pat
     code = main(["fit-dma", str(_master_curve(places)), "--maxwell", "0", option, path])
     assert code == 2
     assert_cannot_write(capsys.readouterr().err, option[2:], path, reasons)
+
+
+def test_a_figure_without_a_suffix_is_a_png_and_its_path_is_printed(results, tmp_path, capsys):
+    """matplotlib writes OUT.png for an OUT without a suffix: that is the path printed (and the
+    one fit-dma's JSON names), not OUT."""
+    out = tmp_path / "plotnoext"
+    assert main(["plot", str(results), "--out", str(out)]) == 0
+    assert capsys.readouterr().out.strip() == f"{out}.png"
+    assert Path(f"{out}.png").read_bytes()[:4] == b"\x89PNG" and not out.exists()
+    fig = tmp_path / "dmanoext"
+    assert main(["fit-dma", str(_master_curve(tmp_path)), "--maxwell", "0", "--plot", str(fig),
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["plot"] == f"{fig}.png"
+    assert Path(f"{fig}.png").read_bytes()[:4] == b"\x89PNG"

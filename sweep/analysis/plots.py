@@ -67,7 +67,7 @@ def figure_path(name: str, out) -> Path:
     Returns
     -------
     Path
-        ``out`` as a path.
+        ``out``, with ``.png`` added when it has no suffix (what matplotlib writes then).
 
     Raises
     ------
@@ -76,7 +76,9 @@ def figure_path(name: str, out) -> Path:
         it can write).
     """
     out = Path(out)
-    fmt = out.suffix[1:].lower() or "png"       # no suffix: matplotlib's default, png
+    if not out.suffix:
+        out = out.with_name(out.name + ".png")
+    fmt = out.suffix[1:].lower()
     pyplot()                                    # matplotlib, or how to install it
     from matplotlib.backend_bases import FigureCanvasBase
 
