@@ -520,13 +520,17 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
               help="A file of a `units: si` config: one line per scene in SI units (speed, "
                    "mu, l0, pull-off and the relaxed JKR pull-off 1.5 pi dg R).")
 @click.option("--csv", "csv_out", default=None, metavar="PATH",
-              help="With --si: also write every SI and dimensionless column as CSV.")
+              help="With --si (refused without it): also write every SI and dimensionless "
+                   "column as CSV.")
 def info_cmd(results, slowest, as_si, csv_out):
     """Summarize a results file: counts by status, parameter ranges, slowest scenes."""
     from .campaign.store import si_table, summary
 
     if not Path(results).exists():
         raise InputError(f"no results at {results}")
+    if csv_out and not as_si:
+        raise InputError("csv: needs --si (the SI table of a `units: si` results file); the "
+                         "dimensionless rows of any file: sweep.load(RESULTS).to_csv(FILE)")
     if as_si:
         df = si_table(results)
         if csv_out:

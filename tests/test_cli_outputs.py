@@ -142,3 +142,17 @@ def test_a_figure_without_a_suffix_is_a_png_and_its_path_is_printed(results, tmp
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["plot"] == f"{fig}.png"
     assert Path(f"{fig}.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_info_csv_needs_si(results, si_results, tmp_path, capsys):
+    """`sweep info FILE --csv X` without --si wrote nothing and exited 0: it is refused in one
+    line (docs/configs.md: --csv is an option of --si), and with --si it writes the table."""
+    out = tmp_path / "x.csv"
+    for path in (results, si_results):
+        capsys.readouterr()
+        assert main(["info", str(path), "--csv", str(out)]) == 2
+        line = one_error_line(capsys.readouterr().err)
+        assert line.startswith("error: csv: needs --si") and "sweep.load" in line
+        assert not out.exists()
+    assert main(["info", str(si_results), "--si", "--csv", str(out)]) == 0
+    assert out.read_text().startswith("scene_id,")
