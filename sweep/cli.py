@@ -424,7 +424,7 @@ def _scene_si(axes, as_json, values):
         kw["preload"] = as_float("preload", axes["preload"])
     if axes["dwell"] is not None:           # and the one --dwell: seconds
         kw["dwell"] = as_float("dwell", axes["dwell"])
-        kw["dwell_hold"] = axes["dwell_hold"]
+    kw["dwell_hold"] = axes["dwell_hold"]    # SIScene refuses "depth" without a protocol
     if axes["machine_stiffness"] is not None:     # and --machine-stiffness: N/m
         kw["machine_stiffness"] = as_float("machine_stiffness", axes["machine_stiffness"])
     if "a0_si" in kw:

@@ -130,6 +130,19 @@ def test_cli_scene_si_errors(capsys, extra, message):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("model", ["pb", "crack", "bem"])
+def test_cli_scene_si_refuses_dwell_hold_depth_without_a_protocol(capsys, model):
+    """`--dwell-hold depth` without a test protocol: the dimensionless CLI, the API and configs
+    refuse it; `--si` ran the relaxed start and exited 0."""
+    assert main(["scene", "--n", "0.8", "--a0", "2", "--rate", "1", "--model", model,
+                 "--dwell-hold", "depth"]) == 2
+    assert "needs a protocol" in capsys.readouterr().err
+    assert main(SI_ARGS + ["--model", model, "--dwell-hold", "depth", "--json"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1
+    assert err.startswith("error: dwell_hold: 'depth' needs a test protocol"), err
+
+
 def test_cli_scene_si_options_need_si(capsys):
     assert main(["scene", "--n", "0.8", "--a0", "2", "--rate", "1", "--R", "1e-3"]) == 2
     assert "--R: SI options need --si" in capsys.readouterr().err
