@@ -404,7 +404,7 @@ def scene_text(res, preset: str) -> list[str]:
 
 def _scene_si(axes, as_json, values):
     """``sweep scene --si``: build an SIScene, run it, print both unit systems."""
-    from .campaign.si import SIScene, run_si
+    from .campaign.si import run_si, si_point
 
     ctx = click.get_current_context()
     clash = [f"--{name}" for name in ("k", "mu", "a0", "delta0", "rate", "approach_rate")
@@ -431,7 +431,10 @@ def _scene_si(axes, as_json, values):
         kw["a0"] = kw.pop("a0_si")
     pz = {"pz_law": axes["pz_law"], **{name: as_float(name, axes[name])
                                        for name in ("pz_v0", "pz_xi") if axes[name] is not None}}
-    out = run_si(SIScene(n=as_float("n", n), material=material, **pz, **kw), model)
+    # the checks of a `units: si` config's point: the derived scene within the Scene's ranges
+    si, _ = si_point({"n": as_float("n", n), "material": material, "model": model,
+                      "stop": axes["stop"], **pz, **kw}, "--si")
+    out = run_si(si, model)
     if as_json:
         echo_json(out)
     else:
