@@ -278,11 +278,8 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, exact, as_json, tr
         raise InputError(f"{', '.join(missing)} must be given (or use --si)")
     sc = scene_from_options(axes)
     overrides = {}
-    if nodes is not None:
-        try:
-            overrides["nodes"] = int(nodes.strip())
-        except ValueError:
-            raise InputError(f"nodes must be an integer (got {nodes!r})") from None
+    if nodes is not None:               # its range: Numerics's
+        overrides["nodes"] = check_int("nodes", nodes)
     if domain is not None:
         overrides["domain"] = as_float("domain", domain)
     if step is not None:
@@ -611,10 +608,7 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
     c = parse_floats("wlf", wlf)
     if len(c) != 3:
         raise InputError(f"wlf must be three numbers C1,C2,Tg (got {wlf!r})")
-    try:
-        n_arms = check_int("maxwell", int(arms.strip()), 0, 200)
-    except ValueError:
-        raise InputError(f"maxwell must be an integer in [0, 200] (got {arms!r})") from None
+    n_arms = check_int("maxwell", arms, 0, 200)
     if plot_out is not None:                # its format, before the fits
         from .analysis.plots import figure_path
 
@@ -697,12 +691,8 @@ def _with_fit_options(fn):
 
 
 def _fit_numbers(saturation: str, boot: str) -> tuple[float, int]:
-    try:
-        n_boot = int(boot.strip())
-    except ValueError:
-        raise InputError(f"boot must be an integer in [0, 1000000] (got {boot!r})") from None
     return (check_range("saturation", saturation, 0.0, 10.0, lo_open=True),
-            check_int("boot", n_boot, lo=0, hi=1_000_000))
+            check_int("boot", boot, lo=0, hi=1_000_000))
 
 
 @cli.group("fit")

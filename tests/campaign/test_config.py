@@ -158,6 +158,45 @@ def test_bad_values_name_key_and_allowed(over, needle):
     assert needle in text, text
 
 
+def test_integer_fields_take_numeric_strings_and_whole_floats():
+    """docs/configs.md: numeric strings such as "1e6" wherever a number is expected. YAML 1.1
+    reads `1e6` as the string '1e6'; integer fields refused it ("numerics.max_steps must be an
+    integer (got '1e6')"). An exact integer as a string or float is that integer, and the
+    scene ids (which hash the numerics) are those of the plain integer."""
+    text = ("name: t\ngrid: {{n: 0.8, a0: 2, rate: {{log10: [0, 2, {num}]}}}}\n"
+            "numerics: {{preset: fast, max_steps: {steps}, nodes: {nodes}}}\n")
+    plain = parse_config(text.format(num=3, steps=1000000, nodes=200))
+    assert plain.tasks()[0][1].rate == 1.0 and len(plain.tasks()) == 3
+    for num, steps, nodes in (('"3"', "1e6", "2e2"), ("3.0", "1.0e+6", '"200"'),
+                              ("3", '"1000000"', "200.0")):
+        cfg = parse_config(text.format(num=num, steps=steps, nodes=nodes))
+        assert [sid for sid, _ in cfg.tasks()] == [sid for sid, _ in plain.tasks()]
+        assert cfg.config_hash == plain.config_hash
+        assert cfg.numerics.max_steps == 1000000 and type(cfg.numerics.max_steps) is int
+        assert cfg.numerics.nodes == 200 and type(cfg.numerics.nodes) is int
+
+
+@pytest.mark.parametrize("over, needle", [
+    ({"numerics": {"preset": "fast", "max_steps": "1.5e3"}}, None),
+    ({"numerics": {"preset": "fast", "max_steps": 1000.5}},
+     "numerics.max_steps must be an integer (got 1000.5)"),
+    ({"numerics": {"preset": "fast", "nodes": "1.5"}},
+     "numerics.nodes must be an integer (got '1.5')"),
+    ({"numerics": {"preset": "fast", "nodes": "two"}},
+     "numerics.nodes must be an integer (got 'two')"),
+    ({"numerics": {"preset": "fast", "nodes": True}},
+     "numerics.nodes must be an integer (got True)"),
+    ({"grid": {"n": 0.8, "rate": {"log10": [0, 2, "2.5"]}, "a0": 2}},
+     "grid.rate.log10[2] (num) must be an integer (got '2.5')"),
+])
+def test_integer_fields_refuse_fractions(over, needle):
+    if needle is None:              # "1.5e3" is 1500, an integer: accepted
+        assert config_from_dict(base(**over)).numerics.max_steps == 1500
+        return
+    text = msg(**over)
+    assert needle in text, text
+
+
 def test_missing_grid_and_non_mapping():
     with pytest.raises(InputError, match="grid: required key is missing"):
         config_from_dict({"name": "x"})
