@@ -469,3 +469,25 @@ def test_si_grid_with_a_table_needs_no_moduli_and_refuses_other_ones():
     with pytest.raises(InputError, match="E0, Einf, n, tau0: required for material mpl"):
         config_from_dict({"name": "s", "units": "si",
                           "grid": {**grid, "material": ["mpl", grid["material"]]}})
+
+
+def test_the_configs_the_docs_show_write_distinct_results_files():
+    """Each sweep config in the README and docs/ writes its own results file: two configs of
+    one name (the README's SI `name: gmm` and configs.md's dimensionless one) both wrote
+    results/gmm.h5, and the second run was refused ("units differ ...")."""
+    import re
+
+    import yaml
+
+    outputs = {}
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]:
+        text = page.read_text()
+        for m in re.finditer(r"^```ya?ml\n(.*?)^```", text, re.S | re.M):
+            d = yaml.safe_load(m.group(1))
+            if not (isinstance(d, dict) and "grid" in d and "name" in d):
+                continue
+            where = f"{page.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}"
+            out = d.get("output", f"results/{d['name']}.h5")
+            assert out not in outputs, f"{where} and {outputs[out]} both write {out}"
+            outputs[out] = where
+    assert "results/gmm.h5" in outputs and len(outputs) >= 5
