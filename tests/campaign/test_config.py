@@ -491,3 +491,20 @@ def test_the_configs_the_docs_show_write_distinct_results_files():
             assert out not in outputs, f"{where} and {outputs[out]} both write {out}"
             outputs[out] = where
     assert "results/gmm.h5" in outputs and len(outputs) >= 5
+
+
+def test_configs_md_shows_how_several_problems_are_reported(tmp_path, capsys, monkeypatch):
+    """docs/configs.md said the problems are reported "one line each"; they are one line, joined
+    by "; ". The page's example is what `sweep run` prints for that config."""
+    import re
+
+    from sweep.cli import main
+
+    text = " ".join((ROOT / "docs" / "configs.md").read_text().split())
+    assert "one line each" not in text
+    shown = re.search(r"`(error: bad\.yaml: 2 problems: [^`]*)`", text).group(1)
+    cfg = tmp_path / "bad.yaml"
+    cfg.write_text("name: bad\ngrid: {n: -1, rate: 0, a0: 2}\n")
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "bad.yaml"]) == 2
+    assert capsys.readouterr().err == shown + "\n"
