@@ -197,9 +197,18 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
 
 # == single scene command (scene) ==
 
+#: The help of a Scene option where the command line takes less than the field: a Prony
+#: table is a config's material (or the API's), not a value of ``--material``.
+CLI_ONLY_HELP = {
+    "material": "creep compliance: MPL retardation spectrum or SLS; mpl, sls (a Prony table "
+                "is the material of a config, {prony: file} or inline: docs/configs.md)",
+}
+
+
 def scene_options(func):
     """One option per Scene field, from its metadata (sweep.scene.AXES): name, default,
-    allowed values and help are declared once, in sweep/scene.py."""
+    allowed values and help are declared once, in sweep/scene.py (:data:`CLI_ONLY_HELP`
+    where the option takes less than the field)."""
     for a in reversed(list(AXES.values())):
         # --pz_law and --pz-law alike
         names = dict.fromkeys((f"--{a.name}", f"--{a.name.replace('_', '-')}"))
@@ -212,7 +221,8 @@ def scene_options(func):
                 help=a.describe() + ".")
         else:
             option = click.option(*names, a.name, type=click.Choice(list(a.choices)),
-                                  default=a.default, show_default=True, help=a.describe() + ".")
+                                  default=a.default, show_default=True,
+                                  help=CLI_ONLY_HELP.get(a.name, a.describe()) + ".")
         func = option(func)
     return func
 

@@ -109,6 +109,19 @@ def test_scene_nodes_takes_an_exact_integer_in_any_form(capsys):
     assert capsys.readouterr().err.strip() == "error: nodes must be an integer (got '150.5')"
 
 
+def test_scene_help_offers_material_only_what_it_takes(capsys):
+    """`sweep scene --help` said --material [mpl|sls] also takes "a Prony table ({prony: file}
+    or inline ...)"; the option takes mpl or sls, and the help says where a table goes."""
+    assert main(["scene", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    help_ = text[text.index("--material [mpl|sls]"):text.index("--stop")]
+    assert "or a Prony table ({prony: file} or inline" not in help_
+    assert "MPL retardation spectrum or SLS; mpl, sls" in help_
+    assert "a Prony table is the material of a config" in help_
+    assert main(SCENE + ["--material", "prony:x.csv"]) == 2
+    assert "'prony:x.csv' is not one of 'mpl', 'sls'" in capsys.readouterr().err
+
+
 def test_failed_scene_exits_1(capsys):
     # mu = 10, a0 = 10 on a graded mesh of 300 nodes: the process zone spans half a node
     # spacing; refused with the advice, status failed (without --nodes the scene runs on
