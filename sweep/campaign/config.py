@@ -259,7 +259,7 @@ def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) ->
         for i, v in enumerate(vals):
             w = f"{where}[{i}]" if isinstance(spec, list) else where
             try:
-                if axis == "material" and not isinstance(v, str):
+                if axis == "material" and v not in allowed:   # a table, or what is allowed
                     out.append(_table(w, v))
                 else:
                     out.append(check_choice(w, v, allowed))
@@ -327,8 +327,8 @@ def _table(where: str, spec) -> SceneTable:
     """A ``material`` value that is a Prony table (``{prony: path}``, relative to the working
     directory, or an inline table; :func:`sweep.scene.scene_table`): InputError naming it."""
     if not isinstance(spec, (dict, SceneTable)):
-        raise InputError(f"{where} must be mpl, sls or a Prony table {{prony: file}} or "
-                         f"{{tau: [...], E: [...], E0: ...}} (got {spec!r})")
+        raise InputError(f"{where} must be mpl, sls or a Prony table, given as {{prony: path}} "
+                         f"or inline {{tau: [...], E: [...], E0: ...}} (got {spec!r})")
     try:
         return scene_table(spec)
     except InputError as exc:

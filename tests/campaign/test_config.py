@@ -140,7 +140,12 @@ def test_every_problem_reported_at_once():
     ({"grid": {"n": 0.8, "rate": {"log10": [0, 2, 2.5]}, "a0": 2}}, "(num) must be an integer"),
     ({"grid": {"n": 0.8, "rate": {"geomspace": [1, 2, 3]}, "a0": 2}}, "a range must be"),
     ({"grid": {"n": 0.8, "rate": 1, "a0": 2, "material": "elastic"}},
-     "grid.material must be one of mpl, sls"),
+     "grid.material must be mpl, sls or a Prony table, given as {prony: path} or inline "
+     "{tau: [...], E: [...], E0: ...} (got 'elastic')"),
+    ({"units": "si", "grid": {"R": 1e-4, "E0": 1e6, "Einf": 1e7, "nu": 0.5, "n": 0.8,
+                              "tau0": 0.1, "dg": 0.05, "h0": 2e-7, "preload": 1e-5,
+                              "speed": 1e-6, "material": ["mpl", "foo"]}},
+     "grid.material[1] must be mpl, sls or a Prony table, given as {prony: path} or inline"),
     ({"grid": [{"n": 0.8, "rate": 1, "a0": 2}, {"n": 9, "rate": 1, "a0": 2}]}, "grid[1].n"),
     ({"grid": "n=1"}, "grid: must be a mapping of axes"),
     ({"grid": []}, "grid: must not be an empty list"),
