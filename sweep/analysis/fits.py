@@ -38,6 +38,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from .. import units
 from ..errors import InputError, check_positive, check_range
+from ..scene import SCENE_AXES
 from ..theory import jkr_pull_off, pb_gamma_eff, pb_gamma_eff_spectrum
 
 __all__ = [
@@ -798,7 +799,11 @@ def vr_paper_range(df: pd.DataFrame, rate_range=PAPER_VR_RATE_RANGE,
 
 def vr_local_slope(df: pd.DataFrame, alpha: float = units.ALPHA_PB) -> list[dict]:
     r"""How far the v-r data are from one power law: the local slope ``d ln vhat / d ln
-    rhat_PB`` between neighbouring rates of each (n, k) MPL group, and ``vhat / rhat_PB``.
+    rhat_PB`` between neighbouring rates of each MPL group, and ``vhat / rhat_PB``.
+
+    A group is one value of every scene axis but the rate (n, k, mu, a0 or delta0, ...):
+    the v-r campaign has one a0 per (n, k), a threshold grid several, each its own curve
+    (pooled, points of one rate and another a0 gave a slope of +-inf).
 
     Returns
     -------
@@ -811,7 +816,8 @@ def vr_local_slope(df: pd.DataFrame, alpha: float = units.ALPHA_PB) -> list[dict
     d = _vr_points(df, alpha)
     rates = np.sort(d["rate"].unique())
     slopes = {}
-    for _, g in d.groupby(["n", "k"]):
+    curve = [a for a in SCENE_AXES if a != "rate" and a in d.columns]
+    for _, g in d.groupby(curve, dropna=False):
         g = g.sort_values("rate")
         r = g["rate"].to_numpy(dtype=float)
         lr, lv = np.log(g["rhat_pb"].to_numpy(dtype=float)), np.log(g["vhat"].to_numpy(dtype=float))

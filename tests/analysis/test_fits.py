@@ -410,6 +410,31 @@ def test_vr_local_slope_and_ratio():
     assert ls[0]["v_over_r_median"] == pytest.approx(5.0, rel=1e-10)
 
 
+def test_vr_local_slope_of_a_grid_with_several_a0_per_rate():
+    """A threshold-style grid (several a0 per (n, k, rate)): the local slope pooled the a0 of
+    one rate, dividing by ln rhat - ln rhat = 0 (numpy's "divide by zero" warning, slopes
+    -inf). Each a0 is its own curve: vhat = c(a0) rhat^1.1 has the slope 1.1 everywhere."""
+    import warnings
+
+    frames = []
+    for a0, c in ((2.0, 3.0), (3.0, 4.0), (5.0, 6.0)):
+        df = synthetic_vr_runs()
+        df["a0"] = a0
+        df["crack_speed"] *= c / 3.0
+        frames.append(df)
+    df = pd.concat(frames, ignore_index=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ls = an.vr_local_slope(df)
+        out = an.vr_analysis(df, n_boot=0)
+    assert len(ls) == 15 and math.isnan(ls[0]["slope_median"])
+    for r in ls[1:]:
+        assert r["n_groups"] == 12                       # 2 n x 2 k x 3 a0
+        for key in ("slope_median", "slope_min", "slope_max"):
+            assert r[key] == pytest.approx(1.1, rel=1e-10)
+    assert out["local_slope"] == ls
+
+
 def test_alpha_per_k_recovers_each_k():
     a = synthetic_vr_runs(alpha_true=0.5)
     b = synthetic_vr_runs(alpha_true=units.ALPHA_PB)
