@@ -154,10 +154,11 @@ def power_law_fit(x, y, n_boot: int = N_BOOT, seed: int = 0,
     y = np.asarray(y, dtype=float).ravel()
     if x.size != y.size:
         raise InputError(f"x and y must have equal lengths (got {x.size} and {y.size})")
-    if x.size < 3 or np.unique(x).size < 2:
-        raise InputError(
-            f"a power-law fit needs at least 3 points with 2 distinct x (got {x.size})"
-        )
+    if x.size < 3:
+        raise InputError(f"a power-law fit needs at least 3 points (got {x.size})")
+    if np.unique(x).size < 2:
+        raise InputError(f"a power-law fit needs at least 2 distinct x (got {x.size} points, "
+                         f"all at x = {x[0]:.6g})")
     if not (np.all(x > 0) and np.all(y > 0) and np.all(np.isfinite(x * y))):
         raise InputError("a power-law fit needs finite positive x and y")
     confidence = check_range("confidence", confidence, 0.0, 1.0, lo_open=True, hi_open=True)
@@ -650,9 +651,18 @@ def vr_fit(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTION,
     """
     d = _vr_points(df, alpha)
     uns = d[_unsaturated(d, saturation_fraction)]
-    return {"all": power_law_fit(d["rhat_pb"], d["vhat"], n_boot, seed),
-            "unsaturated": power_law_fit(uns["rhat_pb"], uns["vhat"], n_boot, seed),
+    return {"all": _named_fit("all MPL points", d["rhat_pb"], d["vhat"], n_boot, seed),
+            "unsaturated": _named_fit(f"unsaturated points (P_po < {saturation_fraction:g} * "
+                                      f"1.5/k)", uns["rhat_pb"], uns["vhat"], n_boot, seed),
             "saturation_fraction": float(saturation_fraction)}
+
+
+def _named_fit(what: str, x, y, n_boot: int, seed: int) -> dict:
+    """:func:`power_law_fit` of the selection ``what``, which its InputError names."""
+    try:
+        return power_law_fit(x, y, n_boot, seed)
+    except InputError as exc:
+        raise InputError(f"{what}: {exc}") from None
 
 
 def pb_gamma_eff_scene(material: str, n: float, k: float, vhat):
@@ -778,7 +788,8 @@ def vr_paper_range(df: pd.DataFrame, rate_range=PAPER_VR_RATE_RANGE,
     def fit_in(lo_, hi_):
         r = d["rate"].to_numpy(dtype=float)
         sel = d[(r >= lo_ * (1 - 1e-9)) & (r <= hi_ * (1 + 1e-9))]
-        return power_law_fit(sel["rhat_pb"], sel["vhat"], n_boot, seed)
+        return _named_fit(f"MPL points at rates r-hat in [{lo_:g}, {hi_:g}]", sel["rhat_pb"],
+                          sel["vhat"], n_boot, seed)
 
     fit = fit_in(lo, hi)
     ranges = []

@@ -52,6 +52,30 @@ def test_power_law_bad_input():
         an.power_law_fit([1, 2, 3], [1, -2, 3])
 
 
+def test_power_law_too_few_points_say_what_is_missing():
+    """"needs at least 3 points with 2 distinct x (got 4)" did not say what was missing."""
+    with pytest.raises(InputError) as info:
+        an.power_law_fit([2.0, 2.0, 2.0, 2.0], [1, 2, 3, 4])
+    assert str(info.value) == ("a power-law fit needs at least 2 distinct x (got 4 points, "
+                               "all at x = 2)")
+    with pytest.raises(InputError) as info:
+        an.power_law_fit([1.0, 2.0], [1, 2])
+    assert str(info.value) == "a power-law fit needs at least 3 points (got 2)"
+
+
+def test_cli_fit_vr_names_the_selection_too_small_to_fit(tmp_path, capsys):
+    """Two rates, 0.316 and 1, x 4 groups: 8 points, but the paper's rate range [1, 1e6]
+    holds 4 at one rhat_PB. The error names that selection and what it lacks."""
+    df = synthetic_vr_runs()
+    df = df[df["rate"].isin(sorted(df["rate"].unique())[1:3])]
+    path = tmp_path / "vr.h5"
+    write_results(path, df)
+    assert main(["fit", "vr", str(path), "--boot", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("error: MPL points at rates r-hat in [1, 1e+06]: a power-law fit needs at "
+                   "least 2 distinct x (got 4 points, all at x = 0.143887)\n")
+
+
 # ------------------------------------------------------------------ threshold radius
 def saturating(a, plateau=12.0, length=0.6, a_start=1.0):
     """P(a) = plateau - c exp(-a/L): dP/da = (c/L) exp(-a/L) falls monotonically."""
