@@ -456,7 +456,10 @@ def config_from_dict(data, text: str | None = None, source: str = "<dict>") -> S
     if name is None:
         problems.append("name: required key is missing (a short name such as 'smoke')")
         name = ""
-    elif not isinstance(name, str) or not _NAME_RE.match(name):
+    elif not isinstance(name, str):           # YAML read it as a number, a date, a list ...
+        problems.append(f"name: must be a string, quoted in YAML where it reads as something "
+                        f"else (name: \"{name}\") (got {name!r})")
+    elif not _NAME_RE.match(name):
         problems.append(f"name: must be a string of letters, digits, '-', '_', '.' "
                         f"(got {name!r})")
     description = data.get("description", "") or ""

@@ -513,3 +513,20 @@ def test_configs_md_shows_how_several_problems_are_reported(tmp_path, capsys, mo
     monkeypatch.chdir(tmp_path)
     assert main(["run", "bad.yaml"]) == 2
     assert capsys.readouterr().err == shown + "\n"
+
+
+@pytest.mark.parametrize("text, got", [("name: 123", "123"), ("name: 2024-01-02",
+                                                             "datetime.date(2024, 1, 2)"),
+                                       ("name: 1e3", None)])
+def test_a_name_yaml_reads_as_no_string_says_to_quote_it(text, got):
+    """`name: 123` said "must be a string of letters, digits ... (got 123)", which 123 is;
+    YAML read it as a number: the message says to quote it. (`1e3` is a string in YAML 1.1.)"""
+    src = text + "\ngrid: {n: 0.8, rate: 1, a0: 2}\n"
+    if got is None:
+        assert parse_config(src).name == "1e3"
+        return
+    with pytest.raises(InputError) as info:
+        parse_config(src)
+    value = text.split(": ")[1]
+    assert str(info.value) == (f"<string>: name: must be a string, quoted in YAML where it "
+                               f'reads as something else (name: "{value}") (got {got})')
