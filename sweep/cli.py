@@ -26,7 +26,7 @@ import numpy as np  # loaded anyway by sweep.scene
 from click.core import ParameterSource
 
 from .errors import (InputError, as_float, check_array, check_choice, check_int, check_positive,
-                     check_range)
+                     check_range, writing)
 from ._version import __version__
 from .scene import AXES, PRESETS, REFINEMENTS_ON_REQUEST, Numerics, Scene
 
@@ -197,9 +197,18 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
 
 # == single scene command (scene) ==
 
+#: The help of a Scene option where the command line takes less than the field: a Prony
+#: table is a config's material (or the API's), not a value of ``--material``.
+CLI_ONLY_HELP = {
+    "material": "creep compliance: MPL retardation spectrum or SLS; mpl, sls (a Prony table "
+                "is the material of a config, {prony: file} or inline: docs/configs.md)",
+}
+
+
 def scene_options(func):
     """One option per Scene field, from its metadata (sweep.scene.AXES): name, default,
-    allowed values and help are declared once, in sweep/scene.py."""
+    allowed values and help are declared once, in sweep/scene.py (:data:`CLI_ONLY_HELP`
+    where the option takes less than the field)."""
     for a in reversed(list(AXES.values())):
         # --pz_law and --pz-law alike
         names = dict.fromkeys((f"--{a.name}", f"--{a.name.replace('_', '-')}"))
@@ -212,7 +221,8 @@ def scene_options(func):
                 help=a.describe() + ".")
         else:
             option = click.option(*names, a.name, type=click.Choice(list(a.choices)),
-                                  default=a.default, show_default=True, help=a.describe() + ".")
+                                  default=a.default, show_default=True,
+                                  help=CLI_ONLY_HELP.get(a.name, a.describe()) + ".")
         func = option(func)
     return func
 
@@ -278,11 +288,8 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, exact, as_json, tr
         raise InputError(f"{', '.join(missing)} must be given (or use --si)")
     sc = scene_from_options(axes)
     overrides = {}
-    if nodes is not None:
-        try:
-            overrides["nodes"] = int(nodes.strip())
-        except ValueError:
-            raise InputError(f"nodes must be an integer (got {nodes!r})") from None
+    if nodes is not None:               # its range: Numerics's
+        overrides["nodes"] = check_int("nodes", nodes)
     if domain is not None:
         overrides["domain"] = as_float("domain", domain)
     if step is not None:
@@ -404,7 +411,7 @@ def scene_text(res, preset: str) -> list[str]:
 
 def _scene_si(axes, as_json, values):
     """``sweep scene --si``: build an SIScene, run it, print both unit systems."""
-    from .campaign.si import SIScene, run_si
+    from .campaign.si import run_si, si_point
 
     ctx = click.get_current_context()
     clash = [f"--{name}" for name in ("k", "mu", "a0", "delta0", "rate", "approach_rate")
@@ -424,14 +431,17 @@ def _scene_si(axes, as_json, values):
         kw["preload"] = as_float("preload", axes["preload"])
     if axes["dwell"] is not None:           # and the one --dwell: seconds
         kw["dwell"] = as_float("dwell", axes["dwell"])
-        kw["dwell_hold"] = axes["dwell_hold"]
+    kw["dwell_hold"] = axes["dwell_hold"]    # SIScene refuses "depth" without a protocol
     if axes["machine_stiffness"] is not None:     # and --machine-stiffness: N/m
         kw["machine_stiffness"] = as_float("machine_stiffness", axes["machine_stiffness"])
     if "a0_si" in kw:
         kw["a0"] = kw.pop("a0_si")
     pz = {"pz_law": axes["pz_law"], **{name: as_float(name, axes[name])
                                        for name in ("pz_v0", "pz_xi") if axes[name] is not None}}
-    out = run_si(SIScene(n=as_float("n", n), material=material, **pz, **kw), model)
+    # the checks of a `units: si` config's point: the derived scene within the Scene's ranges
+    si, _ = si_point({"n": as_float("n", n), "material": material, "model": model,
+                      "stop": axes["stop"], **pz, **kw}, "--si")
+    out = run_si(si, model)
     if as_json:
         echo_json(out)
     else:
@@ -450,7 +460,10 @@ def _scene_si(axes, as_json, values):
 
 @cli.command("plot")
 @click.argument("results")
-@click.option("--out", default=None, help="Output PNG (default: RESULTS with suffix .png).")
+@click.option("--out", default=None,
+              help="Output figure, its format the suffix (.png, .svg, .pdf, ...; .png added "
+                   "when there is none); default: RESULTS with suffix .png. Prints the path "
+                   "written.")
 def plot_command(results, out):
     """Plot pull-off vs rate (and P(a) trajectories, if stored) of a results file."""
     from .analysis.plots import plot_sweep
@@ -517,17 +530,23 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
               help="A file of a `units: si` config: one line per scene in SI units (speed, "
                    "mu, l0, pull-off and the relaxed JKR pull-off 1.5 pi dg R).")
 @click.option("--csv", "csv_out", default=None, metavar="PATH",
-              help="With --si: also write every SI and dimensionless column as CSV.")
+              help="With --si (refused without it): also write every SI and dimensionless "
+                   "column as CSV.")
 def info_cmd(results, slowest, as_si, csv_out):
     """Summarize a results file: counts by status, parameter ranges, slowest scenes."""
     from .campaign.store import si_table, summary
 
     if not Path(results).exists():
         raise InputError(f"no results at {results}")
+    if csv_out and not as_si:
+        raise InputError("csv: needs --si (the SI table of a `units: si` results file); the "
+                         "dimensionless rows of any file: sweep.load(RESULTS).to_csv(FILE)")
     if as_si:
         df = si_table(results)
         if csv_out:
-            df.to_csv(csv_out, index=False)
+            # opened here, not by pandas: the operating system's reason in the error
+            with writing("csv", csv_out), open(csv_out, "w", newline="") as fh:
+                df.to_csv(fh, index=False)
         # the SI inputs that vary over the file (besides the speed) get a column each
         varied = [c for c in df.columns if c.startswith("si_") and c != "si_speed"
                   and df[c].nunique(dropna=True) > 1]
@@ -599,17 +618,18 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
     c = parse_floats("wlf", wlf)
     if len(c) != 3:
         raise InputError(f"wlf must be three numbers C1,C2,Tg (got {wlf!r})")
-    try:
-        n_arms = check_int("maxwell", int(arms.strip()), 0, 200)
-    except ValueError:
-        raise InputError(f"maxwell must be an integer in [0, 200] (got {arms!r})") from None
+    n_arms = check_int("maxwell", arms, 0, 200)
+    if plot_out is not None:                # its format, before the fits
+        from .analysis.plots import figure_path
+
+        figure_path("plot", plot_out)
     data = read_dma_csv(csv_file, T_ref=as_float("tref", tref), wlf=tuple(c))
     mpl = fit_mpl(data)
     mx = fit_maxwell(data, n_arms) if n_arms > 0 else None
     kk = kramers_kronig_check(data, noise=check_range("noise", as_float("noise", noise),
                                                       0.0, 0.5))
     if plot_out is not None:
-        plot_dma(data, mpl, mx, plot_out)
+        plot_out = str(plot_dma(data, mpl, mx, plot_out, "plot"))    # the path written
     out = {"source": csv_file, "kind": data.kind, "points": int(data.omega.size),
            "omega_min_rad_s": float(data.omega.min()),
            "omega_max_rad_s": float(data.omega.max()),
@@ -618,11 +638,8 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
            "mpl": mpl.to_dict(), "maxwell": None if mx is None else mx.to_dict(),
            "kramers_kronig": kk.to_dict(), "plot": plot_out}
     if json_out is not None:
-        try:
-            with open(json_out, "w") as fh:   # numpy scalars as Python numbers
-                fh.write(json.dumps(out, indent=1, default=lambda x: x.item()) + "\n")
-        except OSError as exc:
-            raise InputError(f"out: cannot write {json_out} ({exc.strerror})") from None
+        with writing("out", json_out), open(json_out, "w") as fh:   # numpy scalars as numbers
+            fh.write(json.dumps(out, indent=1, default=lambda x: x.item()) + "\n")
     if as_json:
         echo_json(out)
         return
@@ -684,12 +701,8 @@ def _with_fit_options(fn):
 
 
 def _fit_numbers(saturation: str, boot: str) -> tuple[float, int]:
-    try:
-        n_boot = int(boot.strip())
-    except ValueError:
-        raise InputError(f"boot must be an integer in [0, 1000000] (got {boot!r})") from None
     return (check_range("saturation", saturation, 0.0, 10.0, lo_open=True),
-            check_int("boot", n_boot, lo=0, hi=1_000_000))
+            check_int("boot", boot, lo=0, hi=1_000_000))
 
 
 @cli.group("fit")
@@ -833,12 +846,9 @@ def calibrate_cmd(config, as_json, out_dir, jobs, quiet):
     if jobs is not None:
         check_int("jobs", jobs, 1, 4096)
     cal = load_calibration(config)
-    if out_dir is not None:
-        try:
+    if out_dir is not None:                 # before the fit: a bad DIR fails at once
+        with writing("out", out_dir, "create"):
             Path(out_dir).mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise InputError(f"out: cannot create {out_dir!r} ({exc.strerror or exc})") \
-                from None
     progress = None if quiet else (lambda line: click.echo(line, err=True))
     result = calibrate(cal, jobs=jobs, progress=progress)
     paths = write_outputs(result, out_dir) if out_dir is not None else []

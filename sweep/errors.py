@@ -10,6 +10,7 @@ The CLI turns an ``InputError`` into that line on stderr and exit code 2.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from typing import Iterable
 
 import numpy as np
@@ -70,13 +71,48 @@ def check_positive(name: str, value) -> float:
     return check_range(name, value, lo=0.0, lo_open=True)
 
 
+def _exact_int(value) -> int | None:
+    """``value`` as an int if it is one exactly: an int, a float with no fraction, or a
+    numeric string of either (``"200"``, ``"1e6"``, as YAML 1.1 reads ``1e6``); else None."""
+    if isinstance(value, (bool, np.bool_)):
+        return None
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, str):
+        text = value.strip()
+        try:
+            return int(text)
+        except ValueError:
+            try:
+                value = float(text)
+            except ValueError:
+                return None
+    if isinstance(value, (float, np.floating)) and math.isfinite(value) and value.is_integer():
+        return int(value)
+    return None
+
+
 def check_int(name: str, value, lo=None, hi=None) -> int:
-    """Return ``value`` as an int within [lo, hi]."""
-    if isinstance(value, bool) or not (
-        isinstance(value, (int, np.integer)) or (isinstance(value, float) and value.is_integer())
-    ):
+    """Return ``value`` as an int within [lo, hi].
+
+    Parameters
+    ----------
+    name : str
+        The parameter, named in the error.
+    value : int, float or str
+        An integer, or a float or numeric string that is one exactly (``1000.0``,
+        ``"1e3"``, ``"200"``); ``1.5``, ``"1.5"`` and booleans are refused.
+    lo, hi : int, optional
+        The allowed range, inclusive.
+
+    Raises
+    ------
+    InputError
+        ``<name> must be an integer (got ...)`` or ``... an integer in [lo, hi] (got ...)``.
+    """
+    v = _exact_int(value)
+    if v is None:
         raise InputError(f"{name} must be an integer (got {value!r})")
-    v = int(value)
     if (lo is not None and v < lo) or (hi is not None and v > hi):
         lo_s = "-inf" if lo is None else str(lo)
         hi_s = "inf" if hi is None else str(hi)
@@ -101,6 +137,42 @@ def check_array(name: str, values, lo=None, hi=None, lo_open=False, hi_open=Fals
     for x in arr.ravel():
         check_range(name, x, lo, hi, lo_open, hi_open)
     return arr
+
+
+@contextmanager
+def writing(name: str, path, verb: str = "write"):
+    """Turn an ``OSError`` raised while writing ``path`` into a one-line :class:`InputError`.
+
+    Parameters
+    ----------
+    name : str
+        The parameter (option) that gave the path, e.g. ``"out"``.
+    path : str or os.PathLike
+        The file (or directory) being written.
+    verb : str, optional
+        What is done to it: ``"write"`` (default) or ``"create"`` (a directory).
+
+    Raises
+    ------
+    InputError
+        ``<name>: cannot <verb> <path> (<reason>)``, the reason the operating system gives
+        (and the path it names when that is another one, e.g. a parent that is a file).
+
+    Examples
+    --------
+    >>> with writing("csv", "/proc/nope/x.csv"):           # doctest: +SKIP
+    ...     open("/proc/nope/x.csv", "w")
+    """
+    try:
+        yield
+    except OSError as exc:
+        if isinstance(exc, FileExistsError):     # a parent directory to create is a file
+            reason = f"{exc.filename} is a file, not a directory"
+        else:
+            reason = exc.strerror or str(exc)
+            if exc.filename is not None and str(exc.filename) != str(path):
+                reason += f": {exc.filename}"
+        raise InputError(f"{name}: cannot {verb} {path} ({reason})") from None
 
 
 #: exceptions that are numerical or physical failures of a scene (a singular matrix, an

@@ -93,6 +93,35 @@ def test_scene_bad_input_one_line_exit_2(args, name, capsys):
     assert err.count("\n") == 0 and name in err
 
 
+def test_scene_nodes_takes_an_exact_integer_in_any_form(capsys):
+    """`--nodes 1e3` was refused ("nodes must be an integer (got '1e3')"): a number that is
+    an integer is that integer, in the scene's numerics and its id."""
+    pb = ["scene", "--n", "0.8", "--a0", "2", "--rate", "1", "--model", "pb", "--json"]
+    rows = []
+    for nodes in ("1e3", "1000", "1000.0"):
+        assert main(pb + ["--nodes", nodes]) == 0
+        rows.append(json.loads(capsys.readouterr().out))
+    assert {r["num_nodes"] for r in rows} == {1000}
+    assert len({r["scene_id"] for r in rows}) == 1
+    assert main(pb + ["--nodes", "1.5e2"]) == 0                 # 150
+    assert json.loads(capsys.readouterr().out)["num_nodes"] == 150
+    assert main(pb + ["--nodes", "150.5"]) == 2
+    assert capsys.readouterr().err.strip() == "error: nodes must be an integer (got '150.5')"
+
+
+def test_scene_help_offers_material_only_what_it_takes(capsys):
+    """`sweep scene --help` said --material [mpl|sls] also takes "a Prony table ({prony: file}
+    or inline ...)"; the option takes mpl or sls, and the help says where a table goes."""
+    assert main(["scene", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    help_ = text[text.index("--material [mpl|sls]"):text.index("--stop")]
+    assert "or a Prony table ({prony: file} or inline" not in help_
+    assert "MPL retardation spectrum or SLS; mpl, sls" in help_
+    assert "a Prony table is the material of a config" in help_
+    assert main(SCENE + ["--material", "prony:x.csv"]) == 2
+    assert "'prony:x.csv' is not one of 'mpl', 'sls'" in capsys.readouterr().err
+
+
 def test_failed_scene_exits_1(capsys):
     # mu = 10, a0 = 10 on a graded mesh of 300 nodes: the process zone spans half a node
     # spacing; refused with the advice, status failed (without --nodes the scene runs on

@@ -65,6 +65,7 @@ deviation ``S``; ``--sigma`` adds a ``sigma_N`` column ``S P``).
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import math
 import os
@@ -87,10 +88,10 @@ from ..campaign.config import UniqueKeyLoader
 from ..campaign.si import SI_AXES, SIScene, run_si
 from ..campaign.store import to_jsonable
 from ..engine import bem
-from ..errors import InputError, check_choice, check_int, check_range
+from ..errors import InputError, check_choice, check_int, check_range, writing
 from ..scene import PZ_LAWS, PZ_PARAMETERS, Numerics
 from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
-from .plots import pyplot
+from .plots import pyplot, save_figure
 
 __all__ = ["Parameter", "Calibration", "load_calibration", "calibration_from_dict",
            "calibrate", "synthesize", "write_outputs", "SceneEvaluator", "FIT_FIELDS"]
@@ -219,27 +220,54 @@ def _limits(name) -> tuple:
 
 
 def _read_data(path: Path) -> tuple:
+    """The measurements of a calibration's ``data`` CSV: ``speed_m_s``, ``pull_off_N`` and
+    ``sigma_N`` (None without that column).
+
+    A ``#`` starts a comment (to the end of its line); blank lines are skipped. Every row has
+    as many fields as the header: a row with more or fewer (an unlabelled extra column, a
+    trailing comma) is refused, naming the row, rather than read shifted by a column.
+
+    Raises
+    ------
+    InputError
+        One line naming the file, and the row and column of a bad value (the value as
+        written in the file).
+    """
     where = f"data {str(path)!r}"
     if not path.is_file():
         raise InputError(f"data: no such file {str(path)!r}")
     try:
-        df = pd.read_csv(path, comment="#", skipinitialspace=True)
-    except Exception as exc:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{where}: not a readable CSV ({_one_line(exc)})") from None
-    df.columns = [str(c).strip() for c in df.columns]
+    rows = [(number, [f.strip() for f in fields])
+            for number, line in enumerate(lines, 1) if line.split("#", 1)[0].strip()
+            for fields in csv.reader([line.split("#", 1)[0]], skipinitialspace=True)]
+    header = rows[0][1] if rows else []
     for col in DATA_COLUMNS:
-        if col not in df.columns:
+        if col not in header:
             raise InputError(f"{where}: missing column {col} (columns speed_m_s, pull_off_N "
-                             f"and optional sigma_N; got {', '.join(df.columns) or 'none'})")
-    cols = [*DATA_COLUMNS, *(["sigma_N"] if "sigma_N" in df.columns else [])]
+                             f"and optional sigma_N; got {', '.join(header) or 'none'})")
+    for i, (number, fields) in enumerate(rows[1:], 1):
+        if len(fields) != len(header):
+            raise InputError(f"{where}: row {i} (line {number}) has {len(fields)} fields, the "
+                             f"header {len(header)} ({', '.join(header)}): an unlabelled or "
+                             f"missing column, or a trailing comma?")
+    cols = [*DATA_COLUMNS, *(["sigma_N"] if "sigma_N" in header else [])]
     out = {}
     for col in cols:
-        vals = pd.to_numeric(df[col], errors="coerce").to_numpy(dtype=float)
-        for i, v in enumerate(vals):
+        j = header.index(col)
+        vals = []
+        for i, (_, fields) in enumerate(rows[1:], 1):
+            try:
+                v = float(fields[j])
+            except ValueError:
+                v = math.nan
             if not math.isfinite(v) or v <= 0.0:
-                raise InputError(f"{where}: {col} must be a number > 0 (row {i + 1}: "
-                                 f"{df[col].iloc[i]!r})")
-        out[col] = vals
+                raise InputError(f"{where}: {col} must be a number > 0 (row {i}: "
+                                 f"{fields[j] or 'empty'})")
+            vals.append(v)
+        out[col] = np.array(vals, dtype=float)
     if not len(out["speed_m_s"]):
         raise InputError(f"{where}: no data rows")
     return out["speed_m_s"], out["pull_off_N"], out.get("sigma_N")
@@ -899,12 +927,11 @@ def write_outputs(result: dict, out_dir) -> list:
     """Write ``calibration.json``, ``fit.png`` (data, fitted curve, band; log axes) and
     ``profile_<name>.png`` per parameter into ``out_dir``; returns the paths."""
     out = Path(out_dir)
-    try:
+    with writing("out", out, "create"):
         out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"out: cannot create {str(out)!r} ({exc.strerror or exc})") from None
     paths = [out / "calibration.json"]
-    paths[0].write_text(to_json(result) + "\n")
+    with writing("out", paths[0]):
+        paths[0].write_text(to_json(result) + "\n")
     plt = pyplot()
     d, c = result["data"], result["curve"]
     fig, ax = plt.subplots(figsize=(6.0, 4.5))
@@ -926,9 +953,7 @@ def write_outputs(result: dict, out_dir) -> list:
     ax.set_title(f"{result['name']} ({result['model']}): {est}", fontsize=8)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "fit.png", dpi=120)
-    plt.close(fig)
-    paths.append(out / "fit.png")
+    paths.append(save_figure(fig, out / "fit.png"))
     thr = result["fit"]["threshold"]
     for name, pr in result["profiles"].items():
         prm = result["parameters"][name]
@@ -950,10 +975,7 @@ def write_outputs(result: dict, out_dir) -> list:
         ax.set_title(f"{name}: {prm['status']}", fontsize=9)
         ax.legend(fontsize=7)
         fig.tight_layout()
-        p = out / f"profile_{name}.png"
-        fig.savefig(p, dpi=110)
-        plt.close(fig)
-        paths.append(p)
+        paths.append(save_figure(fig, out / f"profile_{name}.png", dpi=110))
     return paths
 
 

@@ -626,17 +626,29 @@ def kramers_kronig_check(data, threshold: float | None = None, per_decade: float
 
 # ============================================================================ plot
 
-def plot_dma(data, mpl: MPLFit | None, maxwell: MaxwellFit | None, out):
+def plot_dma(data, mpl: MPLFit | None, maxwell: MaxwellFit | None, out, name: str = "out"):
     """The paper's Fig. EE: E' and E'' vs omega, data and fits (needs the ``plot`` extra).
 
-    Returns the output path.
+    Parameters
+    ----------
+    data : DMAData
+    mpl : MPLFit or None
+    maxwell : MaxwellFit or None
+    out : str or Path
+        The figure's file; its suffix is the format (:func:`sweep.analysis.plots.figure_path`).
+    name : str, optional
+        The option that gave ``out``, named in a one-line error (a format matplotlib cannot
+        write, a path that cannot be written).
+
+    Returns
+    -------
+    Path
+        The path written.
     """
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise InputError("plot needs matplotlib: pip install 'visco-sweep[plot]'") from None
+    from .plots import figure_path, pyplot, save_figure
+
+    plt = pyplot()
+    out = figure_path(name, out)
     data = _as_data(data)
     w = data.omega
     wf = np.logspace(math.log10(w.min()), math.log10(w.max()), 400)
@@ -657,6 +669,4 @@ def plot_dma(data, mpl: MPLFit | None, maxwell: MaxwellFit | None, out):
     ref = f" at T_ref = {data.T_ref:g} C" if data.T_ref is not None else ""
     fig.suptitle(f"DMA master curve{ref}: {os.path.basename(data.source)}")
     fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    return out
+    return save_figure(fig, out, name)

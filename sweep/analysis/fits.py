@@ -38,6 +38,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from .. import units
 from ..errors import InputError, check_positive, check_range
+from ..scene import SCENE_AXES
 from ..theory import jkr_pull_off, pb_gamma_eff, pb_gamma_eff_spectrum
 
 __all__ = [
@@ -153,10 +154,11 @@ def power_law_fit(x, y, n_boot: int = N_BOOT, seed: int = 0,
     y = np.asarray(y, dtype=float).ravel()
     if x.size != y.size:
         raise InputError(f"x and y must have equal lengths (got {x.size} and {y.size})")
-    if x.size < 3 or np.unique(x).size < 2:
-        raise InputError(
-            f"a power-law fit needs at least 3 points with 2 distinct x (got {x.size})"
-        )
+    if x.size < 3:
+        raise InputError(f"a power-law fit needs at least 3 points (got {x.size})")
+    if np.unique(x).size < 2:
+        raise InputError(f"a power-law fit needs at least 2 distinct x (got {x.size} points, "
+                         f"all at x = {x[0]:.6g})")
     if not (np.all(x > 0) and np.all(y > 0) and np.all(np.isfinite(x * y))):
         raise InputError("a power-law fit needs finite positive x and y")
     confidence = check_range("confidence", confidence, 0.0, 1.0, lo_open=True, hi_open=True)
@@ -649,9 +651,18 @@ def vr_fit(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTION,
     """
     d = _vr_points(df, alpha)
     uns = d[_unsaturated(d, saturation_fraction)]
-    return {"all": power_law_fit(d["rhat_pb"], d["vhat"], n_boot, seed),
-            "unsaturated": power_law_fit(uns["rhat_pb"], uns["vhat"], n_boot, seed),
+    return {"all": _named_fit("all MPL points", d["rhat_pb"], d["vhat"], n_boot, seed),
+            "unsaturated": _named_fit(f"unsaturated points (P_po < {saturation_fraction:g} * "
+                                      f"1.5/k)", uns["rhat_pb"], uns["vhat"], n_boot, seed),
             "saturation_fraction": float(saturation_fraction)}
+
+
+def _named_fit(what: str, x, y, n_boot: int, seed: int) -> dict:
+    """:func:`power_law_fit` of the selection ``what``, which its InputError names."""
+    try:
+        return power_law_fit(x, y, n_boot, seed)
+    except InputError as exc:
+        raise InputError(f"{what}: {exc}") from None
 
 
 def pb_gamma_eff_scene(material: str, n: float, k: float, vhat):
@@ -777,7 +788,8 @@ def vr_paper_range(df: pd.DataFrame, rate_range=PAPER_VR_RATE_RANGE,
     def fit_in(lo_, hi_):
         r = d["rate"].to_numpy(dtype=float)
         sel = d[(r >= lo_ * (1 - 1e-9)) & (r <= hi_ * (1 + 1e-9))]
-        return power_law_fit(sel["rhat_pb"], sel["vhat"], n_boot, seed)
+        return _named_fit(f"MPL points at rates r-hat in [{lo_:g}, {hi_:g}]", sel["rhat_pb"],
+                          sel["vhat"], n_boot, seed)
 
     fit = fit_in(lo, hi)
     ranges = []
@@ -798,7 +810,11 @@ def vr_paper_range(df: pd.DataFrame, rate_range=PAPER_VR_RATE_RANGE,
 
 def vr_local_slope(df: pd.DataFrame, alpha: float = units.ALPHA_PB) -> list[dict]:
     r"""How far the v-r data are from one power law: the local slope ``d ln vhat / d ln
-    rhat_PB`` between neighbouring rates of each (n, k) MPL group, and ``vhat / rhat_PB``.
+    rhat_PB`` between neighbouring rates of each MPL group, and ``vhat / rhat_PB``.
+
+    A group is one value of every scene axis but the rate (n, k, mu, a0 or delta0, ...):
+    the v-r campaign has one a0 per (n, k), a threshold grid several, each its own curve
+    (pooled, points of one rate and another a0 gave a slope of +-inf).
 
     Returns
     -------
@@ -811,7 +827,8 @@ def vr_local_slope(df: pd.DataFrame, alpha: float = units.ALPHA_PB) -> list[dict
     d = _vr_points(df, alpha)
     rates = np.sort(d["rate"].unique())
     slopes = {}
-    for _, g in d.groupby(["n", "k"]):
+    curve = [a for a in SCENE_AXES if a != "rate" and a in d.columns]
+    for _, g in d.groupby(curve, dropna=False):
         g = g.sort_values("rate")
         r = g["rate"].to_numpy(dtype=float)
         lr, lv = np.log(g["rhat_pb"].to_numpy(dtype=float)), np.log(g["vhat"].to_numpy(dtype=float))

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..campaign.config import AXES
 from ..campaign.store import load, load_trajectory
-from ..errors import InputError
+from ..errors import InputError, writing
 from ..scene import AXES as AXIS_INFO
 from ..theory import jkr_load
 
@@ -52,6 +52,75 @@ def pyplot():
     except ImportError:  # pragma: no cover - the extra is installed by make demo/test
         raise InputError("plot needs matplotlib: pip install 'visco-sweep[plot]'") from None
     return plt
+
+
+def figure_path(name: str, out) -> Path:
+    """The path a figure given to option ``name`` is written to, checked before drawing.
+
+    Parameters
+    ----------
+    name : str
+        The option that gave the path (``out``, ``plot``), named in the error.
+    out : str or Path
+        The output file; its suffix is the format.
+
+    Returns
+    -------
+    Path
+        ``out``, with ``.png`` added when it has no suffix (what matplotlib writes then).
+
+    Raises
+    ------
+    InputError
+        When matplotlib cannot write the format of the suffix (one line with the formats
+        it can write).
+    """
+    out = Path(out)
+    if not out.suffix:
+        out = out.with_name(out.name + ".png")
+    fmt = out.suffix[1:].lower()
+    pyplot()                                    # matplotlib, or how to install it
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if fmt not in formats:
+        raise InputError(f"{name}: cannot write a figure as {out.suffix!r} (got {str(out)!r}; "
+                         f"suffixes: {', '.join('.' + f for f in sorted(formats))})")
+    return out
+
+
+def save_figure(fig, out, name: str = "out", dpi: int = 120) -> Path:
+    """Write ``fig`` to ``out`` (creating its directory) and close it; one-line errors.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    out : str or Path
+        The output file (:func:`figure_path`).
+    name : str, optional
+        The option that gave the path, named in an error.
+    dpi : int, optional
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Raises
+    ------
+    InputError
+        An unknown format, or a path that cannot be written (a missing or read-only
+        directory, a parent that is a file, a directory; :func:`sweep.errors.writing`).
+    """
+    plt = pyplot()
+    try:
+        out = figure_path(name, out)
+        with writing(name, out):
+            out.parent.mkdir(parents=True, exist_ok=True)
+            fig.savefig(out, dpi=dpi)
+    finally:
+        plt.close(fig)
+    return out
 
 
 def mark_failed(ax, df) -> int:
@@ -462,16 +531,12 @@ def plot_sweep(path, out=None) -> Path:
     out : str or Path, optional
         Output PNG; default: the results file with the suffix ``.png``.
     """
-    plt = pyplot()
     path = Path(path)
     df = load(path)
     if df.empty:
         raise InputError(f"results: {path} holds no finished scene")
     ok = df[df["status"] == "ok"]
-    out = Path(out) if out is not None else path.with_suffix(".png")
+    out = figure_path("out", out if out is not None else path.with_suffix(".png"))
     fig = sweep_figure(df, f"{path.name}: {len(ok)} ok, {len(df) - len(ok)} failed",
                        _trajectory_reader(path, ok))
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    return out
+    return save_figure(fig, out)

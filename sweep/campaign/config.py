@@ -57,16 +57,12 @@ import yaml
 from ..errors import InputError, as_float, check_choice, check_int, check_range
 from ..scene import AXES as SCENE_AXIS_INFO
 from ..scene import Numerics, Scene, SceneTable, scene_id, scene_table
-from .si import SI_AXES, SI_INITIAL, TABLE_FIELDS, SIScene
+from .si import SI_AXES, SI_INITIAL, SI_SCENE_AXES, TABLE_FIELDS, SIScene, si_point
 
 #: Top-level keys of a config file.
 TOP_KEYS = ("name", "description", "units", "grid", "numerics", "store", "output")
 #: Values of ``units``: the grid in the dimensionless Scene axes, or in SI (sweep.campaign.si.SI_AXES).
 UNITS = ("dimensionless", "si")
-#: Categorical Scene axes an SI grid takes as they are.
-SI_SCENE_AXES = ("model", "material", "stop", "pz_law", "dwell_hold")
-#: Of those, the ones the SI scene holds (the rest pass to the Scene as they are).
-SI_SCENE_FIELDS = ("material", "pz_law", "dwell_hold")
 #: Grid axes, in the order the Cartesian product iterates them (last varies fastest).
 #: Grid axes in the order of expansion (the last varies fastest): the Scene fields by their
 #: ``order`` metadata.
@@ -147,7 +143,7 @@ class SweepConfig:
                 point = dict(zip(order, values))
                 si = None
                 if self.units == "si":
-                    si, scene = _si_point(point, f"grid[{gi}]" if len(self.grids) > 1 else "grid")
+                    si, scene = si_point(point, f"grid[{gi}]" if len(self.grids) > 1 else "grid")
                 else:
                     scene = Scene(**point)
                 sid = scene_id(scene, self.numerics)
@@ -263,7 +259,7 @@ def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) ->
         for i, v in enumerate(vals):
             w = f"{where}[{i}]" if isinstance(spec, list) else where
             try:
-                if axis == "material" and not isinstance(v, str):
+                if axis == "material" and v not in allowed:   # a table, or what is allowed
                     out.append(_table(w, v))
                 else:
                     out.append(check_choice(w, v, allowed))
@@ -331,8 +327,8 @@ def _table(where: str, spec) -> SceneTable:
     """A ``material`` value that is a Prony table (``{prony: path}``, relative to the working
     directory, or an inline table; :func:`sweep.scene.scene_table`): InputError naming it."""
     if not isinstance(spec, (dict, SceneTable)):
-        raise InputError(f"{where} must be mpl, sls or a Prony table {{prony: file}} or "
-                         f"{{tau: [...], E: [...], E0: ...}} (got {spec!r})")
+        raise InputError(f"{where} must be mpl, sls or a Prony table, given as {{prony: path}} "
+                         f"or inline {{tau: [...], E: [...], E0: ...}} (got {spec!r})")
     try:
         return scene_table(spec)
     except InputError as exc:
@@ -371,18 +367,6 @@ def _check_grid(where: str, grid, problems: list[str]) -> dict | None:
 
 def _si_order(name: str) -> int:
     return SI_AXES[name].order if name in SI_AXES else SCENE_AXIS_INFO[name].order
-
-
-def _si_point(point: dict, where: str):
-    """The SIScene and the Scene of one point of an SI grid (InputError naming the point)."""
-    extra = {a: point[a] for a in SI_SCENE_AXES if a in point and a not in SI_SCENE_FIELDS}
-    phys = {a: v for a, v in point.items() if a not in SI_SCENE_AXES}
-    try:
-        si = SIScene(**phys, **{a: point[a] for a in SI_SCENE_FIELDS if a in point})
-        return si, si.to_scene(**extra)
-    except InputError as exc:
-        desc = ", ".join(f"{a}={v:g}" for a, v in phys.items() if v is not None)
-        raise InputError(f"{where} (SI point {desc}): {exc}") from None
 
 
 def _check_si_grid(where: str, grid, problems: list[str]) -> dict | None:
@@ -472,7 +456,10 @@ def config_from_dict(data, text: str | None = None, source: str = "<dict>") -> S
     if name is None:
         problems.append("name: required key is missing (a short name such as 'smoke')")
         name = ""
-    elif not isinstance(name, str) or not _NAME_RE.match(name):
+    elif not isinstance(name, str):           # YAML read it as a number, a date, a list ...
+        problems.append(f"name: must be a string, quoted in YAML where it reads as something "
+                        f"else (name: \"{name}\") (got {name!r})")
+    elif not _NAME_RE.match(name):
         problems.append(f"name: must be a string of letters, digits, '-', '_', '.' "
                         f"(got {name!r})")
     description = data.get("description", "") or ""

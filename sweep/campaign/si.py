@@ -47,7 +47,7 @@ from ..scene import (AXES, DWELL_HOLDS, MATERIALS, PZ_LAWS, SCENE_LIMITS, Axis, 
 from ..theory import jkr_contact_radius, jkr_pull_off
 from ..units import PhysicalScale
 
-__all__ = ["SIScene", "run_si", "SI_MODELS", "SI_AXES", "si_row"]
+__all__ = ["SIScene", "run_si", "SI_MODELS", "SI_AXES", "si_row", "si_point"]
 
 SI_MODELS = ("bem", "crack", "pb", "auto")
 
@@ -89,6 +89,10 @@ SI_AXES = {a.name: a for a in (
     _si_axis("machine_stiffness", "N/m", "stiffness of the machine (force sensor) in series "
              "with the sphere (unset: a rigid machine)", required=False, order=2),
 )}
+#: Categorical Scene axes an SI grid (and ``sweep scene --si``) takes as they are.
+SI_SCENE_AXES = ("model", "material", "stop", "pz_law", "dwell_hold")
+#: Of those, the ones the SI scene holds (the rest pass to the Scene as they are).
+SI_SCENE_FIELDS = ("material", "pz_law", "dwell_hold")
 #: The initial-state fields of an SI grid: exactly one is given.
 SI_INITIAL = ("preload", "a0", "indentation")
 #: The SI fields a Prony table replaces (its moduli and times).
@@ -300,6 +304,39 @@ class SIScene:
         if self.table is not None:
             d["material"] = self.table.label
         return d
+
+
+def si_point(point: dict, where: str) -> tuple[SIScene, Scene]:
+    """The SI scene of one point and the dimensionless :class:`sweep.Scene` it derives to,
+    both checked: what a ``units: si`` config and ``sweep scene --si`` run.
+
+    Parameters
+    ----------
+    point : dict
+        SI fields (:data:`SI_AXES`) and the Scene axes :data:`SI_SCENE_AXES` (``model``,
+        ``material``, ``stop``, ``pz_law``, ``dwell_hold``).
+    where : str
+        Where the point comes from (``grid``, ``grid[1]``, ``--si``), named in the error.
+
+    Returns
+    -------
+    tuple of (SIScene, Scene)
+
+    Raises
+    ------
+    InputError
+        One line naming ``where`` and the SI point, for a bad SI field or a derived scene
+        outside the Scene's ranges (e.g. a rate above 1e12, an a0 below 0.3 a_ref): every
+        model's scene passes the same checks, whichever model then runs it.
+    """
+    extra = {a: point[a] for a in SI_SCENE_AXES if a in point and a not in SI_SCENE_FIELDS}
+    phys = {a: v for a, v in point.items() if a not in SI_SCENE_AXES}
+    try:
+        si = SIScene(**phys, **{a: point[a] for a in SI_SCENE_FIELDS if a in point})
+        return si, si.to_scene(**extra)
+    except InputError as exc:
+        desc = ", ".join(f"{a}={v:g}" for a, v in phys.items() if v is not None)
+        raise InputError(f"{where} (SI point {desc}): {exc}") from None
 
 
 def _si_of(si: SIScene, dimless: dict) -> dict:

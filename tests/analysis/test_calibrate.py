@@ -269,6 +269,47 @@ def test_bad_files_one_line_exit_2(tmp_path, capsys, change, words):
     assert words in err, err
 
 
+@pytest.mark.parametrize("csv, words", [
+    # an unlabelled extra column: pandas read it shifted by one, the speeds as the index
+    ("speed_m_s,pull_off_N\n1e-6,0.0145,1\n1e-5,0.02,1\n1e-4,0.03,1\n",
+     "row 1 (line 2) has 3 fields, the header 2 (speed_m_s, pull_off_N)"),
+    # trailing commas: read as a NaN pull-off, "(row 1: np.float64(nan))"
+    ("# lab\nspeed_m_s,pull_off_N\n1e-6,0.0145\n1e-5,0.02,\n1e-4,0.03,\n",
+     "row 2 (line 4) has 3 fields, the header 2"),
+    ("speed_m_s,pull_off_N,sigma_N\n1e-6,0.0145,1e-3\n1e-5,0.02\n1e-4,0.03,1e-3\n",
+     "row 2 (line 3) has 2 fields, the header 3"),
+    # a bad value: the value as written, not a numpy repr ("np.float64(-1e-06)")
+    ("speed_m_s,pull_off_N\n1e-6,0.0145\n-1e-05,0.02\n1e-4,0.03\n",
+     "speed_m_s must be a number > 0 (row 2: -1e-05)"),
+    ("speed_m_s,pull_off_N\n1e-6,0.0145\n1e-5,\n1e-4,0.03\n",
+     "pull_off_N must be a number > 0 (row 2: empty)"),
+    ("speed_m_s,pull_off_N\n1e-6,0.0145\n1e-5,abc\n1e-4,0.03\n",
+     "pull_off_N must be a number > 0 (row 2: abc)"),
+])
+def test_data_rows_must_match_the_header(tmp_path, capsys, csv, words):
+    path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED)
+    (tmp_path / "d.csv").write_text(csv)
+    assert main(["calibrate", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: data ") and "\n" not in err and "np." not in err
+    assert words in err, err
+
+
+def test_data_comments_blank_lines_and_spaces_are_read():
+    """What pandas read before still reads: # comments (whole or trailing), blank lines,
+    spaces after commas, columns in any order."""
+    import tempfile
+    from pathlib import Path
+
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "d.csv"
+        p.write_text("# synthetic\n\npull_off_N, sigma_N, speed_m_s\n0.01, 1e-3, 1e-6  # a\n"
+                     "\n0.02, 2e-3, 1e-5\n")
+        speed, po, sigma = cb._read_data(p)
+    assert speed.tolist() == [1e-6, 1e-5] and po.tolist() == [0.01, 0.02]
+    assert sigma.tolist() == [1e-3, 2e-3]
+
+
 def test_missing_data_file_is_one_line(tmp_path, capsys):
     path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED)          # no CSV written
     assert main(["calibrate", str(path)]) == 2

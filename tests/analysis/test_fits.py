@@ -52,6 +52,30 @@ def test_power_law_bad_input():
         an.power_law_fit([1, 2, 3], [1, -2, 3])
 
 
+def test_power_law_too_few_points_say_what_is_missing():
+    """"needs at least 3 points with 2 distinct x (got 4)" did not say what was missing."""
+    with pytest.raises(InputError) as info:
+        an.power_law_fit([2.0, 2.0, 2.0, 2.0], [1, 2, 3, 4])
+    assert str(info.value) == ("a power-law fit needs at least 2 distinct x (got 4 points, "
+                               "all at x = 2)")
+    with pytest.raises(InputError) as info:
+        an.power_law_fit([1.0, 2.0], [1, 2])
+    assert str(info.value) == "a power-law fit needs at least 3 points (got 2)"
+
+
+def test_cli_fit_vr_names_the_selection_too_small_to_fit(tmp_path, capsys):
+    """Two rates, 0.316 and 1, x 4 groups: 8 points, but the paper's rate range [1, 1e6]
+    holds 4 at one rhat_PB. The error names that selection and what it lacks."""
+    df = synthetic_vr_runs()
+    df = df[df["rate"].isin(sorted(df["rate"].unique())[1:3])]
+    path = tmp_path / "vr.h5"
+    write_results(path, df)
+    assert main(["fit", "vr", str(path), "--boot", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("error: MPL points at rates r-hat in [1, 1e+06]: a power-law fit needs at "
+                   "least 2 distinct x (got 4 points, all at x = 0.143887)\n")
+
+
 # ------------------------------------------------------------------ threshold radius
 def saturating(a, plateau=12.0, length=0.6, a_start=1.0):
     """P(a) = plateau - c exp(-a/L): dP/da = (c/L) exp(-a/L) falls monotonically."""
@@ -408,6 +432,31 @@ def test_vr_local_slope_and_ratio():
             assert r["slope_max"] == pytest.approx(1.1, rel=1e-10)
     assert ls[1]["slope_median"] == pytest.approx(1.0, rel=1e-10)    # on 5 rhat
     assert ls[0]["v_over_r_median"] == pytest.approx(5.0, rel=1e-10)
+
+
+def test_vr_local_slope_of_a_grid_with_several_a0_per_rate():
+    """A threshold-style grid (several a0 per (n, k, rate)): the local slope pooled the a0 of
+    one rate, dividing by ln rhat - ln rhat = 0 (numpy's "divide by zero" warning, slopes
+    -inf). Each a0 is its own curve: vhat = c(a0) rhat^1.1 has the slope 1.1 everywhere."""
+    import warnings
+
+    frames = []
+    for a0, c in ((2.0, 3.0), (3.0, 4.0), (5.0, 6.0)):
+        df = synthetic_vr_runs()
+        df["a0"] = a0
+        df["crack_speed"] *= c / 3.0
+        frames.append(df)
+    df = pd.concat(frames, ignore_index=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ls = an.vr_local_slope(df)
+        out = an.vr_analysis(df, n_boot=0)
+    assert len(ls) == 15 and math.isnan(ls[0]["slope_median"])
+    for r in ls[1:]:
+        assert r["n_groups"] == 12                       # 2 n x 2 k x 3 a0
+        for key in ("slope_median", "slope_min", "slope_max"):
+            assert r[key] == pytest.approx(1.1, rel=1e-10)
+    assert out["local_slope"] == ls
 
 
 def test_alpha_per_k_recovers_each_k():

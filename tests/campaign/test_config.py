@@ -140,7 +140,12 @@ def test_every_problem_reported_at_once():
     ({"grid": {"n": 0.8, "rate": {"log10": [0, 2, 2.5]}, "a0": 2}}, "(num) must be an integer"),
     ({"grid": {"n": 0.8, "rate": {"geomspace": [1, 2, 3]}, "a0": 2}}, "a range must be"),
     ({"grid": {"n": 0.8, "rate": 1, "a0": 2, "material": "elastic"}},
-     "grid.material must be one of mpl, sls"),
+     "grid.material must be mpl, sls or a Prony table, given as {prony: path} or inline "
+     "{tau: [...], E: [...], E0: ...} (got 'elastic')"),
+    ({"units": "si", "grid": {"R": 1e-4, "E0": 1e6, "Einf": 1e7, "nu": 0.5, "n": 0.8,
+                              "tau0": 0.1, "dg": 0.05, "h0": 2e-7, "preload": 1e-5,
+                              "speed": 1e-6, "material": ["mpl", "foo"]}},
+     "grid.material[1] must be mpl, sls or a Prony table, given as {prony: path} or inline"),
     ({"grid": [{"n": 0.8, "rate": 1, "a0": 2}, {"n": 9, "rate": 1, "a0": 2}]}, "grid[1].n"),
     ({"grid": "n=1"}, "grid: must be a mapping of axes"),
     ({"grid": []}, "grid: must not be an empty list"),
@@ -154,6 +159,45 @@ def test_every_problem_reported_at_once():
                "k": {"linspace": [0.1, 0.2, 300]}}}, "more than the maximum"),
 ])
 def test_bad_values_name_key_and_allowed(over, needle):
+    text = msg(**over)
+    assert needle in text, text
+
+
+def test_integer_fields_take_numeric_strings_and_whole_floats():
+    """docs/configs.md: numeric strings such as "1e6" wherever a number is expected. YAML 1.1
+    reads `1e6` as the string '1e6'; integer fields refused it ("numerics.max_steps must be an
+    integer (got '1e6')"). An exact integer as a string or float is that integer, and the
+    scene ids (which hash the numerics) are those of the plain integer."""
+    text = ("name: t\ngrid: {{n: 0.8, a0: 2, rate: {{log10: [0, 2, {num}]}}}}\n"
+            "numerics: {{preset: fast, max_steps: {steps}, nodes: {nodes}}}\n")
+    plain = parse_config(text.format(num=3, steps=1000000, nodes=200))
+    assert plain.tasks()[0][1].rate == 1.0 and len(plain.tasks()) == 3
+    for num, steps, nodes in (('"3"', "1e6", "2e2"), ("3.0", "1.0e+6", '"200"'),
+                              ("3", '"1000000"', "200.0")):
+        cfg = parse_config(text.format(num=num, steps=steps, nodes=nodes))
+        assert [sid for sid, _ in cfg.tasks()] == [sid for sid, _ in plain.tasks()]
+        assert cfg.config_hash == plain.config_hash
+        assert cfg.numerics.max_steps == 1000000 and type(cfg.numerics.max_steps) is int
+        assert cfg.numerics.nodes == 200 and type(cfg.numerics.nodes) is int
+
+
+@pytest.mark.parametrize("over, needle", [
+    ({"numerics": {"preset": "fast", "max_steps": "1.5e3"}}, None),
+    ({"numerics": {"preset": "fast", "max_steps": 1000.5}},
+     "numerics.max_steps must be an integer (got 1000.5)"),
+    ({"numerics": {"preset": "fast", "nodes": "1.5"}},
+     "numerics.nodes must be an integer (got '1.5')"),
+    ({"numerics": {"preset": "fast", "nodes": "two"}},
+     "numerics.nodes must be an integer (got 'two')"),
+    ({"numerics": {"preset": "fast", "nodes": True}},
+     "numerics.nodes must be an integer (got True)"),
+    ({"grid": {"n": 0.8, "rate": {"log10": [0, 2, "2.5"]}, "a0": 2}},
+     "grid.rate.log10[2] (num) must be an integer (got '2.5')"),
+])
+def test_integer_fields_refuse_fractions(over, needle):
+    if needle is None:              # "1.5e3" is 1500, an integer: accepted
+        assert config_from_dict(base(**over)).numerics.max_steps == 1500
+        return
     text = msg(**over)
     assert needle in text, text
 
@@ -442,3 +486,59 @@ def test_a_compliant_machine_with_a_protocol_is_refused_when_the_config_loads():
     with pytest.raises(InputError, match="machine_stiffness"):
         Scene(n=0.8, k=0.1, mu=3.24, rate=10.0, approach_rate=10.0, preload=2.0, dwell=1.0,
               machine_stiffness=1.0)
+
+
+def test_the_configs_the_docs_show_write_distinct_results_files():
+    """Each sweep config in the README and docs/ writes its own results file: two configs of
+    one name (the README's SI `name: gmm` and configs.md's dimensionless one) both wrote
+    results/gmm.h5, and the second run was refused ("units differ ...")."""
+    import re
+
+    import yaml
+
+    outputs = {}
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]:
+        text = page.read_text()
+        for m in re.finditer(r"^```ya?ml\n(.*?)^```", text, re.S | re.M):
+            d = yaml.safe_load(m.group(1))
+            if not (isinstance(d, dict) and "grid" in d and "name" in d):
+                continue
+            where = f"{page.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}"
+            out = d.get("output", f"results/{d['name']}.h5")
+            assert out not in outputs, f"{where} and {outputs[out]} both write {out}"
+            outputs[out] = where
+    assert "results/gmm.h5" in outputs and len(outputs) >= 5
+
+
+def test_configs_md_shows_how_several_problems_are_reported(tmp_path, capsys, monkeypatch):
+    """docs/configs.md said the problems are reported "one line each"; they are one line, joined
+    by "; ". The page's example is what `sweep run` prints for that config."""
+    import re
+
+    from sweep.cli import main
+
+    text = " ".join((ROOT / "docs" / "configs.md").read_text().split())
+    assert "one line each" not in text
+    shown = re.search(r"`(error: bad\.yaml: 2 problems: [^`]*)`", text).group(1)
+    cfg = tmp_path / "bad.yaml"
+    cfg.write_text("name: bad\ngrid: {n: -1, rate: 0, a0: 2}\n")
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "bad.yaml"]) == 2
+    assert capsys.readouterr().err == shown + "\n"
+
+
+@pytest.mark.parametrize("text, got", [("name: 123", "123"), ("name: 2024-01-02",
+                                                             "datetime.date(2024, 1, 2)"),
+                                       ("name: 1e3", None)])
+def test_a_name_yaml_reads_as_no_string_says_to_quote_it(text, got):
+    """`name: 123` said "must be a string of letters, digits ... (got 123)", which 123 is;
+    YAML read it as a number: the message says to quote it. (`1e3` is a string in YAML 1.1.)"""
+    src = text + "\ngrid: {n: 0.8, rate: 1, a0: 2}\n"
+    if got is None:
+        assert parse_config(src).name == "1e3"
+        return
+    with pytest.raises(InputError) as info:
+        parse_config(src)
+    value = text.split(": ")[1]
+    assert str(info.value) == (f"<string>: name: must be a string, quoted in YAML where it "
+                               f'reads as something else (name: "{value}") (got {got})')

@@ -130,6 +130,55 @@ def test_cli_scene_si_errors(capsys, extra, message):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("model", ["pb", "crack", "bem"])
+def test_cli_scene_si_refuses_dwell_hold_depth_without_a_protocol(capsys, model):
+    """`--dwell-hold depth` without a test protocol: the dimensionless CLI, the API and configs
+    refuse it; `--si` ran the relaxed start and exited 0."""
+    assert main(["scene", "--n", "0.8", "--a0", "2", "--rate", "1", "--model", model,
+                 "--dwell-hold", "depth"]) == 2
+    assert "needs a protocol" in capsys.readouterr().err
+    assert main(SI_ARGS + ["--model", model, "--dwell-hold", "depth", "--json"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1
+    assert err.startswith("error: ") and "dwell_hold: 'depth' needs a test protocol" in err, err
+
+
+SMALL = ["scene", "--si", "--R", "1e-4", "--E0", "1e6", "--Einf", "1e7", "--nu", "0.5", "--n",
+         "0.8", "--tau0", "0.1", "--dg", "0.05", "--h0", "2e-7"]
+
+
+@pytest.mark.parametrize("extra, field, message", [
+    # rate = speed tau0 / h0 = 5e15, beyond the Scene's (0, 1e12]
+    (["--preload", "1e-5", "--speed", "1e10", "--model", "crack"], "preload: 1.0e-5",
+     "rate must be in (0, 1e+12] (got 5e+15)"),
+    # a0 = 1 nm = 9.5e-5 a_ref, below the Scene's [0.3, 50] (`--a0 0.01 --model pb` is refused)
+    (["--a0-si", "1e-9", "--speed", "1e-6", "--model", "pb"], "a0: 1.0e-9",
+     "a0 must be in [0.3, 50] (got 9.46832e-05)"),
+])
+def test_cli_scene_si_passes_the_checks_of_an_si_config(tmp_path, capsys, extra, field,
+                                                        message):
+    """`sweep scene --si` ran derived scenes that a `units: si` config with the same point (and
+    the dimensionless route) refuse: both now check the point with campaign.si.si_point."""
+    cfg = tmp_path / "c.yaml"
+    model = extra[extra.index("--model") + 1]
+    speed = extra[extra.index("--speed") + 1]
+    cfg.write_text(f"name: c\nunits: si\ngrid: {{R: 1.0e-4, E0: 1.0e+6, Einf: 1.0e+7, nu: 0.5, "
+                   f"n: 0.8, tau0: 0.1, dg: 0.05, h0: 2.0e-7, {field}, speed: {speed}, "
+                   f"model: {model}}}\noutput: {tmp_path / 'c.h5'}\n")
+    assert main(["run", str(cfg)]) == 2
+    assert message in capsys.readouterr().err
+    assert main(SMALL + extra) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1
+    assert err.startswith("error: --si (SI point n=0.8, R=0.0001, ") and message in err, err
+
+
+def test_cli_scene_si_within_the_ranges_still_runs(capsys):
+    assert main(SMALL + ["--a0-si", "1e-5", "--speed", "1e-6", "--model", "pb", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["status"] == "ok" and d["scene"]["rate"] == pytest.approx(0.5, rel=1e-12)
+
+
 def test_cli_scene_si_options_need_si(capsys):
     assert main(["scene", "--n", "0.8", "--a0", "2", "--rate", "1", "--R", "1e-3"]) == 2
     assert "--R: SI options need --si" in capsys.readouterr().err
