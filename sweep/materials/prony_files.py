@@ -348,6 +348,10 @@ def _make(form, tau, w, *, E0=None, Einf=None, where, fmt, name, source, units_k
         raise InputError(f"{where}: {what} must be >= 0, so that the relaxation modulus never "
                          f"increases (got {col}[{bad[0]}] = {w[bad[0]]:g})")
     keep = w > 0.0
+    if not keep.any():
+        what = "moduli E" if form == "wiechert" else "weights c"
+        raise InputError(f"{where}: every one of the {what} is 0 (a table needs one arm > 0; "
+                         f"without one the material is elastic, k = 1)")
     order = np.argsort(tau[keep], kind="stable")
     tau, w = tau[keep][order], w[keep][order]
     if form == "kelvin":

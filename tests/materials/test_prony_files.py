@@ -211,6 +211,10 @@ BAD = [
      "# time_unit = s\ntau,E\n1,1\n", "modulus unit must be one of Pa, kPa, MPa, GPa"),
     ("bad form", None, {"tau": [1.0], "E": [1e6], "E0": 1e6, "form": "kelvin"},
      "form kelvin needs the column c"),
+    ("every weight zero", None, {"tau": [1.0, 2.0], "c": [0.0, 0.0], "E0": 1, "form": "kelvin"},
+     "every one of the weights c is 0"),
+    ("every modulus zero", None, {"tau": [1.0], "E": [0.0], "E0": 1e6},
+     "every one of the moduli E is 0"),
 ]
 
 
