@@ -19,6 +19,7 @@ import numpy as np
 from .. import materials, units
 from ..kernels.interface import TIP_GAP
 from ..materials import SLS, MPLRetardation, Prony
+from ..materials._checks import MAX_WINDOW_DECADES
 from ..materials.prony_series import PronySeries
 from ..scene import Numerics, Scene, SceneTable
 from ..theory import jkr_contact_radius
@@ -397,6 +398,13 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None, *,
             t_min = min(t_min, t_approach[0])
             t_max = max(t_max, 10.0 ** math.ceil(math.log10(t_approach[1] + protocol.dwell +
                                                             t_max)))
+            if math.log10(t_max / t_min) > MAX_WINDOW_DECADES:
+                raise Refused(f"the test protocol's times span {t_min:.3g} to {t_max:.3g} tau0 "
+                              f"(the approach's smallest steps to the retraction at rate "
+                              f"{scene.rate:g}), more than a Prony series spans "
+                              f"(1e{MAX_WINDOW_DECADES:g}): bring the approach's and the "
+                              f"retraction's rates within about 1e{MAX_WINDOW_DECADES - 5:g} "
+                              f"of each other")
         n = scene.n if scene.material == "mpl" else 0.0
         prony = prony_series(scene.material, n, scene.k, t_min, t_max, numerics.prony_rtol)
         weights = np.ascontiguousarray(prony.weights, dtype=float)

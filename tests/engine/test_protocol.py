@@ -580,3 +580,14 @@ def test_a_retraction_after_a_dwell_of_1e15_is_read_on_its_own_clock():
     assert long.pull_off == pytest.approx(short.pull_off, rel=1e-5)
     assert long.crack_speed == pytest.approx(short.crack_speed, rel=1e-3)
     assert long.t_pulloff == pytest.approx(1e15, rel=1e-12)
+
+
+def test_a_protocol_whose_times_no_prony_series_spans_says_so():
+    """An approach at rate 1 and a retraction at 1e-150: the scene's times span 1e-4 to
+    1e147 tau0, past the widest Prony window (1e100). The row said "InputError: t_max/t_min
+    must be at most 1e100", an input error for input the Scene accepts; it names the rates."""
+    res = simulate(Scene(n=0.8, k=0.1, mu=3.24, rate=1e-150, approach_rate=1.0, preload=1.0,
+                         dwell=0.0), Numerics.preset("fast"))
+    assert res.status == "failed" and "InputError" not in res.reason
+    assert "more than a Prony series spans (1e100)" in res.reason
+    assert "retraction's rates within about 1e95" in res.reason
