@@ -261,9 +261,8 @@ def estimate_error(res: Result, length: float, solve: Callable[[Numerics], Resul
             res.error_estimate = change / (factor ** ESTIMATE_ORDER - 1.0) + prony
             res.hysteresis_error = hysteresis_error(res, coarse.hysteresis_energy,
                                                     factor ** ESTIMATE_ORDER - 1.0)
-            how += (f": an error estimate of {res.error_estimate:.2g} (the change over "
-                    f"{factor:.3g}^{ESTIMATE_ORDER:g} - 1"
-                    + (f", plus the Prony fit's {prony:.2g})" if prony > 0 else ")"))
+            how += (f": estimate {res.error_estimate:.2g} (change / ({factor:.3g}^"
+                    f"{ESTIMATE_ORDER:g} - 1)" + (f" + Prony {prony:.2g})" if prony > 0 else ")"))
             break
     else:
         res.error_estimate = resolution_error(res.spacing, length) + prony
