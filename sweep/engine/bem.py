@@ -87,8 +87,17 @@ def simulate(scene: Scene, numerics: Numerics | None = None) -> Result:
         if not numerics.exact:
             estimate_error(res, derive(scene, numerics).tip_zone,
                            lambda coarse: _attempt(scene, coarse, deadline))
+        elif res.ok:
+            res.reason = f"{res.reason}; {EXACT_NOTE}" if res.reason else EXACT_NOTE
     res.wall_s = time.perf_counter() - t_start
     return res
+
+
+#: what an ``ok`` row of the exact hereditary reference (``numerics.exact``) says of its error:
+#: it is the Prony series' reference (no series, no Prony error), and its mesh's error is not
+#: estimated (a coarser solve of the quadratic-cost history doubles its cost)
+EXACT_NOTE = ("exact hereditary reference: no error estimate (no Prony series; the mesh's "
+              "error is not estimated: compare two resolutions)")
 
 
 def _attempt(scene: Scene, numerics: Numerics, deadline: float = math.inf) -> Result:

@@ -98,6 +98,9 @@ def test_prony_matches_exact_convolution(n, rate):
     assert prony.steps == exact.steps
     assert prony.pull_off == pytest.approx(exact.pull_off, rel=2e-3)
     assert exact.prony_terms == 0 and prony.prony_terms > 0
+    # every row states its error: the exact reference's says it has no estimate
+    assert "exact hereditary reference: no error estimate" in exact.reason
+    assert math.isnan(exact.error_estimate)
 
 
 def test_prony_error_shrinks_with_rtol():
