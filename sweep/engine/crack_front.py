@@ -584,6 +584,18 @@ def _lapack_solve(factors, b):
     return x
 
 
+#: a scene whose Gamma(v)/dg - 1 at RELAXED_SPEEDS times its loading speed (a bound of the
+#: crack speed at the pull-off: 2.3 times it for JKR at Gamma = dg) is at most RELAXED_LIMIT is
+#: the relaxed limit, the JKR contact at Gamma = dg (:func:`simulate_crack`): below a rate of
+#: about 1e-11 (n 0.8, k 0.1, mu 3.24), where the integrator's g - 1 drowned in the rounding of
+#: g (the edge pinned for good below rate 1e-29, the time budget spent; 1.4999998 at 1e-28)
+RELAXED_SPEEDS = 10.0
+RELAXED_LIMIT = 1e-10
+#: the crack-front integrator's first step is at least this many float spacings of its start
+#: time (:func:`unload`)
+FIRST_STEP_SPACINGS = 1e3
+
+
 def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
            a_end=0.02, time_budget_s=0.0) -> CrackFrontSolution:
     r"""Unload a relaxed JKR contact at constant speed with the crack-front model.
@@ -676,8 +688,13 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     pulloff = None                      # (t, a) of the first tensile load minimum
     runaway = None                      # past the pull-off, where the edge ran away
     try:
+        # the first step at least a few of the float spacings at t1: below rate ~1e-29 the
+        # pinned phase ends at t1 ~ 1e30 tau0, where 1e-3 tau0 is no step at all (the
+        # integrator stalled until the time budget, or found no step)
+        first = max(min(1e-6 * span, 1e-3 / max(rate, 1.0)), FIRST_STEP_SPACINGS
+                    * float(np.spacing(abs(t1) + span)))
         solver = Radau(rhs, t1, [a0], t1 + span, rtol=rtol, atol=atol, jac=jac,
-                       first_step=min(1e-6 * span, 1e-3 / max(rate, 1.0)))
+                       first_step=first)
         solver.lu, solver.solve_lu = _lapack_lu, _lapack_solve
         while True:
             message = solver.step()
@@ -861,6 +878,16 @@ def simulate_crack(scene, numerics=None):
         else:
             law = scene_law(scene.n, scene.k, scene.mu, scene.material, scene.pz_law,
                             scene.pz_v0, scene.pz_xi)
+            slow = float(law.gamma(RELAXED_SPEEDS * scene.rate * units.h0_hat(scene.mu))) - 1.0
+            if slow <= RELAXED_LIMIT:
+                closed = _elastic_crack(scene, Result(scene=scene, numerics=numerics), t_start,
+                                        c=1.0)
+                closed.error_estimate = max(slow, 0.0)
+                note = (f"the relaxed limit: Gamma(v)/dg - 1 = {slow:.2g} at {RELAXED_SPEEDS:g} "
+                        f"times the loading speed (at most {RELAXED_LIMIT:g}): the JKR contact "
+                        f"at the constant Gamma = dg")
+                closed.reason = f"{note}; {closed.reason}" if closed.reason else note
+                return closed
         s = unload(law, rate=scene.rate, mu=scene.mu, a0=scene.a0, delta0=scene.delta0,
                    stop=scene.stop, time_budget_s=numerics.time_budget_s)
     except NUMERICAL_ERRORS as exc:   # reported; a bug (TypeError, ...) raises
@@ -886,13 +913,14 @@ def simulate_crack(scene, numerics=None):
     return res
 
 
-def _elastic_crack(scene, res, t_start):
+def _elastic_crack(scene, res, t_start, c=None):
     """A (nearly) elastic scene, 1/k - 1 <= :data:`NEARLY_ELASTIC`, with the crack-front
-    model: the JKR contact opened at the constant Gamma = c dg, c = 1/sqrt(k), under fixed
-    grip (:func:`constant_gamma_pull_off`); the crack speed at the pull-off radius follows
+    model: the JKR contact opened at the constant Gamma = c dg, c = 1/sqrt(k) (or ``c``
+    given: 1, the relaxed limit of a scene too slow for its Gamma(v) to rise above dg), under
+    fixed grip (:func:`constant_gamma_pull_off`); the crack speed at the pull-off radius follows
     from the indentation speed, v = rate h0 / (d delta/d a) (none where a0 is below the
     load-control pull-off radius: there the tension is largest at the start)."""
-    c = 1.0 / math.sqrt(scene.k)
+    c = 1.0 / math.sqrt(scene.k) if c is None else c
     a0 = scene.a0 if scene.a0 is not None else float(jkr_contact_radius(indentation=scene.delta0))
     a_load = A_PULL_OFF_FORCE * c ** (1.0 / 3.0)        # the load-control pull-off radius
     a_po = a_load if a0 >= a_load else a0
