@@ -591,11 +591,6 @@ def _lapack_solve(factors, b):
 #: g (the edge pinned for good below rate 1e-29, the time budget spent; 1.4999998 at 1e-28)
 RELAXED_SPEEDS = 10.0
 RELAXED_LIMIT = 1e-10
-#: the crack-front integrator's first step is at least this many float spacings of its start
-#: time (:func:`unload`)
-FIRST_STEP_SPACINGS = 1e3
-
-
 def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
            a_end=0.02, time_budget_s=0.0) -> CrackFrontSolution:
     r"""Unload a relaxed JKR contact at constant speed with the crack-front model.
@@ -688,13 +683,8 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
     pulloff = None                      # (t, a) of the first tensile load minimum
     runaway = None                      # past the pull-off, where the edge ran away
     try:
-        # the first step at least a few of the float spacings at t1: below rate ~1e-29 the
-        # pinned phase ends at t1 ~ 1e30 tau0, where 1e-3 tau0 is no step at all (the
-        # integrator stalled until the time budget, or found no step)
-        first = max(min(1e-6 * span, 1e-3 / max(rate, 1.0)), FIRST_STEP_SPACINGS
-                    * float(np.spacing(abs(t1) + span)))
         solver = Radau(rhs, t1, [a0], t1 + span, rtol=rtol, atol=atol, jac=jac,
-                       first_step=first)
+                       first_step=min(1e-6 * span, 1e-3 / max(rate, 1.0)))
         solver.lu, solver.solve_lu = _lapack_lu, _lapack_solve
         while True:
             message = solver.step()
