@@ -266,18 +266,44 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "a0_si", "indentatio
 @click.option("--nodes", type=str, default=None, help="Override the preset's node count.")
 @click.option("--domain", type=str, default=None, help="Mesh radius (a_ref); default automatic.")
 @click.option("--step", type=str, default=None, help="Largest indentation step (units of h0).")
+@click.option("--band-resolution", "band_resolution", type=str, default=None,
+              help="Override the preset's fine spacing: tip zone / band_resolution.")
+@click.option("--max-nodes", "max_nodes", type=str, default=None,
+              help="Override the preset's largest mesh (nodes).")
+@click.option("--max-steps", "max_steps", type=str, default=None,
+              help="Override the preset's largest number of steps.")
+@click.option("--time-budget", "time_budget_s", type=str, default=None,
+              help="The scene's time budget [s] (0: none).")
 @click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
-def scene_command(preset, pull_off_rtol, nodes, domain, step, exact, as_json, trajectory, si,
-                  **values):
+def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, max_nodes,
+                  max_steps, time_budget_s, exact, as_json, trajectory, si, **values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .engine.models import simulate
 
     si_values = {name: values.pop(name) for name in _SI_OPTIONS}
     axes = values
+    overrides = {}
+    if nodes is not None:               # its range: Numerics's
+        overrides["nodes"] = check_int("nodes", nodes)
+    if domain is not None:
+        overrides["domain"] = as_float("domain", domain)
+    if step is not None:
+        overrides["step"] = as_float("step", step)
+    # the knobs a failure's advice names (raise band_resolution, max_nodes, max_steps or
+    # time_budget_s); their ranges: Numerics's
+    for name, value, read in (("band_resolution", band_resolution, as_float),
+                              ("max_nodes", max_nodes, check_int),
+                              ("max_steps", max_steps, check_int),
+                              ("time_budget_s", time_budget_s, as_float)):
+        if value is not None:
+            overrides[name] = read(name, value)
+    if exact:
+        overrides["exact"] = True
+    num = _scene_numerics(preset, pull_off_rtol, overrides)
     if si:
-        _scene_si(axes, as_json, si_values)
+        _scene_si(axes, as_json, si_values, num)
         return
     given = [f"--{name.replace('_', '-')}" for name, v in si_values.items() if v is not None]
     if given:
@@ -287,16 +313,6 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, exact, as_json, tr
     if missing:
         raise InputError(f"{', '.join(missing)} must be given (or use --si)")
     sc = scene_from_options(axes)
-    overrides = {}
-    if nodes is not None:               # its range: Numerics's
-        overrides["nodes"] = check_int("nodes", nodes)
-    if domain is not None:
-        overrides["domain"] = as_float("domain", domain)
-    if step is not None:
-        overrides["step"] = as_float("step", step)
-    if exact:
-        overrides["exact"] = True
-    num = _scene_numerics(preset, pull_off_rtol, overrides)
     res = simulate(sc, num)
     if as_json:
         echo_json(res.to_dict(trajectory=trajectory))
@@ -409,8 +425,9 @@ def scene_text(res, preset: str) -> list[str]:
     return lines
 
 
-def _scene_si(axes, as_json, values):
-    """``sweep scene --si``: build an SIScene, run it, print both unit systems."""
+def _scene_si(axes, as_json, values, numerics):
+    """``sweep scene --si``: build an SIScene, run it at ``numerics``, print both unit
+    systems."""
     from .campaign.si import run_si, si_point
 
     ctx = click.get_current_context()
@@ -441,7 +458,7 @@ def _scene_si(axes, as_json, values):
     # the checks of a `units: si` config's point: the derived scene within the Scene's ranges
     si, _ = si_point({"n": as_float("n", n), "material": material, "model": model,
                       "stop": axes["stop"], **pz, **kw}, "--si")
-    out = run_si(si, model)
+    out = run_si(si, model, numerics)
     if as_json:
         echo_json(out)
     else:

@@ -189,3 +189,34 @@ def test_scene_text_shows_a_protocols_cycle_and_its_error(capsys):
     assert main(["scene", "--n", "0.5", "--k", "1", "--mu", "5", "--rate", "10",
                  "--a0", "2"]) == 0
     assert "cycle" not in capsys.readouterr().out
+
+
+def test_scene_takes_the_knobs_its_advice_names(capsys):
+    """A failure's advice names band_resolution, max_nodes, max_steps and time_budget_s;
+    `sweep scene` had none of these options. Each reaches the row's numerics."""
+    assert main(SCENE + ["--band-resolution", "12", "--max-nodes", "500", "--max-steps", "1e5",
+                         "--time-budget", "60", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert (out["num_band_resolution"], out["num_max_nodes"], out["num_max_steps"],
+            out["num_time_budget_s"]) == (12.0, 500, 100000, 60.0)
+    assert main(SCENE + ["--band-resolution", "1"]) == 2
+    assert "band_resolution must be in [2, 500] (got 1)" in capsys.readouterr().err
+
+
+def test_scene_si_runs_at_the_numerics_asked_for(capsys):
+    """`sweep scene --si` ignored --preset (and every numerics option): the fast and the
+    accurate presets gave the balanced row. Independent value: run_si at those numerics."""
+    from sweep import Numerics
+    from sweep.campaign.si import SIScene, run_si
+
+    si = ["scene", "--si", "--R", "1e-4", "--E0", "1e6", "--Einf", "1e7", "--nu", "0.5", "--n",
+          "0.8", "--tau0", "0.1", "--dg", "0.05", "--h0", "2e-7", "--a0-si", "1e-5", "--speed",
+          "1e-6", "--model", "bem", "--json"]
+    pull_offs = {}
+    for preset in ("fast", "accurate"):
+        assert main(si + ["--preset", preset]) == 0
+        pull_offs[preset] = json.loads(capsys.readouterr().out)["pull_off"]
+    assert pull_offs["fast"] != pull_offs["accurate"]
+    scene = SIScene(n=0.8, R=1e-4, E0=1e6, Einf=1e7, nu=0.5, tau0=0.1, dg=0.05, h0=2e-7,
+                    a0=1e-5, speed=1e-6)
+    assert pull_offs["fast"] == run_si(scene, "bem", Numerics.preset("fast"))["pull_off"]
