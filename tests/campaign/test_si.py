@@ -455,33 +455,3 @@ def test_cli_scene_si_machine_stiffness_in_n_per_m(capsys):
     assert d["scene"]["machine_stiffness"] == pytest.approx(
         2e3 * d["d_ref_m"] / d["load_ref_N"], rel=1e-12)
     assert d["status"] == "failed" and "machine_stiffness" in d["reason"]
-
-
-def test_a_results_file_holds_its_tables_as_they_were_run(tmp_path, capsys, monkeypatch):
-    """A config whose material is a table file records the config with the table inline: a
-    table edited after a run grows the file's grid (it had taken the earlier scenes for the
-    edited table's: "4 finished of 2"), and `sweep info --si` reads the file after the table
-    has gone (it had refused: "cannot read the Prony table")."""
-    from sweep.campaign.store import load
-
-    monkeypatch.chdir(tmp_path)
-    table = tmp_path / "tab.csv"
-    table.write_text("# visco-sweep prony\n# E0 = 1e6\n# modulus_unit = Pa\n# time_unit = s\n"
-                     "tau,E\n1.0,9e6\n")
-    cfg = tmp_path / "t.yaml"
-    cfg.write_text("name: t\nunits: si\ngrid: {material: {prony: tab.csv}, R: 5e-3, nu: 0.5, "
-                   "dg: 0.05, h0: 2e-7, a0: 1e-4, speed: [1e-6, 1e-5], model: crack}\n"
-                   "output: t.h5\n")
-    assert main(["run", str(cfg), "-j", "1", "--progress", "none"]) == 0
-    table.write_text(table.read_text().replace("9e6", "5e6"))
-    assert main(["run", str(cfg), "-j", "1", "--progress", "none"]) == 0
-    rows = load(tmp_path / "t.h5")
-    assert len(rows) == 4 and rows.material.nunique() == 2
-    capsys.readouterr()
-    assert main(["info", str(tmp_path / "t.h5")]) == 0
-    out = capsys.readouterr().out
-    assert "grown: the grid is the union of this config and 1 earlier one" in out
-    assert "scenes: 4 finished of 4" in out
-    table.unlink()
-    assert main(["info", str(tmp_path / "t.h5"), "--si"]) == 0
-    assert len(capsys.readouterr().out.splitlines()) == 1 + 4
