@@ -233,3 +233,19 @@ def test_a_process_zone_runs_the_crack_front_model_and_the_others_refuse_it(k):
         assert "pz_law gent-schultz" in r.reason and "model bem, crack or auto" in r.reason
         assert not is_physical_refusal(r.reason)      # another model answers it
         assert r.model_used == model
+
+
+def test_auto_keeps_an_unresolved_bem_row_nearer_than_the_crack_front_model():
+    """A process zone at mu 3.24 (fast preset): the BEM's row is unresolved (estimate 0.081
+    against pull_off_rtol 0.03) and the crack-front model's measured error there is 0.9.
+    auto swapped the first for the second, "ok" with a 90 % error; the BEM's row stays, its
+    reason saying why (in a sweep, a row estimated 0.041 had become one "ok" at 4.65)."""
+    scene = Scene(n=0.4, k=0.1, mu=3.24, a0=3.0, rate=10.0, pz_law="gent-schultz", pz_v0=0.1,
+                  pz_xi=0.4, model="auto")
+    res = models.simulate(scene, Numerics.preset("fast"))
+    assert res.status == "failed" and res.model_used == "bem"
+    assert res.reason.startswith("unresolved:")
+    assert "crack-front model's measured error" in res.reason
+    assert res.error_estimate < 0.3 and math.isfinite(res.pull_off)
+    crack = models.simulate(Scene(**{**scene.to_dict(), "model": "crack"}), Numerics.preset("fast"))
+    assert crack.ok and crack.error_estimate > res.error_estimate
