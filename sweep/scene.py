@@ -302,10 +302,12 @@ class Scene:
     stop : {"pulloff", "separation"}
         Stop right after the load minimum has passed and recovered ("pulloff"), or follow
         the whole curve until the contact is lost ("separation").
-    model : {"bem", "crack", "pb", "auto"}
+    model : {"bem", "crack", "pb", "elastic", "auto"}
         Which model runs the scene (:mod:`sweep.engine.models`): the BEM (default), the crack-front
-        model, the paper's closed-form PB estimate, or "auto" (the BEM where its mesh fits the
-        numerics' node count, else the crack-front model); ``Result.model_used`` records it.
+        model, the paper's closed-form PB estimate, the quasi-static elastic branch (k = 1), or
+        "auto" (the cheapest whose measured error meets ``pull_off_rtol``, else the BEM, and the
+        crack-front model where the BEM fails for a reason it lifts: docs/models.md);
+        ``Result.model_used`` records it.
     pz_law : {"none", "gent-schultz"}
         Rate-dependent process zone of the interface: "none" (default; the work of adhesion
         dg is rate independent, the BEM's Lennard-Jones law) or "gent-schultz",
@@ -742,8 +744,14 @@ class Numerics:
 
     @classmethod
     def preset(cls, name: str = "balanced", **overrides) -> "Numerics":
-        """Numerics of a named preset ("fast", "balanced", "accurate"), with overrides."""
+        """Numerics of a named preset ("fast", "balanced", "accurate"), with overrides (an
+        unknown one: InputError naming the allowed fields, as :meth:`from_dict`)."""
         check_choice("preset", name, PRESETS)
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = set(overrides) - names
+        if unknown:
+            raise InputError(f"numerics: unknown key(s) {', '.join(sorted(unknown))} "
+                             f"(allowed: {', '.join(sorted(names))})")
         return cls(**{**PRESETS[name], **overrides})
 
     def to_dict(self) -> dict:
@@ -844,7 +852,10 @@ class Result:
     a_pulloff, a_inner_pulloff : float
         Max-tension radius (gap = 3^(1/6) h0) and inner radius (gap = h0) at pull-off, a_ref.
     delta_pulloff, t_pulloff : float
-        Indentation (d_ref) and time since the start of unloading (tau0) at pull-off.
+        Indentation (d_ref) and time (tau0) at pull-off: since the start of unloading, or
+        with a test protocol since first contact (the records' clock runs through the
+        approach, the dwell and the retraction; the retraction's start is the first record
+        of ``trajectory["phase"] == 2``).
     crack_speed : float
         v_a = -da/dt at pull-off, in a_ref / tau0 (local fit of a(t)).
     vhat : float

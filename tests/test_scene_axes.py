@@ -81,3 +81,14 @@ def test_a_value_just_past_a_bound_is_printed_in_full():
         with pytest.raises(InputError) as info:
             Scene(n=0.8, k=k, mu=3.24, a0=2.0, rate=10.0)
         assert str(info.value) == f"k must be in (0, 1] {got}"
+
+
+def test_a_preset_with_an_unknown_override_names_the_allowed_fields():
+    """Numerics.preset("fast", bogus=1) raised a plain TypeError, where from_dict names the
+    allowed keys in an InputError (a one-line message at the CLI)."""
+    from sweep import Numerics
+    from sweep.errors import InputError
+
+    with pytest.raises(InputError, match=r"numerics: unknown key\(s\) bogus \(allowed: "):
+        Numerics.preset("fast", bogus=1)
+    assert Numerics.preset("fast", nodes=120).nodes == 120

@@ -248,6 +248,10 @@ def _read_data(path: Path) -> tuple:
         if col not in header:
             raise InputError(f"{where}: missing column {col} (columns speed_m_s, pull_off_N "
                              f"and optional sigma_N; got {', '.join(header) or 'none'})")
+    unknown = [col for col in header if col not in (*DATA_COLUMNS, "sigma_N")]
+    if unknown:     # a misspelt sigma_N was an unweighted fit, silently
+        raise InputError(f"{where}: unknown column(s) {', '.join(unknown)} (columns speed_m_s, "
+                         f"pull_off_N and optional sigma_N)")
     for i, (number, fields) in enumerate(rows[1:], 1):
         if len(fields) != len(header):
             raise InputError(f"{where}: row {i} (line {number}) has {len(fields)} fields, the "
@@ -345,7 +349,8 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
             fixed[key] = check_choice(f"fixed.{key}", v, PZ_LAWS)
             continue
         if key not in FIT_FIELDS:
-            raise InputError(f"fixed.{key}: unknown SI field (allowed: {', '.join(FIT_FIELDS)})")
+            raise InputError(f"fixed.{key}: unknown SI field (allowed: "
+                             f"{', '.join(FIT_FIELDS)}, pz_law)")
         lo, hi, lo_open = _limits(key)
         fixed[key] = check_range(f"fixed.{key}", v, lo, hi, lo_open=lo_open)
     params = []

@@ -285,6 +285,9 @@ def test_bad_files_one_line_exit_2(tmp_path, capsys, change, words):
      "pull_off_N must be a number > 0 (row 2: empty)"),
     ("speed_m_s,pull_off_N\n1e-6,0.0145\n1e-5,abc\n1e-4,0.03\n",
      "pull_off_N must be a number > 0 (row 2: abc)"),
+    # a misspelt sigma_N: an unweighted fit, silently
+    ("speed_m_s,pull_off_N,sigma_n\n1e-4,0.02,0.001\n1e-3,0.03,0.001\n",
+     "unknown column(s) sigma_n (columns speed_m_s, pull_off_N and optional sigma_N)"),
 ])
 def test_data_rows_must_match_the_header(tmp_path, capsys, csv, words):
     path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED)
