@@ -207,3 +207,13 @@ def is_physical_refusal(reason: str) -> bool:
     """Whether a failed result's ``reason`` is a physical refusal (:data:`PHYSICAL_REFUSALS`):
     the scene's physics has no answer, as opposed to a numerical failure."""
     return any(reason.startswith(p) for p in PHYSICAL_REFUSALS)
+
+
+def shortened(reason: str, limit: int) -> str:
+    """``reason`` as quoted inside another (a fallback's, a refinement's): whole where it has
+    at most ``limit`` characters, else cut at the last word boundary before it, with " ..."
+    (a cut mid-word read "... above pull_o)")."""
+    if len(reason) <= limit:
+        return reason
+    cut = reason[:limit].rsplit(" ", 1)[0].rstrip(",;:(")
+    return f"{cut} ..."

@@ -468,6 +468,23 @@ def test_log_lines_name_the_scene_inputs(tmp_path, monkeypatch, capsys):
                 f"rate={scene.rate:g} pull_off=") in line
 
 
+def test_log_lines_tell_apart_scenes_that_differ_in_their_protocol_or_zone():
+    """A grid over dwell, dwell_hold or a process zone printed four identical lines ("ok n=0.5
+    k=0.2 mu=5 rate=1"): the fields a scene has are named, the defaults left out."""
+    from sweep.campaign.scheduler import scene_inputs
+
+    plain = dict(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0, material="mpl", model="bem",
+                 stop="pulloff", pz_law="none", dwell_hold="force")
+    assert scene_inputs(plain) == "n=0.8 k=0.1 mu=3.24 a0=2 rate=10"
+    protocol = {**plain, "a0": None, "approach_rate": 1.0, "preload": 2.0, "dwell": 10.0}
+    assert scene_inputs({**protocol, "dwell_hold": "depth"}) == (
+        "n=0.8 k=0.1 mu=3.24 rate=10 approach_rate=1 preload=2 dwell=10 dwell_hold=depth")
+    assert scene_inputs(protocol).endswith("dwell=10")
+    zone = {**plain, "pz_law": "gent-schultz", "pz_v0": 0.1, "pz_xi": 0.4, "stop": "separation"}
+    assert scene_inputs(zone) == ("n=0.8 k=0.1 mu=3.24 a0=2 rate=10 pz_v0=0.1 pz_xi=0.4 "
+                                  "pz_law=gent-schultz stop=separation")
+
+
 def test_first_run_says_it_compiles(monkeypatch):
     from sweep.campaign import scheduler
     from sweep.engine import bem

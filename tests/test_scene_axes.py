@@ -92,3 +92,12 @@ def test_a_preset_with_an_unknown_override_names_the_allowed_fields():
     with pytest.raises(InputError, match=r"numerics: unknown key\(s\) bogus \(allowed: "):
         Numerics.preset("fast", bogus=1)
     assert Numerics.preset("fast", nodes=120).nodes == 120
+
+
+def test_a_quoted_reason_is_cut_at_a_word():
+    """A fallback quoting the BEM's reason cut it mid-word ("... above pull_o)")."""
+    from sweep.errors import shortened
+
+    text = "unresolved: the pull-off moves by 0.046, above pull_off_rtol = 0.03; raise it"
+    assert shortened(text, 200) == text
+    assert shortened(text, 50) == "unresolved: the pull-off moves by 0.046, above ..."

@@ -237,13 +237,20 @@ def _num(x) -> str | None:
 
 def scene_inputs(row: dict) -> str:
     """The inputs of a scene as ``n=0.8 k=0.5 mu=3.24 a0=2 rate=100`` (``delta0=`` for a
-    scene started from an indentation; ``material=`` and ``model=`` when not the default)."""
+    scene started from an indentation; a test protocol's, a process zone's and a compliant
+    machine's fields where the scene has them; ``material=``, ``model=``, ``stop=``,
+    ``dwell_hold=`` when not the default), so that the scenes of a grid over any axis are
+    told apart."""
     parts = []
-    for name in ("n", "k", "mu", "a0", "delta0", "rate"):
+    for name in ("n", "k", "mu", "a0", "delta0", "rate", "approach_rate", "preload", "dwell",
+                 "pz_v0", "pz_xi", "machine_stiffness"):
         v = _num(row.get(name))
         if v is not None:
             parts.append(f"{name}={v}")
-    for name, default in (("material", "mpl"), ("model", "bem")):
+    protocol = _num(row.get("dwell")) is not None
+    for name, default in (("dwell_hold", "force" if protocol else row.get("dwell_hold")),
+                          ("pz_law", "none"), ("material", "mpl"), ("model", "bem"),
+                          ("stop", "pulloff")):
         v = row.get(name)
         if v not in (None, "", default):
             parts.append(f"{name}={v}")

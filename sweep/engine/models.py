@@ -48,7 +48,7 @@ from typing import NamedTuple
 
 from .. import units
 from ..errors import (NUMERICAL_ERRORS, check_choice, check_positive, is_internal_error,
-                      is_physical_refusal)
+                      is_physical_refusal, shortened)
 from ..scene import MATERIALS, Numerics, Result, Scene, SceneTable
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem, budget
@@ -153,7 +153,7 @@ def _bem(scene, numerics=None):
             break
         if not (attempt.ok or (_refinable(attempt, scene) and not _folded(attempt))):
             res.reason += (f"; refined to band_resolution {finer.band_resolution:.4g}, step "
-                           f"{finer.step:.3g}: {attempt.reason[:160]}")
+                           f"{finer.step:.3g}: {shortened(attempt.reason, 160)}")
             break
         res, used, count = attempt, finer, count + 1
     if _refinable(res, scene) and count < numerics.refinements and budget.remaining() <= 0:
@@ -401,7 +401,7 @@ def _fallback(scene, failed: Result, model: str) -> Choice | None:
             or scene.protocol() is not None):
         return None
     return Choice("crack", f"auto: crack-front model: the {NAMES[model]} failed "
-                           f"({failed.reason[:160]})")
+                           f"({shortened(failed.reason, 160)})")
 
 
 #: model name -> simulate(scene, numerics=None) -> Result
@@ -537,14 +537,14 @@ def _simulate_model(scene, model: str, numerics) -> Result:
         # contact, which a DMT-like contact (mu 0.01, a small preload) need not reach: the
         # BEM marches it
         choice = Choice("bem", f"{model}: BEM: the elastic branch failed the test protocol "
-                               f"({res.reason[:120]})")
+                               f"({shortened(res.reason, 120)})")
         res = run("bem")
     if model == "auto" and choice.model in ("crack", "pb") and scene.mu <= BEM_MU_RANGE[1] \
             and not res.error_estimate <= numerics.pull_off_rtol:
         miss = (f"auto: BEM: the {NAMES[choice.model]}'s measured error at its amplification "
                 f"{amplification(res.pull_off):.3g}, {res.error_estimate:.2g}, exceeds "
                 f"pull_off_rtol {numerics.pull_off_rtol:g}" if res.ok else
-                f"auto: BEM: the {NAMES[choice.model]} failed ({res.reason[:120]})")
+                f"auto: BEM: the {NAMES[choice.model]} failed ({shortened(res.reason, 120)})")
         choice, res = Choice("bem", miss), run("bem")
     if model == "auto" and choice.model in ("bem", "elastic") and res.status == "failed":
         fallback = _fallback(scene, res, choice.model)

@@ -11,6 +11,7 @@ import dataclasses
 import math
 from typing import Callable
 
+from ..errors import shortened
 from ..scene import Numerics, Result
 from . import budget
 from .postprocess import cycle_end, work_quadrature_error
@@ -267,7 +268,7 @@ def estimate_error(res: Result, length: float, solve: Callable[[Numerics], Resul
     else:
         res.error_estimate = resolution_error(res.spacing, length) + prony
         note = (f"error estimate a priori, {RESOLUTION_ERROR_K:g} (spacing/tip zone)^2: the "
-                f"check on a coarser mesh failed ({coarse.reason[:120]})")
+                f"check on a coarser mesh failed ({shortened(coarse.reason, 120)})")
         res.reason = f"{res.reason}; {note}" if res.reason else note
         how = f"the a-priori estimate {res.error_estimate:.2g}"
     if res.error_estimate > tol:
