@@ -301,6 +301,10 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, m
             overrides[name] = read(name, value)
     if exact:
         overrides["exact"] = True
+    meshless = [f"--{name.replace('_', '-')}" for name in MESH_OPTIONS if name in overrides]
+    if axes["model"] in ("crack", "pb") and meshless:      # accepted and ignored, before
+        raise InputError(f"{', '.join(meshless)}: model {axes['model']} has no mesh and no "
+                         f"time steps (the BEM's and the elastic branch's options)")
     num = _scene_numerics(preset, pull_off_rtol, overrides)
     if si:
         _scene_si(axes, as_json, si_values, num)
@@ -330,6 +334,10 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, m
             click.echo(line)
     if not res.ok:
         raise SystemExit(1)
+
+
+#: `sweep scene`'s numerics options that only a model with a mesh reads (bem, elastic)
+MESH_OPTIONS = ("nodes", "domain", "step", "band_resolution", "max_nodes", "max_steps", "exact")
 
 
 def _scene_numerics(preset: str, pull_off_rtol: str | None, overrides: dict) -> Numerics:
@@ -641,6 +649,13 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
 
         figure_path("plot", plot_out)
     data = read_dma_csv(csv_file, T_ref=as_float("tref", tref), wlf=tuple(c))
+    ctx = click.get_current_context()
+    shifts = [f"--{name}" for name in ("tref", "wlf")
+              if ctx.get_parameter_source(name) == ParameterSource.COMMANDLINE]
+    if shifts and data.kind == "master":     # given and ignored, silently, before
+        raise InputError(f"{', '.join(shifts)}: {csv_file} is a master curve (omega_rad_s, "
+                         f"E_storage_Pa, E_loss_Pa); the WLF shift applies to a temperature "
+                         f"sweep (T_C, f_Hz, ...)")
     mpl = fit_mpl(data)
     mx = fit_maxwell(data, n_arms) if n_arms > 0 else None
     kk = kramers_kronig_check(data, noise=check_range("noise", as_float("noise", noise),

@@ -220,3 +220,15 @@ def test_scene_si_runs_at_the_numerics_asked_for(capsys):
     scene = SIScene(n=0.8, R=1e-4, E0=1e6, Einf=1e7, nu=0.5, tau0=0.1, dg=0.05, h0=2e-7,
                     a0=1e-5, speed=1e-6)
     assert pull_offs["fast"] == run_si(scene, "bem", Numerics.preset("fast"))["pull_off"]
+
+
+def test_scene_refuses_mesh_options_for_a_model_without_a_mesh(capsys):
+    """`--model crack --nodes 100 --exact` (or pb) was accepted and ignored; a time budget
+    applies to every model and stays accepted."""
+    base = ["scene", "--n", "0.8", "--k", "0.1", "--mu", "3.24", "--a0", "2", "--rate", "10"]
+    assert main(base + ["--model", "crack", "--nodes", "100", "--exact"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "error: --nodes, --exact: model crack has no mesh and no time steps (the BEM's and "
+        "the elastic branch's options)")
+    assert main(base + ["--model", "pb", "--band-resolution", "20"]) == 2
+    assert main(base + ["--model", "crack", "--time-budget", "30", "--json"]) == 0

@@ -135,6 +135,18 @@ def write_master(path, w, E):
     path.write_text("\n".join(lines) + "\n")
 
 
+def test_cli_fit_dma_refuses_a_wlf_shift_of_a_master_curve(tmp_path, capsys):
+    """--tref and --wlf apply to a temperature sweep; on a master curve they were accepted
+    and ignored, silently."""
+    w = np.logspace(-2, 19, 43)
+    p = tmp_path / "master.csv"
+    write_master(p, w, MPLRetardation(**TRUE).complex_modulus(w))
+    for extra in (["--tref", "0"], ["--wlf", "17,51,-120"]):
+        assert main(["fit-dma", str(p), "--maxwell", "0", *extra]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith(f"error: {extra[0]}: ") and "is a master curve" in err
+
+
 def test_cli_fit_dma_json(tmp_path, capsys):
     w = np.logspace(-2, 19, 43)
     E = MPLRetardation(**TRUE).complex_modulus(w)
