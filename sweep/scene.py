@@ -249,9 +249,10 @@ def scene_table(value, *, base_dir=None, nu=None) -> SceneTable:
     if tau0 != 1.0:
         digest = hashlib.sha256(f"{digest};tau0={tau0:.9e}".encode()).hexdigest()[:16]
     col = "E" if value.form == "wiechert" else "c"
+    # both moduli as read, so that the spec reads back to the same numbers, E0 to the last
+    # digit (derived from Einf, a Wiechert table's E0 moved by one: an SI scene's mu, its id)
     spec = {"form": value.form, "tau": value.times.tolist(), col: value.weights.tolist(),
-            **({"Einf": float(value.Einf)} if value.form == "wiechert"
-               else {"E0": float(value.E0)}),
+            "E0": float(value.E0), "Einf": float(value.Einf), "recorded": True,
             "name": value.name}
     if value.modulus_unit is not None:
         spec.update(modulus_unit=value.modulus_unit, time_unit=value.time_unit)

@@ -163,6 +163,20 @@ class SweepConfig:
                           sort_keys=True, separators=(",", ":"))
         return hashlib.sha1(text.encode()).hexdigest()[:16]
 
+    @property
+    def recorded_text(self) -> str:
+        """The config text a results file records: ``text`` itself, or where a material is
+        a Prony table read from a file (``{prony: path}``), the config with every table
+        inline (:meth:`to_dict`) as it was read. The file then says what it holds on its
+        own: a table edited since grows the file's grid like any changed axis value (its
+        earlier scenes had been taken for the edited table's, "4 finished of 2"), and
+        ``sweep info --si`` reads the file where the table is not (it had refused, "cannot
+        read the Prony table")."""
+        if not _names_a_file(yaml.safe_load(self.text) if self.text else None):
+            return self.text
+        return (f"# {self.source}, as run: its Prony tables inline as they were read\n"
+                + yaml.safe_dump(self.to_dict(), sort_keys=False))
+
     def output_path(self, out: str | os.PathLike | None = None) -> Path:
         """Absolute output path (``out`` overrides ``output``; relative to the cwd)."""
         p = Path(out if out is not None else self.output).expanduser()
@@ -183,6 +197,15 @@ class SweepConfig:
             "store": {"trajectories": self.trajectories},
             "output": self.output,
         }
+
+
+def _names_a_file(data) -> bool:
+    """Whether parsed config ``data`` holds a Prony table given by a file (``{prony: ...}``)."""
+    if isinstance(data, dict):
+        return "prony" in data or any(_names_a_file(v) for v in data.values())
+    if isinstance(data, list):
+        return any(_names_a_file(v) for v in data)
+    return False
 
 
 class UniqueKeyLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):

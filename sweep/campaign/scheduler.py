@@ -532,7 +532,7 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
     tasks = cfg.tasks()
 
     store = ResultStore(path, config_hash=cfg.config_hash, config_name=cfg.name,
-                        config_text=cfg.text, config_source=cfg.source, n_scenes=len(tasks),
+                        config_text=cfg.recorded_text, config_source=cfg.source, n_scenes=len(tasks),
                         trajectories=cfg.trajectories, template_row=template_row(cfg),
                         interval=consolidate_every, config=cfg)
     try:

@@ -143,7 +143,11 @@ _ACCEPTED = ("a visco-sweep Prony CSV ('# visco-sweep prony' first line, header 
              "row), an ANSYS TB,PRONY card, or the JSON of sweep fit-dma --json")
 _MARKER = "visco-sweep prony"
 _CSV_KEYS = ("form", "E0", "Einf", "modulus_unit", "time_unit")
-_INLINE_KEYS = ("tau", "E", "c", "form", "E0", "Einf", "modulus_unit", "time_unit", "name")
+_INLINE_KEYS = ("tau", "E", "c", "form", "E0", "Einf", "modulus_unit", "time_unit", "name",
+                "recorded")
+#: a recorded table's two moduli (``recorded: true``) agree with each other to this (they
+#: were computed from each other when the table was first read)
+RECORDED_RTOL = 1e-9
 _FILE_KEYS = ("prony", "nu", "Einf", "name")
 _FORMS = {"wiechert": "wiechert", "maxwell": "wiechert", "kelvin": "kelvin"}
 _HASH_DIGITS = 10
@@ -354,6 +358,7 @@ def _make(form, tau, w, *, E0=None, Einf=None, where, fmt, name, source, units_k
                          f"without one the material is elastic, k = 1)")
     order = np.argsort(tau[keep], kind="stable")
     tau, w = tau[keep][order], w[keep][order]
+    recorded = E0 is not None and Einf is not None     # both: a table as it was read
     if form == "kelvin":
         s = float(w.sum())
         if not s < 1.0:
@@ -361,7 +366,7 @@ def _make(form, tau, w, *, E0=None, Einf=None, where, fmt, name, source, units_k
                              f"is Einf (1 - sum c)) (got sum {s:.6g})")
         if E0 is None:
             E0 = Einf * (1.0 - s)
-        Einf = E0 / (1.0 - s)
+        derived = E0 / (1.0 - s)
         kind = "kelvin"
     else:
         s = float(w.sum())
@@ -371,8 +376,12 @@ def _make(form, tau, w, *, E0=None, Einf=None, where, fmt, name, source, units_k
                 raise InputError(f"{where}: Einf = {Einf:.6g} must exceed the sum of the arm "
                                  f"moduli {s:.6g} (the relaxed modulus Einf - sum E must be "
                                  f"> 0; a liquid has no relaxed contact)")
-        Einf = E0 + s
+        derived = E0 + s
         kind = "maxwell"
+    if recorded and not math.isclose(derived, Einf, rel_tol=RECORDED_RTOL):
+        raise InputError(f"{where}: E0 = {E0:.6g} and Einf = {Einf:.6g} disagree (the table "
+                         f"gives Einf = {derived:.10g} from E0); give one of them")
+    Einf = Einf if recorded else derived
     if not (math.isfinite(E0) and E0 > 0.0):
         raise InputError(f"{where}: the relaxed modulus E0 must be > 0 (got {E0:.6g})")
     material = Prony(w, tau, E0=E0, kind=kind)
@@ -450,7 +459,8 @@ def _inline(spec, where, fmt, name, source):
         raise InputError(f"{where} needs tau, the list of times (got keys {', '.join(spec)})")
     tau = _numbers(f"{where} tau", spec["tau"])
     w = _numbers(f"{where} {col}", spec[col])
-    E0, Einf, m_scale = _plateau(where, spec.get("E0"), spec.get("Einf"), spec.get("modulus_unit"))
+    E0, Einf, m_scale = _plateau(where, spec.get("E0"), spec.get("Einf"),
+                                 spec.get("modulus_unit"), recorded=bool(spec.get("recorded")))
     t_scale = 1.0
     if spec.get("time_unit") is not None:
         t_scale = _unit(where, spec["time_unit"], TIME_UNITS, "time_unit: time")
@@ -469,20 +479,26 @@ def _numbers(where, values) -> np.ndarray:
     return np.array([_number(f"{where}[{i}]", v) for i, v in enumerate(values)], dtype=float)
 
 
-def _plateau(where, E0, Einf, modulus_unit):
-    """The one given plateau modulus, scaled by the modulus unit: (E0, Einf, scale)."""
-    if (E0 is None) == (Einf is None):
+def _plateau(where, E0, Einf, modulus_unit, recorded=False):
+    """The given plateau modulus, scaled by the modulus unit: (E0, Einf, scale), one of them
+    None; both where ``recorded`` (a table as a results file records it, both moduli as they
+    were read, so that it reads back to the same numbers: :func:`_make` checks they agree)."""
+    if (E0 is None) == (Einf is None) and not (recorded and E0 is not None):
         raise InputError(f"{where} needs exactly one of E0 (relaxed modulus) or Einf "
                          f"(instantaneous modulus) (got {'both' if E0 is not None else 'neither'})")
     scale = 1.0
     if modulus_unit is not None:
         scale = _unit(where, modulus_unit, MODULUS_UNITS, "modulus_unit: modulus")
-    name, value = ("E0", E0) if E0 is not None else ("Einf", Einf)
-    x = _number(f"{where} {name}", value)
-    if not x > 0.0:
-        raise InputError(f"{where}: {name} must be > 0 (got {x:g})")
-    x *= scale
-    return (x, None, scale) if name == "E0" else (None, x, scale)
+    out = []
+    for name, value in (("E0", E0), ("Einf", Einf)):
+        if value is None:
+            out.append(None)
+            continue
+        x = _number(f"{where} {name}", value)
+        if not x > 0.0:
+            raise InputError(f"{where}: {name} must be > 0 (got {x:g})")
+        out.append(x * scale)
+    return out[0], out[1], scale
 
 
 # ============================================================================ visco-sweep CSV

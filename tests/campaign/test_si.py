@@ -455,3 +455,65 @@ def test_cli_scene_si_machine_stiffness_in_n_per_m(capsys):
     assert d["scene"]["machine_stiffness"] == pytest.approx(
         2e3 * d["d_ref_m"] / d["load_ref_N"], rel=1e-12)
     assert d["status"] == "failed" and "machine_stiffness" in d["reason"]
+
+
+def test_a_results_file_holds_its_tables_as_they_were_run(tmp_path, capsys, monkeypatch):
+    """A config whose material is a table file records the config with the table inline: a
+    table edited after a run grows the file's grid (it had taken the earlier scenes for the
+    edited table's: "4 finished of 2"), and `sweep info --si` reads the file after the table
+    has gone (it had refused: "cannot read the Prony table")."""
+    from sweep.campaign.store import load
+
+    monkeypatch.chdir(tmp_path)
+    table = tmp_path / "tab.csv"
+    table.write_text("# visco-sweep prony\n# E0 = 1e6\n# modulus_unit = Pa\n# time_unit = s\n"
+                     "tau,E\n1.0,9e6\n")
+    cfg = tmp_path / "t.yaml"
+    cfg.write_text("name: t\nunits: si\ngrid: {material: {prony: tab.csv}, R: 5e-3, nu: 0.5, "
+                   "dg: 0.05, h0: 2e-7, a0: 1e-4, speed: [1e-6, 1e-5], model: crack}\n"
+                   "output: t.h5\n")
+    assert main(["run", str(cfg), "-j", "1", "--progress", "none"]) == 0
+    table.write_text(table.read_text().replace("9e6", "5e6"))
+    assert main(["run", str(cfg), "-j", "1", "--progress", "none"]) == 0
+    rows = load(tmp_path / "t.h5")
+    assert len(rows) == 4 and rows.material.nunique() == 2
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "t.h5")]) == 0
+    out = capsys.readouterr().out
+    assert "grown: the grid is the union of this config and 1 earlier one" in out
+    assert "scenes: 4 finished of 4" in out
+    table.unlink()
+    assert main(["info", str(tmp_path / "t.h5"), "--si"]) == 0
+    assert len(capsys.readouterr().out.splitlines()) == 1 + 4
+
+
+def test_a_recorded_table_reads_back_to_the_same_scenes(tmp_path, capsys, monkeypatch):
+    """A fit-dma table (its relaxed modulus derived from Einf and the arms): recorded inline
+    with one modulus, it read back one last digit off, so the SI scenes' mu and ids moved
+    (`sweep info --si` raised KeyError; a grown file miscounted). Recorded with both moduli,
+    the config reads back to the same config hash, in every format of the table."""
+    from sweep.campaign.config import parse_config
+
+    monkeypatch.chdir(Path(__file__).resolve().parents[2])
+    for name in ("pdms_fit_dma.json", "pdms_prony.csv", "pdms_prony_ansys.mpl",
+                 "pdms_prony_visco_sweep.csv"):
+        cfg = parse_config(f"name: t\nunits: si\ngrid: {{material: {{prony: tests/data/prony/"
+                           f"{name}}}, R: 5.19e-3, nu: 0.5, dg: 0.1523, h0: 30.8e-9, "
+                           f"preload: 1.5e-3, speed: [1e-6, 1e-5], model: crack}}\n")
+        assert parse_config(cfg.recorded_text).config_hash == cfg.config_hash, name
+    cfg = tmp_path / "g.yaml"
+    cfg.write_text(f"name: g\nunits: si\ngrid: {{material: {{prony: {DATA_FIT}}}, R: 5.19e-3, "
+                   "nu: 0.5, dg: 0.1523, h0: 30.8e-9, preload: 1.5e-3, speed: [1e-6, 1e-5], "
+                   f"model: crack}}\noutput: {tmp_path / 'g.h5'}\n")
+    assert main(["run", str(cfg), "-j", "1", "--progress", "none"]) == 0
+    cfg.write_text(cfg.read_text().replace("[1e-6, 1e-5]", "[1e-6, 1e-5, 1e-4]"))
+    assert main(["run", str(cfg), "-j", "1", "--progress", "none"]) == 0
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "g.h5")]) == 0
+    assert "scenes: 3 finished of 3" in capsys.readouterr().out
+    assert main(["info", str(tmp_path / "g.h5"), "--si"]) == 0
+    assert len(capsys.readouterr().out.splitlines()) == 1 + 3
+
+
+#: a fit-dma JSON table (tests/data/prony), its relaxed modulus derived from Einf
+DATA_FIT = "tests/data/prony/pdms_fit_dma.json"
