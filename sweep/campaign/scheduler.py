@@ -247,10 +247,10 @@ def scene_inputs(row: dict) -> str:
         v = _num(row.get(name))
         if v is not None:
             parts.append(f"{name}={v}")
-    protocol = _num(row.get("dwell")) is not None
-    for name, default in (("dwell_hold", "force" if protocol else row.get("dwell_hold")),
-                          ("pz_law", "none"), ("material", "mpl"), ("model", "bem"),
-                          ("stop", "pulloff")):
+    defaults = {"pz_law": "none", "material": "mpl", "model": "bem", "stop": "pulloff"}
+    if _num(row.get("dwell")) is not None:       # what a dwell holds: a protocol's only
+        defaults = {"dwell_hold": "force", **defaults}
+    for name, default in defaults.items():
         v = row.get(name)
         if v not in (None, "", default):
             parts.append(f"{name}={v}")

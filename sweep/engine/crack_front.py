@@ -584,13 +584,6 @@ def _lapack_solve(factors, b):
     return x
 
 
-#: a scene whose Gamma(v)/dg - 1 at RELAXED_SPEEDS times its loading speed (a bound of the
-#: crack speed at the pull-off: 2.3 times it for JKR at Gamma = dg) is at most RELAXED_LIMIT is
-#: the relaxed limit, the JKR contact at Gamma = dg (:func:`simulate_crack`): below a rate of
-#: about 1e-11 (n 0.8, k 0.1, mu 3.24), where the integrator's g - 1 drowned in the rounding of
-#: g (the edge pinned for good below rate 1e-29, the time budget spent; 1.4999998 at 1e-28)
-RELAXED_SPEEDS = 10.0
-RELAXED_LIMIT = 1e-10
 def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
            a_end=0.02, time_budget_s=0.0) -> CrackFrontSolution:
     r"""Unload a relaxed JKR contact at constant speed with the crack-front model.
@@ -771,8 +764,8 @@ def unload(law, *, rate, mu, a0=None, delta0=None, stop="pulloff", rtol=1e-8,
         notes.append("crack speed at the end of the Persson-Brener table (Gamma ~ 1/k)")
     if runaway is not None:
         g_end = float(energy_release_rate(a[-1], d[-1]))
-        bound = (f" against the law's largest Gamma/dg, {g_max:.6g}" if math.isfinite(g_max)
-                 and hasattr(law, "g_max") else "")
+        bound = f" against the law's largest Gamma/dg, {g_max:.6g}" if hasattr(law, "g_max") \
+            else ""
         notes.append(f"followed to a = {runaway:.4g}, where the integrator finds no step (g = "
                      f"{g_end:.6g}{bound}): the edge runs away and the contact separates at "
                      f"once")
@@ -822,6 +815,15 @@ def crack_front_advice(scene) -> str:
     """", or use the crack-front model (model crack)" where that model runs ``scene``
     (:func:`answers`), else "": the end of a BEM failure's advice."""
     return ", or use the crack-front model (model crack)" if answers(scene) else ""
+
+
+#: a scene whose Gamma(v)/dg - 1 at RELAXED_SPEEDS times its loading speed (a bound of the
+#: crack speed at the pull-off: 2.3 times it for JKR at Gamma = dg) is at most RELAXED_LIMIT is
+#: the relaxed limit, the JKR contact at Gamma = dg (:func:`simulate_crack`): below a rate of
+#: about 1e-11 (n 0.8, k 0.1, mu 3.24), where the integrator's g - 1 drowned in the rounding of
+#: g (the edge pinned for good below rate 1e-29, the time budget spent; 1.4999998 at 1e-28)
+RELAXED_SPEEDS = 10.0
+RELAXED_LIMIT = 1e-10
 
 
 def simulate_crack(scene, numerics=None):

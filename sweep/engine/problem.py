@@ -344,14 +344,13 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None, *,
     window (:mod:`sweep.engine.tip_following`), which a refusal names.
     """
     lo, hi = BEM_MU_RANGE
-    if not lo <= scene.mu <= hi and (scene.protocol() is not None
-                                     or scene.machine_stiffness is not None):
-        raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
-                      f", the one model that runs a test protocol or a compliant machine")
     if not lo <= scene.mu <= hi:
+        others = (", the one model that runs a test protocol or a compliant machine"
+                  if scene.protocol() is not None or scene.machine_stiffness is not None else
+                  "; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
+                  "elastic or auto, large contacts the crack-front model (model crack)")
         raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
-                      f"; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
-                      f"elastic or auto, large contacts the crack-front model (model crack)")
+                      f"{others}")
     protocol = scene.protocol()
     if protocol and numerics.exact:
         raise Refused("a protocol's approach and dwell run the hereditary BEM's time march: "
