@@ -532,8 +532,8 @@ def _probe(scene, numerics, run, delta0, a0, per_step, margin, deadline) -> str:
     if need.steps * per_step > margin * left:
         return (f"time budget: needs at least {total} steps ({need.describe()}, as the first "
                 f"{n - 1} steps took) at {1e3 * per_step:.2g} ms per step on {run.h.size} "
-                f"nodes: about {need.steps * per_step:.0f} s more, > {margin:g} x the "
-                f"{left:.0f} s left of time_budget_s = {numerics.time_budget_s:g}; raise "
+                f"nodes: about {need.steps * per_step:.2g} s more, > {margin:g} x the "
+                f"{max(left, 0.0):.2g} s left of time_budget_s = {numerics.time_budget_s:g}; raise "
                 f"time_budget_s, or lower band_resolution{crack_front_advice(scene)}")
     return ""
 

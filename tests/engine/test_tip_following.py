@@ -319,6 +319,11 @@ def test_a_scene_beyond_its_budget_is_refused_after_the_probe_with_what_it_needs
     assert res.status == "failed"
     assert res.reason.startswith("time budget: needs at least"), res.reason
     assert "time_budget_s" in res.reason and "steps" in res.reason
+    # the seconds in two significant digits: below 1 s they had read "about 0 s more, > 2 x
+    # the 0 s left"
+    more = float(res.reason.split("about ")[1].split(" s more")[0])
+    left = float(res.reason.split("x the ")[1].split(" s left")[0])
+    assert more > 0.0 and 0.0 <= left < 1.0
     from sweep.engine.bem import CHUNK_STEPS
     assert res.steps <= tf.PROBE_STEPS + CHUNK_STEPS       # after the probe or one chunk
     need = int(res.reason.split("needs at least ")[1].split()[0])
