@@ -27,8 +27,10 @@ moduli, in Pa (a table that states no units is taken as Pa and s), ``tau0`` is 1
 scene's time unit; its times are the table's retardation times in s) and ``n`` is unused
 (:data:`TABLE_N` in the dimensionless scene, for bookkeeping). The reference modulus of
 the scales (``a_ref``, ``mu``, ``l0``) is the relaxed ``E0* = E0 / (1 - nu^2)``, as for the
-MPL. Giving ``E0``, ``Einf`` or ``tau0`` with a table is an error unless it equals the
-table's. The dimensionless scene holds everything
+MPL. The moduli are read at the 10 significant digits of the table's hash
+(:func:`sweep.materials.prony_files.hash_rounded`), so that the same table in any format
+gives the same scene. Giving ``E0``, ``Einf`` or ``tau0`` with a table is an error unless it
+equals the table's. The dimensionless scene holds everything
 a model needs; a :class:`sweep.Scene` is built when its parameters are within the Scene's
 ranges (the BEM's), the crack-front and pb models run on the plain parameters at any ``mu``.
 """
@@ -42,6 +44,7 @@ from ..engine.crack_front import scene_law, unload
 from ..engine.models import (MACHINE_REFUSALS, PROCESS_ZONE_REFUSALS, PROTOCOL_REFUSALS,
                              choose_model, pb_estimate, simulate_model)
 from ..errors import InputError, as_float, check_choice, check_positive, check_range
+from ..materials.prony_files import hash_rounded
 from ..scene import (AXES, DWELL_HOLDS, MATERIALS, PZ_LAWS, SCENE_LIMITS, Axis, Scene,
                      SceneTable, check_process_zone, scene_table)
 from ..theory import jkr_contact_radius, jkr_pull_off
@@ -147,7 +150,9 @@ class SIScene:
                                                           rel_tol=1e-12):
                     raise InputError(f"{name}: the Prony table {table.name} gives {name} = "
                                      f"{value:.6g}; leave {name} out (got {given!r})")
-                set_(name, value)
+                # the moduli at the digits the table's hash reads: the same table from any
+                # format derives the same scales, hence the same scene ids
+                set_(name, value if name == "tau0" else hash_rounded(value))
         for name in ("R", "E0", "Einf", "tau0", "dg", "h0", "speed"):
             set_(name, check_positive(name, getattr(self, name)))
         if self.n is not None:

@@ -81,7 +81,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError
-from ..scene import SCENE_AXES, SCENE_ID_VERSION, Numerics
+from ..scene import SCENE_AXES, SCENE_ID_VERSION, TABLE_MATERIAL, Numerics
 from .config import parse_config
 from .si import si_row
 
@@ -356,6 +356,11 @@ TWIN_RTOL = 1e-14
 #: the significant digits of the floats by which candidate twins are looked up (two floats
 #: TWIN_RTOL apart round apart here once in about 1e4: that scene then runs again)
 TWIN_DIGITS = 10
+#: a Prony-table scene of an SI grid written before the table's moduli were read at its
+#: hash's 10 digits (:func:`sweep.materials.prony_files.hash_rounded`): its floats derived
+#: from the relaxed modulus (mu, a0, preload, ...) differ from today's by up to ~1e-10
+#: relative, and are looked up at 6 digits (two such floats round apart there once in 1e4)
+TABLE_TWIN_RTOL, TABLE_TWIN_DIGITS = 1e-9, 6
 
 
 def _twin_fields(scene, numerics) -> dict | None:
@@ -382,18 +387,24 @@ def _twin_scalar(value):
     return NotImplemented
 
 
-def _twin_key(fields: dict) -> tuple:
-    return tuple(sorted((k, float(f"{v:.{TWIN_DIGITS}g}") if isinstance(v, float) else v)
+def _twin_key(fields: dict, digits: int = TWIN_DIGITS) -> tuple:
+    return tuple(sorted((k, float(f"{v:.{digits}g}") if isinstance(v, float) else v)
                         for k, v in fields.items() if k != "scene_id"))
+
+
+def _is_table(fields: dict) -> bool:
+    return str(fields.get("material", "")).startswith(f"{TABLE_MATERIAL}:")
 
 
 def rounding_twins(tasks, rows, numerics) -> dict[str, str]:
     """The ids of ``tasks`` ((scene id, Scene) with the config's ``numerics``) whose scene a
     stored row (``rows``) holds with other last bits (TWIN_RTOL): a file written on a
     machine whose numpy rounded a ``log10`` grid otherwise, before the grids' powers of ten
-    were correctly rounded (:func:`sweep.campaign.config.powers_of_ten`). Such a scene is
-    finished, not run again (its row keeps the floats it ran with). Rows of an internal
-    error do not count. Returns {task's id: the stored row's id}."""
+    were correctly rounded (:func:`sweep.campaign.config.powers_of_ten`); or, for a Prony
+    table's scene (TABLE_TWIN_RTOL), a file of an SI grid written before the table's moduli
+    were read at its hash's digits. Such a scene is finished, not run again (its row keeps
+    the floats it ran with). Rows of an internal error do not count. Returns {task's id:
+    the stored row's id}."""
     wanted = [(sid, f) for sid, f in ((sid, _twin_fields(scene, numerics))
                                       for sid, scene in tasks) if f is not None]
     if not wanted:
@@ -406,13 +417,17 @@ def rounding_twins(tasks, rows, numerics) -> dict[str, str]:
             continue
         fields = {k: _twin_scalar(row.get(k)) for k in keys_with_id}
         if NotImplemented not in fields.values():
-            index.setdefault(_twin_key(fields), []).append(fields)
+            digits = TABLE_TWIN_DIGITS if _is_table(fields) else TWIN_DIGITS
+            index.setdefault(_twin_key(fields, digits), []).append(fields)
     found = {}
     for sid, want in wanted:
-        for fields in index.get(_twin_key(want), []):
+        table = _is_table(want)
+        rtol = TABLE_TWIN_RTOL if table else TWIN_RTOL
+        key = _twin_key(want, TABLE_TWIN_DIGITS if table else TWIN_DIGITS)
+        for fields in index.get(key, []):
             if all(v == fields.get(k) or (
                     isinstance(v, float) and isinstance(fields.get(k), float)
-                    and abs(v - fields[k]) <= TWIN_RTOL * abs(v)) for k, v in want.items()):
+                    and abs(v - fields[k]) <= rtol * abs(v)) for k, v in want.items()):
                 found[sid] = fields["scene_id"]
                 break
     return found

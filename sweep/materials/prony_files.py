@@ -73,6 +73,22 @@ shear relative moduli are those of E. A ``BULK`` table alone is refused; beside 
 table it must be the same series (else nu would change in time). One temperature only. With
 ``/UNITS,SI`` the numbers are Pa and s, with ``/UNITS,MPA`` MPa and s; otherwise as given.
 
+``abaqus`` -- an Abaqus input deck (or the material's part of one; the keywords as in
+Abaqus's Keywords Reference, ``*ELASTIC`` and ``*VISCOELASTIC``) holding
+``*VISCOELASTIC, TIME=PRONY``, whose data lines are ``g_i, k_i, tau_i``: the shear and bulk
+relative moduli and the relaxation time of each term (Abaqus's ``g_R(t) = 1 - sum_i g_i
+(1 - exp(-t/tau_i))``, the Wiechert form with ``E_i = Einf g_i``). The modulus is
+``*ELASTIC``'s single data line ``E, nu``: the relaxed (long-term) modulus by default
+(``MODULI=LONG TERM``, Abaqus's default), the instantaneous one with
+``MODULI=INSTANTANEOUS``; without an ``*ELASTIC`` block ``Einf`` is given with the table.
+Keywords and parameters are case-insensitive, ``**`` lines are comments, other keywords
+(``*MATERIAL``, ``*DENSITY``, ``*TRS``, ...) are skipped: the table is read at its reference
+temperature, and the card's Poisson's ratio is not read (a scene's ``nu`` is its own). With a
+constant Poisson's ratio the shear relative moduli are those of E: every ``k_i`` must equal
+``g_i``, or be 0 in every row (the bulk does not relax, as for a nearly incompressible
+rubber, where E = 3 G). One material, one temperature; Abaqus states no units, so the
+numbers are as given.
+
 ``fit-dma`` -- the JSON that ``sweep fit-dma FILE.csv --maxwell N --out FIT.json`` writes (and
 ``--json`` prints): its
 ``maxwell`` object (``E0`` relaxed [Pa], ``moduli`` [Pa], ``times`` [s]) is the table. A JSON
@@ -90,7 +106,8 @@ and ``name`` beside it as needed.
 Checks (each a one-line :class:`~sweep.errors.InputError` naming the file or key)
 ----------------------------------------------------------------------------------
 Cells that are not finite numbers; an empty table; lists of different lengths (or an ANSYS
-card with an odd number of constants, or NPTS not the number of pairs); times ``<= 0``;
+card with an odd number of constants, or NPTS not the number of pairs; an Abaqus data line
+with fewer than three values); times ``<= 0``;
 moduli, weights or relative moduli ``< 0``; relative moduli (``alpha_i``, ``a_i``, ``c_i``)
 summing to ``>= 1`` and an ``Einf`` not above the sum of the arm moduli (both: the relaxed
 modulus would be ``<= 0``, a liquid, which has no relaxed adhesive contact); a file that is
@@ -128,11 +145,12 @@ import numpy as np
 from ..errors import InputError, check_range
 from .prony_table import Prony
 
-__all__ = ["PronyTable", "read_prony", "FORMATS", "MODULUS_UNITS", "TIME_UNITS"]
+__all__ = ["PronyTable", "read_prony", "hash_rounded", "FORMATS", "MODULUS_UNITS",
+           "TIME_UNITS"]
 
 #: The formats :func:`read_prony` recognizes (the values of ``PronyTable.source_format``,
 #: besides ``"inline"``).
-FORMATS = ("visco-sweep", "pyvisco", "ansys", "fit-dma")
+FORMATS = ("visco-sweep", "pyvisco", "ansys", "abaqus", "fit-dma")
 #: Modulus units a file may state, in Pa.
 MODULUS_UNITS = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
 #: Time units a file may state, in s.
@@ -140,7 +158,8 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0, "h": 3600.0}
 
 _ACCEPTED = ("a visco-sweep Prony CSV ('# visco-sweep prony' first line, header tau,E or "
              "tau,c), pyvisco's df_prony.csv (header i,tau_i,alpha_i,E_0,E_i then a units "
-             "row), an ANSYS TB,PRONY card, or the JSON of sweep fit-dma --json")
+             "row), an ANSYS TB,PRONY card, an Abaqus *VISCOELASTIC, TIME=PRONY block, or "
+             "the JSON of sweep fit-dma --json")
 _MARKER = "visco-sweep prony"
 _CSV_KEYS = ("form", "E0", "Einf", "modulus_unit", "time_unit")
 _INLINE_KEYS = ("tau", "E", "c", "form", "E0", "Einf", "modulus_unit", "time_unit", "name",
@@ -238,6 +257,13 @@ def _round(x: float) -> str:
     return f"{float(x):.{_HASH_DIGITS - 1}e}"
 
 
+def hash_rounded(x: float) -> float:
+    """``x`` to the significant digits by which :meth:`PronyTable.content_hash` reads a
+    table's numbers: what the same table gives in every format (a relative table's relaxed
+    modulus, a difference, differs in its last digits from a format that states it)."""
+    return float(_round(x))
+
+
 # ============================================================================ the entry point
 
 def read_prony(spec, *, base_dir=None, nu=None, Einf=None) -> PronyTable:
@@ -295,7 +321,7 @@ def read_prony(spec, *, base_dir=None, nu=None, Einf=None) -> PronyTable:
     Einf = None if Einf is None else check_range("Einf", Einf, 0.0, lo_open=True)
     fmt = _detect(path, text)
     reader = {"visco-sweep": _read_project_csv, "pyvisco": _read_pyvisco,
-              "ansys": _read_ansys, "fit-dma": _read_json}[fmt]
+              "ansys": _read_ansys, "abaqus": _read_abaqus, "fit-dma": _read_json}[fmt]
     table = reader(path, text, nu=nu, Einf=Einf)
     return table if name is None else replace(table, name=str(name))
 
@@ -314,6 +340,8 @@ def _detect(path: Path, text: str) -> str:
         f = [x.strip().upper() for x in ln.split("!")[0].split(",")]
         if len(f) > 1 and f[0] == "TB" and f[1].startswith("PRON"):
             return "ansys"
+        if _abaqus_keyword(ln)[0] == "VISCOELASTIC":
+            return "abaqus"
     first = next((ln for ln in lines if not ln.startswith("#")), "")
     cols = [c.strip() for c in first.split(",")]
     if "tau_i" in cols and ("alpha_i" in cols or "E_i" in cols or "G_i" in cols):
@@ -726,6 +754,116 @@ def _ansys_pairs(path, table):
         raise InputError(f"{where}: relative moduli a_i must be >= 0 (got a_{bad[0] + 1} = "
                          f"{a[bad[0]]:g})")
     return a, v[1::2]
+
+
+# ============================================================================ Abaqus
+
+def _abaqus_keyword(line: str) -> tuple[str, dict]:
+    """The keyword and parameters of an Abaqus keyword line (``*Elastic, moduli=LONG TERM``:
+    ``("ELASTIC", {"MODULI": "LONG TERM"})``, upper case, blanks collapsed); ``("", {})``
+    for a data or comment line."""
+    line = line.strip()
+    if not line.startswith("*") or line.startswith("**"):
+        return "", {}
+    name, *params = line[1:].split(",")
+    out = {}
+    for p in params:
+        key, _, value = p.partition("=")
+        if key.strip():
+            out[" ".join(key.upper().split())] = " ".join(value.upper().split())
+    return " ".join(name.upper().split()), out
+
+
+def _read_abaqus(path, text, *, Einf=None, **_):
+    where = str(path)
+    blocks = {"VISCOELASTIC": [], "ELASTIC": []}     # [(line, params, [(line, cells)])]
+    block = None
+    for no, raw in enumerate(text.splitlines(), start=1):
+        line = raw.strip()
+        if not line or line.startswith("**"):
+            continue
+        if line.startswith("*"):
+            keyword, params = _abaqus_keyword(line)
+            block = (no, params, []) if keyword in blocks else None
+            if block is not None:
+                blocks[keyword].append(block)
+        elif block is not None:
+            cells = [c.strip() for c in line.split(",")]
+            while cells and not cells[-1]:
+                cells.pop()
+            block[2].append((no, cells))
+    visco, elastic = blocks["VISCOELASTIC"], blocks["ELASTIC"]
+    if len(visco) > 1 or len(elastic) > 1:
+        many = "VISCOELASTIC" if len(visco) > 1 else "ELASTIC"
+        lines = ", ".join(str(b[0]) for b in blocks[many])
+        raise InputError(f"{where}: the deck has {len(blocks[many])} *{many} blocks (lines "
+                         f"{lines}); give one material")
+    no, params, rows = visco[0]
+    if params.get("TIME") != "PRONY":
+        got = ", ".join(f"{k}={v}" if v else k for k, v in params.items()) or "none"
+        raise InputError(f"{where} line {no}: *VISCOELASTIC needs TIME=PRONY, the Prony series "
+                         f"itself (got {got})")
+    if params.get("TYPE", "ISOTROPIC") != "ISOTROPIC":
+        raise InputError(f"{where} line {no}: *VISCOELASTIC TYPE must be ISOTROPIC (got "
+                         f"{params['TYPE']})")
+    if not rows:
+        raise InputError(f"{where} line {no}: empty Prony table (no data lines g_i, k_i, tau_i)")
+    g, k, tau = [], [], []
+    for row_no, cells in rows:
+        if len(cells) < 3:
+            raise InputError(f"{where} line {row_no}: needs 3 values g_i, k_i, tau_i (got "
+                             f"{len(cells)})")
+        for label, out, cell in zip(("g_i", "k_i", "tau_i"), (g, k, tau), cells):
+            out.append(_number(f"{where} line {row_no}, {label}", cell))
+    g, k, tau = np.array(g), np.array(k), np.array(tau)
+    if np.any(k != 0.0) and not np.allclose(k, g, rtol=1e-9, atol=0.0):
+        i = int(np.flatnonzero(~np.isclose(k, g, rtol=1e-9, atol=0.0))[0])
+        raise InputError(f"{where} line {rows[i][0]}: the bulk ratio k_i = {k[i]:g} differs from "
+                         f"the shear ratio g_i = {g[i]:g} (Poisson's ratio would change in time; "
+                         f"only a constant nu is supported: give k_i = g_i, or 0 in every row)")
+    E_inst, relaxed = Einf, None
+    if elastic:
+        e_no, e_params, e_rows = elastic[0]
+        if e_params.get("TYPE", "ISOTROPIC") != "ISOTROPIC":
+            raise InputError(f"{where} line {e_no}: *ELASTIC TYPE must be ISOTROPIC (got "
+                             f"{e_params['TYPE']})")
+        if len(e_rows) != 1:
+            raise InputError(f"{where} line {e_no}: *ELASTIC needs one data line E, nu (got "
+                             f"{len(e_rows)}: temperature-dependent moduli are not supported)")
+        moduli = e_params.get("MODULI", "LONG TERM")
+        if moduli not in ("LONG TERM", "INSTANTANEOUS"):
+            raise InputError(f"{where} line {e_no}: *ELASTIC MODULI must be LONG TERM or "
+                             f"INSTANTANEOUS (got {moduli})")
+        e_row, e_cells = e_rows[0]
+        if not e_cells:
+            raise InputError(f"{where} line {e_row}: *ELASTIC without a modulus")
+        E = _number(f"{where} line {e_row}, E", e_cells[0])
+        if not E > 0.0:
+            raise InputError(f"{where} line {e_row}: the modulus E must be > 0 (got {E:g})")
+        if moduli == "INSTANTANEOUS":
+            E_inst = E
+        else:
+            relaxed = E
+        if Einf is not None:
+            raise InputError(f"{where}: Einf = {Einf:g} given with a deck whose *ELASTIC gives "
+                             f"the modulus; give one")
+    elif Einf is None:
+        raise InputError(f"{where}: the deck gives no modulus (no *ELASTIC block); give Einf "
+                         f"(the instantaneous Young's modulus) with the table")
+    kw = dict(fmt="abaqus", name=path.stem, source=where, units_known=False)
+    if relaxed is None:
+        return _relative(g * E_inst, tau, E_inst, where=where, label="g_i", **kw)
+    # long-term moduli: the relaxed modulus is given, the arms are g_i E_inst with
+    # E_inst = E (1 - sum g_i)^-1
+    s = float(g.sum())
+    if not s < 1.0:
+        raise InputError(f"{where}: the relative moduli g_i must sum to < 1 (the relaxed "
+                         f"modulus is E_inst (1 - sum g_i); 1 is a liquid) (got sum {s:.12g})")
+    bad = np.flatnonzero(g < 0.0)
+    if bad.size:
+        raise InputError(f"{where}: relative moduli g_i must be >= 0 (got g_i[{bad[0]}] = "
+                         f"{g[bad[0]]:g})")
+    return _make("wiechert", tau, g * (relaxed / (1.0 - s)), E0=relaxed, where=where, **kw)
 
 
 # ============================================================================ JSON

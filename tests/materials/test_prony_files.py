@@ -110,6 +110,47 @@ def test_ansys_card_as_ansys_writes_it(tmp_path):
     assert t.content_hash() == read_prony(DATA / FILES["fit-dma"]).content_hash()
 
 
+def test_abaqus_deck_gives_the_same_table():
+    """tests/data/prony/pdms_prony_abaqus.inp: ``*ELASTIC, MODULI=INSTANTANEOUS`` (E = Einf)
+    and ``*VISCOELASTIC, TIME=PRONY`` rows g_i = E_i/Einf, k_i = 0, tau_i; Abaqus states no
+    units, so the numbers are as given (here Pa and s)."""
+    E0, E, tau = reference()
+    t = read_prony(DATA / "pdms_prony_abaqus.inp")
+    assert t.source_format == "abaqus" and t.name == "pdms_prony_abaqus"
+    assert t.modulus_unit is None and t.form == "wiechert" and t.n_arms == E.size
+    assert rel(t.weights, E) < RTOL and rel(t.times, tau) < RTOL and rel(t.E0, E0) < RTOL
+    assert t.content_hash() == read_prony(DATA / FILES["fit-dma"]).content_hash()
+
+
+def _abaqus(E0, E, tau, *, elastic, k="0."):
+    Einf = float(E0 + E.sum())
+    rows = [f"{e / Einf!r}, {k if k != 'g' else repr(e / Einf)}, {t!r},"
+            for e, t in zip(E.tolist(), tau.tolist())]
+    return "\n".join(["** a deck as a user writes it: lower case, comments, trailing commas",
+                      "*Heading", "pdms", "*material, name=pdms", "*DENSITY", "965.",
+                      *elastic, "*viscoelastic , time = prony", *rows, "*Trs, definition=WLF",
+                      "20., 8.86, 101.6", "*Step", "*End step"]) + "\n"
+
+
+def test_abaqus_deck_long_term_modulus_and_bulk_ratios(tmp_path):
+    """The default MODULI=LONG TERM gives the relaxed modulus (E_inst = E (1 - sum g_i)^-1;
+    the relaxed modulus of the relative rows loses ~2.7 digits, k = 2.2e-3: 1e-12 holds);
+    k_i = g_i is read as k_i = 0 (a constant nu); no *ELASTIC needs Einf given."""
+    E0, E, tau = reference()
+    ref = read_prony(DATA / FILES["fit-dma"])
+    long_term = _write(tmp_path, "lt.inp", _abaqus(E0, E, tau, elastic=["*Elastic",
+                                                                         f"{float(E0)!r}, 0.49"],
+                                                 k="g"))
+    t = read_prony(long_term)
+    assert rel(t.weights, E) < RTOL and rel(t.E0, E0) < RTOL and rel(t.Einf, ref.Einf) < RTOL
+    assert t.content_hash() == ref.content_hash()
+    bare = _write(tmp_path, "bare.inp", _abaqus(E0, E, tau, elastic=[]))
+    with pytest.raises(InputError, match="no modulus .*give Einf"):
+        read_prony(bare)
+    t = read_prony({"prony": str(bare), "Einf": ref.Einf})
+    assert rel(t.weights, E) < RTOL and t.content_hash() == ref.content_hash()
+
+
 def test_pyvisco_shear_table_needs_nu(tmp_path):
     E0, E, tau = reference()
     Einf = float(E0 + E.sum())
@@ -195,6 +236,29 @@ BAD = [
      "no TB,PRONY,...,SHEAR table"),
     ("bulk differs", "c.mac", ANSYS.format("0.1,1.0,0.2,2.0")
      + "TB,PRONY,1,1,2,BULK\nTBDATA,1,0.3,1.0,0.2,2.0\n", "BULK Prony table differs"),
+    ("Abaqus frequency domain", "a.inp", "*Elastic\n1e6, 0.5\n*Viscoelastic, frequency=PRONY\n"
+     "0.5, 0., 1.\n", "needs TIME=PRONY, the Prony series itself \\(got FREQUENCY=PRONY\\)"),
+    ("Abaqus bulk ratios", "a.inp", "*Elastic\n1e6, 0.4\n*Viscoelastic, time=PRONY\n"
+     "0.5, 0.5, 1.\n0.2, 0.1, 10.\n", r"a.inp line 5: the bulk ratio k_i = 0.1 differs from "
+     r"the shear ratio g_i = 0.2"),
+    ("Abaqus short row", "a.inp", "*Elastic\n1e6, 0.5\n*Viscoelastic, time=PRONY\n0.5, 1.\n",
+     r"line 4: needs 3 values g_i, k_i, tau_i \(got 2\)"),
+    ("Abaqus temperatures", "a.inp", "*Elastic\n1e6, 0.5, 20.\n2e6, 0.5, 40.\n"
+     "*Viscoelastic, time=PRONY\n0.5, 0., 1.\n", "temperature-dependent moduli"),
+    ("Abaqus two materials", "a.inp", "*Elastic\n1e6, 0.5\n*Viscoelastic, time=PRONY\n"
+     "0.5, 0., 1.\n*Viscoelastic, time=PRONY\n0.5, 0., 1.\n",
+     r"the deck has 2 \*VISCOELASTIC blocks \(lines 3, 5\)"),
+    ("Abaqus empty", "a.inp", "*Elastic\n1e6, 0.5\n*Viscoelastic, time=PRONY\n",
+     "empty Prony table"),
+    ("Abaqus g sum 1, instantaneous", "a.inp", "*Elastic, moduli=instantaneous\n1e6, 0.5\n"
+     "*Viscoelastic, time=PRONY\n0.6, 0., 1.\n0.4, 0., 2.\n",
+     "relative moduli g_i must sum to < 1"),
+    ("Abaqus g sum 1, long term", "a.inp", "*Elastic\n1e6, 0.5\n*Viscoelastic, time=PRONY\n"
+     "0.6, 0., 1.\n0.4, 0., 2.\n", "relative moduli g_i must sum to < 1"),
+    ("Abaqus negative g", "a.inp", "*Elastic\n1e6, 0.5\n*Viscoelastic, time=PRONY\n"
+     "-0.1, 0., 1.\n", "relative moduli g_i must be >= 0"),
+    ("Abaqus non-numeric", "a.inp", "*Elastic\n1e6, 0.5\n*Viscoelastic, time=PRONY\n"
+     "0.1, 0., fast\n", r"line 4, tau_i: must be a number \(got 'fast'\)"),
     ("no format", "notes.txt", "omega,E'\n1,2\n", "not a Prony table in any accepted format"),
     ("binary", "x.xls", None, "not a Prony table"),
     ("MPL-only fit", "fit.json", json.dumps({"mpl": {"E0": 1.4e6, "Einf": 3e9, "n": 0.22,

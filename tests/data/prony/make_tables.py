@@ -18,7 +18,11 @@ E0 = 1.458e6 Pa, Einf = 3.089e9 Pa, n = 0.2207, tau0 = 0.01876 s (``sweep/paper/
 * ``pdms_prony_ansys.mpl`` -- the same table as an ANSYS card (``/UNITS,SI``, ``MP,EX`` = the
   instantaneous modulus, ``TB,PRONY,1,1,18,SHEAR``, ``TBDATA`` with a_i = E_i/Einf and tau_i,
   three constants a line with their start slot, as ANSYS writes them);
-* ``pdms_prony_visco_sweep.csv`` -- the same table in this project's CSV (relaxed E0, arms in Pa).
+* ``pdms_prony_visco_sweep.csv`` -- the same table in this project's CSV (relaxed E0, arms in Pa);
+* ``pdms_prony_abaqus.inp`` -- the same table as an Abaqus material (``*ELASTIC,
+  MODULI=INSTANTANEOUS`` with E = Einf, ``*VISCOELASTIC, TIME=PRONY`` rows ``g_i, k_i, tau_i``
+  with g_i = E_i/Einf and k_i = 0), written from ``pdms_fit_dma.json`` alone by
+  ``python tests/data/prony/make_tables.py --abaqus``.
 
 Every number is written with Python's shortest round-trip repr, so the four files hold the
 same table to the last bit but for the products and quotients each format's definition
@@ -28,6 +32,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -86,6 +91,16 @@ def ansys_card(E0: float, moduli, times) -> str:
     return "\n".join(lines) + "\n"
 
 
+def abaqus_inp(E0: float, moduli, times) -> str:
+    Einf = E0 + float(np.sum(moduli))
+    lines = ["** PDMS as an 18-arm Wiechert model (tests/data/prony/make_tables.py)",
+             "*Material, name=PDMS", "*Density", " 965.,",
+             "*Elastic, moduli=INSTANTANEOUS", f" {Einf!r}, 0.499",
+             "*Viscoelastic, time=PRONY"]
+    lines += [f" {e / Einf!r}, 0., {t!r}" for e, t in zip(moduli, times)]
+    return "\n".join(lines) + "\n"
+
+
 def project_csv(E0: float, moduli, times) -> str:
     lines = ["# visco-sweep prony", "# PDMS, 18-arm Wiechert fit (tests/data/prony/make_tables.py)",
              "# form = wiechert", f"# E0 = {E0!r}", "# modulus_unit = Pa", "# time_unit = s",
@@ -95,6 +110,11 @@ def project_csv(E0: float, moduli, times) -> str:
 
 
 def main() -> None:
+    if "--abaqus" in sys.argv[1:]:          # the Abaqus deck alone, from the committed fit
+        mx = json.loads((HERE / "pdms_fit_dma.json").read_text())["maxwell"]
+        (HERE / "pdms_prony_abaqus.inp").write_text(abaqus_inp(
+            float(mx["E0"]), [float(x) for x in mx["moduli"]], [float(x) for x in mx["times"]]))
+        return
     master = HERE / "pdms_mpl_master.csv"
     master.write_text(master_curve())
     doc = fit_dma_json(master, HERE / "pdms_fit_dma.json")
@@ -104,6 +124,7 @@ def main() -> None:
     (HERE / "pdms_prony.csv").write_text(pyvisco_csv(E0, moduli, times))
     (HERE / "pdms_prony_ansys.mpl").write_text(ansys_card(E0, moduli, times))
     (HERE / "pdms_prony_visco_sweep.csv").write_text(project_csv(E0, moduli, times))
+    (HERE / "pdms_prony_abaqus.inp").write_text(abaqus_inp(E0, moduli, times))
     print(f"wrote {HERE}: E0 = {E0:.6g} Pa, Einf = {E0 + sum(moduli):.6g} Pa, "
           f"{sum(m > 0 for m in moduli)} of {len(moduli)} arms non-zero")
 
