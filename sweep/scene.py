@@ -222,7 +222,8 @@ def scene_table(value, *, base_dir=None, nu=None) -> SceneTable:
     """The :class:`SceneTable` of a table: a :class:`SceneTable`, a
     :class:`~sweep.materials.PronyTable`, or a mapping :func:`~sweep.materials.read_prony`
     reads (``{"prony": path, ...}`` or inline ``{"tau": [...], "E": [...], "E0": ...}``),
-    with an optional ``"tau0"`` key (the scene's time unit in the table's, > 0, default 1).
+    with an optional ``"tau0"`` key (the scene's time unit in the table's, s where the table
+    states its units (it was converted to s), > 0, default 1).
 
     ``base_dir`` resolves a relative path (default the working directory); ``nu`` reads a
     shear table. InputError (one line) for anything else or a bad table.
@@ -297,7 +298,8 @@ class Scene:
         a Prony table (a :class:`~sweep.materials.PronyTable`, anything
         :func:`~sweep.materials.read_prony` reads, ``{"prony": path}`` or an inline
         ``{"tau": [...], "E": [...], "E0": ...}``, optionally with ``"tau0"``, the time unit
-        of the scene in the table's time unit, default 1), normalized on construction into a
+        of the scene in the table's time unit, s where the table states its units, default
+        1), normalized on construction into a
         :class:`SceneTable`: Chat = 1 - sum c_i exp(-t/theta_i). The table fixes k (a k other
         than the default 0.1 must equal it) and n is unused, as for "sls".
     stop : {"pulloff", "separation"}

@@ -268,9 +268,11 @@ def _fmt_choices(items) -> str:
     return ", ".join(items)
 
 
-def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) -> tuple | None:
+def _axis_values(where: str, axis: str, spec, problems: list[str], info=None,
+                 nu=None) -> tuple | None:
     """Expand one axis spec into a tuple of validated values (None on error); ``info`` is the
-    axis (default the Scene's)."""
+    axis (default the Scene's); ``nu``, an SI grid's single Poisson's ratio, reads a shear
+    Prony table of the ``material`` axis."""
     info = info or SCENE_AXIS_INFO[axis]
     if not info.numeric:
         allowed = info.choices
@@ -283,7 +285,7 @@ def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) ->
             w = f"{where}[{i}]" if isinstance(spec, list) else where
             try:
                 if axis == "material" and v not in allowed:   # a table, or what is allowed
-                    out.append(_table(w, v))
+                    out.append(_table(w, v, nu))
                 else:
                     out.append(check_choice(w, v, allowed))
             except InputError as exc:
@@ -346,14 +348,21 @@ def _axis_values(where: str, axis: str, spec, problems: list[str], info=None) ->
     return tuple(out) if len(out) == len(vals) else None
 
 
-def _table(where: str, spec) -> SceneTable:
+def _table(where: str, spec, nu=None) -> SceneTable:
     """A ``material`` value that is a Prony table (``{prony: path}``, relative to the working
-    directory, or an inline table; :func:`sweep.scene.scene_table`): InputError naming it."""
+    directory, or an inline table; :func:`sweep.scene.scene_table`), a shear table read with
+    ``nu`` (an SI grid's), which a ``nu`` given with the table must equal: InputError naming
+    it."""
     if not isinstance(spec, (dict, SceneTable)):
         raise InputError(f"{where} must be mpl, sls or a Prony table, given as {{prony: path}} "
                          f"or inline {{tau: [...], E: [...], E0: ...}} (got {spec!r})")
+    if nu is not None and isinstance(spec, dict) and spec.get("nu") is not None:
+        mine = as_float(f"{where}.nu", spec["nu"])
+        if mine != nu:
+            raise InputError(f"{where}.nu: the table's Poisson's ratio {mine:g} differs from "
+                             f"the grid's nu = {nu:g}; give one")
     try:
-        return scene_table(spec)
+        return scene_table(spec, nu=nu)
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
 
@@ -416,10 +425,14 @@ def _check_si_grid(where: str, grid, problems: list[str]) -> dict | None:
     if sum(a in grid for a in SI_INITIAL) != 1:
         problems.append(f"{where}: give exactly one of preload [N], a0 [m] and indentation [m]")
     out = {}
+    # a single Poisson's ratio reads the shear tables of the material axis (a swept nu: a
+    # shear table gives its own, and each point's nu must then be it)
+    nu = grid.get("nu")
+    nu = float(nu) if isinstance(nu, (int, float)) and not isinstance(nu, bool) else None
     for name in allowed:
         if name in grid:
             vals = _axis_values(f"{where}.{name}", name, grid[name], problems,
-                                SI_AXES.get(name))
+                                SI_AXES.get(name), nu=nu)
             if vals is not None:
                 out[name] = vals
         elif name in SI_SCENE_AXES:

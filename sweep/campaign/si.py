@@ -139,6 +139,10 @@ class SIScene:
                 raise InputError(f"{', '.join(missing)}: required for material "
                                  f"{self.material} (or give a Prony table as the material)")
         else:
+            if isinstance(self.material, dict) and self.material.get("nu") is not None \
+                    and as_float("material nu", self.material["nu"]) != self.nu:
+                raise InputError(f"nu: the table's Poisson's ratio {self.material['nu']} "
+                                 f"differs from the scene's nu = {self.nu:g}; give one")
             table = scene_table(self.material, nu=self.nu)
             set_("material", table)
             if self.n is not None:

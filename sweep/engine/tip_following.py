@@ -153,7 +153,9 @@ def indentation_travel(scene: Scene, delta0: float, loading_speed: float) -> flo
         t = D / loading_speed
         return D - float(mat.integrated_compliance(t)) / t * full
 
-    return full if excess(full) <= 0.0 else float(brentq(excess, 1e-12 * full, full))
+    # the mean compliance is at least Chat(0) = k: excess < 0 at k full / 2 (a bracket at a
+    # fixed 1e-12 full was none for k below 1e-12, and brentq raised)
+    return full if excess(full) <= 0.0 else float(brentq(excess, 0.5 * scene.k * full, full))
 
 
 @dataclasses.dataclass

@@ -63,7 +63,7 @@ optional; a file with ``alpha_i`` or ``E_i`` alone is read too, and with both th
 (``a_i`` relative moduli, ``tau_i`` relaxation times; a blank STLOC continues after the last
 slot). The instantaneous Young's modulus is ``MP,EX,MAT,value`` (or ``MPDATA,EX,MAT,,value``)
 from the card, or ``Einf`` given with the table (a card written by ANSYS's curve fitting holds
-only the series). The format was read from pyvisco's ANSYS comparison
+only the series; in Pa where the card states its units, else in its own). The format was read from pyvisco's ANSYS comparison
 (``pyvisco/verify.py``: ``load_prony_ANSYS`` reads the ``TB`` line's 5th field as the number of
 terms and the ``TBDATA`` constants as alternating ``alpha_i, tau_i``; ``prep_prony_ANSYS``
 adds the instantaneous modulus the card lacks) and from the ANSYS 2020 R1 card in pyvisco's
@@ -110,8 +110,14 @@ card with an odd number of constants, or NPTS not the number of pairs; an Abaqus
 with fewer than three values); times ``<= 0``;
 moduli, weights or relative moduli ``< 0``; relative moduli (``alpha_i``, ``a_i``, ``c_i``)
 summing to ``>= 1`` and an ``Einf`` not above the sum of the arm moduli (both: the relaxed
-modulus would be ``<= 0``, a liquid, which has no relaxed adhesive contact); a file that is
-none of the formats (one line naming the file and the accepted formats).
+modulus would be ``<= 0``, a liquid, which has no relaxed adhesive contact), and a relaxed
+modulus given as such a difference below :data:`DERIVED_K_MIN` of the instantaneous one
+(rounding: relative moduli normalized to sum 1); a metadata value with more than one word
+(``# E0 = 1.5 MPa``: the unit has its own line); an ``Einf`` beside a table that gives its
+moduli (every format but an ANSYS card or an Abaqus deck without its modulus); a file that is
+none of the formats (one line naming the file and the accepted formats). A UTF-8 byte-order
+mark (Excel's "CSV UTF-8") is dropped; in this project's CSV a comment line whose text
+before ``=`` is more than one word is a comment, not a key.
 
 "Moduli that do not decrease": a relaxation modulus must not increase in time. With every arm
 ``E_i >= 0`` (or ``c_i >= 0``), ``R(t)`` is a sum of decaying exponentials, non-increasing at
@@ -161,9 +167,16 @@ _ACCEPTED = ("a visco-sweep Prony CSV ('# visco-sweep prony' first line, header 
              "row), an ANSYS TB,PRONY card, an Abaqus *VISCOELASTIC, TIME=PRONY block, or "
              "the JSON of sweep fit-dma --json")
 _MARKER = "visco-sweep prony"
+#: the formats whose file may lack the instantaneous modulus, given as ``Einf`` beside it
+_EINF_FORMATS = ("ansys", "abaqus")
 _CSV_KEYS = ("form", "E0", "Einf", "modulus_unit", "time_unit")
 _INLINE_KEYS = ("tau", "E", "c", "form", "E0", "Einf", "modulus_unit", "time_unit", "name",
                 "recorded")
+#: the least relaxed modulus, over the instantaneous one, that a table giving it as a
+#: difference (Einf minus the arms, or Einf times one minus the relative moduli) resolves:
+#: below it the difference is rounding (pyvisco normalizes an overshooting fit's relative
+#: moduli to sum 1, which in floating point can leave 1e-16)
+DERIVED_K_MIN = 1e-12
 #: a recorded table's two moduli (``recorded: true``) agree with each other to this (they
 #: were computed from each other when the table was first read)
 RECORDED_RTOL = 1e-9
@@ -281,8 +294,10 @@ def read_prony(spec, *, base_dir=None, nu=None, Einf=None) -> PronyTable:
         Poisson's ratio in (-1, 0.5], needed to read a shear table (pyvisco ``G_0, G_i``);
         a ``nu`` key of ``spec`` takes precedence.
     Einf : float, optional
-        The instantaneous Young's modulus for an ANSYS card without ``MP,EX`` (> 0, in the
-        card's units); an ``Einf`` key of ``spec`` takes precedence.
+        The instantaneous Young's modulus for an ANSYS card without ``MP,EX`` or an Abaqus
+        deck without ``*ELASTIC`` (> 0: in Pa where the card states its units, ``/UNITS``,
+        else in the card's own); an ``Einf`` key of ``spec`` takes precedence. Refused with
+        the other formats, which give their moduli.
 
     Returns
     -------
@@ -311,7 +326,7 @@ def read_prony(spec, *, base_dir=None, nu=None, Einf=None) -> PronyTable:
     if base_dir is not None and not path.is_absolute():
         path = Path(base_dir) / path
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")     # a BOM (Excel's CSV UTF-8) dropped
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a Prony table (a binary file); "
                          f"accepted: {_ACCEPTED}") from None
@@ -320,6 +335,10 @@ def read_prony(spec, *, base_dir=None, nu=None, Einf=None) -> PronyTable:
     nu = None if nu is None else check_range("nu", nu, -1.0, 0.5, lo_open=True)
     Einf = None if Einf is None else check_range("Einf", Einf, 0.0, lo_open=True)
     fmt = _detect(path, text)
+    if Einf is not None and fmt not in _EINF_FORMATS:
+        raise InputError(f"{path}: Einf is given with a table only for an ANSYS card without "
+                         f"MP,EX or an Abaqus deck without *ELASTIC; this {fmt} table gives its "
+                         f"moduli itself (got Einf = {Einf:g})")
     reader = {"visco-sweep": _read_project_csv, "pyvisco": _read_pyvisco,
               "ansys": _read_ansys, "abaqus": _read_abaqus, "fit-dma": _read_json}[fmt]
     table = reader(path, text, nu=nu, Einf=Einf)
@@ -387,6 +406,7 @@ def _make(form, tau, w, *, E0=None, Einf=None, where, fmt, name, source, units_k
     order = np.argsort(tau[keep], kind="stable")
     tau, w = tau[keep][order], w[keep][order]
     recorded = E0 is not None and Einf is not None     # both: a table as it was read
+    derived_E0 = E0 is None
     if form == "kelvin":
         s = float(w.sum())
         if not s < 1.0:
@@ -412,6 +432,11 @@ def _make(form, tau, w, *, E0=None, Einf=None, where, fmt, name, source, units_k
     Einf = Einf if recorded else derived
     if not (math.isfinite(E0) and E0 > 0.0):
         raise InputError(f"{where}: the relaxed modulus E0 must be > 0 (got {E0:.6g})")
+    if derived_E0 and E0 < DERIVED_K_MIN * Einf:
+        raise InputError(f"{where}: the arms sum to the instantaneous modulus within rounding "
+                         f"(the relaxed modulus, their difference, is {E0 / Einf:.2g} Einf, "
+                         f"below {DERIVED_K_MIN:g} Einf): a liquid, which has no relaxed "
+                         f"contact (a fit normalized to sum 1 describes one)")
     material = Prony(w, tau, E0=E0, kind=kind)
     for arr in (tau, w):
         arr.setflags(write=False)
@@ -539,12 +564,18 @@ def _read_project_csv(path, text, **_):
             continue
         if s.startswith("#"):
             body = s.lstrip("#").strip()
-            if "=" in body:
-                key, value = (x.strip() for x in body.split("=", 1))
+            key, eq, value = (x.strip() for x in body.partition("="))
+            # "# key = value" is metadata; a comment whose text before "=" is not one word
+            # ("# DMA master curve at T_ref = 20 C") is a comment
+            if eq and key and len(key.split()) == 1:
                 if key not in _CSV_KEYS:
                     raise InputError(f"{path} line {no}: unknown key {key!r} (allowed: "
                                      f"{', '.join(_CSV_KEYS)})")
-                meta[key] = value.split()[0] if value.split() else ""
+                if len(value.split()) > 1:
+                    raise InputError(f"{path} line {no}: {key} must be one value (got "
+                                     f"{value!r}; a modulus's unit goes on its own line, "
+                                     f"# modulus_unit = ..., with # time_unit = ...)")
+                meta[key] = value
             continue
         cells = [c.strip() for c in s.split(",")]
         if header is None:
@@ -716,18 +747,21 @@ def _read_ansys(path, text, *, Einf=None, **_):
             raise InputError(f"{path} line {b['line']}: the BULK Prony table differs from the "
                              f"SHEAR one (Poisson's ratio would change in time; only a constant "
                              f"nu is supported)")
+    # the card's numbers in Pa where it states its units (/UNITS); an Einf given with the
+    # table is the table's modulus as read: in Pa then, else in the card's own units
+    scale = _ANSYS_UNITS.get(units, 1.0)
+    if ex is not None:
+        if not ex > 0.0:
+            raise InputError(f"{path}: MP,EX (the instantaneous modulus) must be > 0 (got {ex:g})")
+        ex = ex * scale
     if ex is not None and Einf is not None and abs(ex - Einf) > 1e-12 * ex:
         raise InputError(f"{path}: Einf = {Einf:g} given with the card differs from its MP,EX "
-                         f"= {ex:g}; give one")
+                         f"= {ex:g}{' Pa' if units in _ANSYS_UNITS else ''}; give one")
     E_inst = ex if ex is not None else Einf
     if E_inst is None:
         raise InputError(f"{path}: the card gives no instantaneous modulus (no MP,EX line); "
                          f"give Einf (the instantaneous Young's modulus) with the table")
-    if not E_inst > 0.0:
-        raise InputError(f"{path}: MP,EX (the instantaneous modulus) must be > 0 (got {E_inst:g})")
-    scale = _ANSYS_UNITS.get(units, 1.0)
-    return _relative(alpha * E_inst * scale, tau, E_inst * scale, where=str(path), label="a_i",
-                     fmt="ansys",
+    return _relative(alpha * E_inst, tau, E_inst, where=str(path), label="a_i", fmt="ansys",
                      name=path.stem, source=str(path), units_known=units in _ANSYS_UNITS)
 
 

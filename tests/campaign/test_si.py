@@ -521,6 +521,35 @@ TABLE_FILES = ("pdms_fit_dma.json", "pdms_prony.csv", "pdms_prony_ansys.mpl",
                "pdms_prony_visco_sweep.csv", "pdms_prony_abaqus.inp")
 
 
+def test_a_shear_table_in_an_si_grid_reads_with_the_grids_nu(tmp_path, monkeypatch):
+    """A pyvisco shear table (G_0, G_i) in a `units: si` grid: the grid's nu converts it
+    (E = 2 (1 + nu) G; it had been refused, "give nu with the table", where SIScene took the
+    grid's), the same scene as the Young's table; a nu given with the table that differs from
+    the grid's is refused (it had converted with 0.3 and made contact with 0.5)."""
+    from sweep.campaign.config import parse_config
+    from sweep.materials import read_prony
+
+    monkeypatch.chdir(tmp_path)
+    young = read_prony(Path(__file__).resolve().parents[2] / PDMS_GMM)
+    G_0 = young.Einf / 3.0 / 1e3                                  # kPa, nu = 0.5
+    rows = ["i,tau_i,alpha_i,G_0,G_i", "-,s,-,kPa,kPa"]
+    rows += [f"{i},{t!r},{e / young.Einf!r},{G_0!r},{G_0 * e / young.Einf!r}"
+             for i, (t, e) in enumerate(zip(young.times.tolist(), young.weights.tolist()), 1)]
+    (tmp_path / "g.csv").write_text("\n".join(rows) + "\n")
+    (tmp_path / "e.csv").write_text((Path(__file__).resolve().parents[2] / PDMS_GMM).read_text())
+    grid = ("R: 5.19e-3, nu: 0.5, dg: 0.1523, h0: 30.8e-9, preload: 1.5e-3, speed: 1e-4, "
+            "model: crack")
+    ids = [parse_config(f"name: t\nunits: si\ngrid: {{material: {{prony: {f}}}, {grid}}}\n")
+           .si_tasks()[0][0] for f in ("g.csv", "e.csv")]
+    assert ids[0] == ids[1]
+    with pytest.raises(InputError, match=r"grid.material.nu: the table's Poisson's ratio 0.3 "
+                                         r"differs from the grid's nu = 0.5; give one"):
+        parse_config(f"name: t\nunits: si\ngrid: {{material: {{prony: g.csv, nu: 0.3}}, {grid}}}\n")
+    with pytest.raises(InputError, match="nu: the table's Poisson's ratio 0.3 differs"):
+        SIScene(material={"prony": "g.csv", "nu": 0.3}, R=5.19e-3, nu=0.5, dg=0.1523,
+                h0=30.8e-9, preload=1.5e-3, speed=1e-4)
+
+
 def test_the_same_table_in_every_format_is_the_same_si_scene(monkeypatch):
     """The relative formats (pyvisco, ANSYS, Abaqus) give the relaxed modulus as a
     difference, 7.5e-14 off the one the fit-dma JSON and this project's CSV state: read at

@@ -330,6 +330,25 @@ def test_a_scene_beyond_its_budget_is_refused_after_the_probe_with_what_it_needs
     assert need > 10000
 
 
+def test_the_least_indentation_travel_of_a_nearly_liquid_table():
+    """k = 1e-12 (a Prony table with a relaxed modulus 1e-12 of its instantaneous one): the
+    bracket of the least travel's root was a fixed 1e-12 of the travel, no bracket at this k,
+    and brentq raised out of simulate; the root now lies in [k/2, 1] of it: D = Cbar(D /
+    (rate h0)) delta0, checked on the mean compliance itself."""
+    table = {"tau": [1e-3, 1e-1], "E": [0.5, 0.5], "E0": 1e-12}
+    sc = Scene(material=table, n=0.8, mu=5.0, a0=2.0, rate=1.0)
+    assert sc.k == pytest.approx(1e-12, rel=1e-3)
+    from sweep.engine.problem import derive
+    speed = derive(sc, Numerics.preset("fast")).loading_speed
+    D = tf.indentation_travel(sc, 10.0, speed)
+    mat = tf.material_of(sc)
+    assert 0.0 < D < 10.0
+    assert D == pytest.approx(float(mat.integrated_compliance(D / speed)) / (D / speed) * 10.0,
+                              rel=1e-9)
+    res = models.simulate(sc, Numerics.preset("fast"))      # a row, whatever its status
+    assert res.status in ("ok", "failed") and res.reason is not None
+
+
 def test_the_least_steps_let_the_step_double_as_the_kernel_does():
     """From step 1 to the largest 8, doubling after EASY_STEPS (8) steps: 8 steps of 1, of
     2 and of 4 cover 56, then steps of 8; below 8 steps' travel, steps of the first size."""

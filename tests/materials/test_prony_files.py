@@ -259,6 +259,24 @@ BAD = [
      "-0.1, 0., 1.\n", "relative moduli g_i must be >= 0"),
     ("Abaqus non-numeric", "a.inp", "*Elastic\n1e6, 0.5\n*Viscoelastic, time=PRONY\n"
      "0.1, 0., fast\n", r"line 4, tau_i: must be a number \(got 'fast'\)"),
+    # pyvisco normalizes an overshooting fit's alpha_i to sum 1: in floating point 1 - 1e-16,
+    # a relaxed modulus of rounding (the BEM then raised, the crack-front model gave 23376)
+    ("relative moduli summing to 1 within rounding", "p.csv", PV_HEAD
+     + "1,0.0001,0.24694527138251782,1500.0,370.41790707377675\n"
+       "2,0.001,0.2478465005495941,1500.0,371.7697508243911\n"
+       "3,0.01,0.1580829171772686,1500.0,237.1243757659029\n"
+       "4,0.1,0.0876733453823922,1500.0,131.5100180735883\n"
+       "5,1.0,0.016543954739349945,1500.0,24.815932109024917\n"
+       "6,10.0,0.11760346392870505,1500.0,176.40519589305757\n"
+       "7,100.0,0.12530454684017214,1500.0,187.9568202602582\n",
+     r"the arms sum to the instantaneous modulus within rounding \(the relaxed modulus, their "
+     r"difference, is 1.6e-16 Einf, below 1e-12 Einf\): a liquid"),
+    ("a unit beside a value", "t.csv", "# visco-sweep prony\n# E0 = 1.5 MPa\ntau,E\n1,1\n",
+     r"t.csv line 2: E0 must be one value \(got '1.5 MPa'; a modulus's unit goes on its own "
+     r"line"),
+    ("Einf beside a table that gives it", "p.csv", PV_HEAD + "1,1.0,0.1,10.0,1.0\n",
+     r"Einf is given with a table only for an ANSYS card without MP,EX or an Abaqus deck "
+     r"without \*ELASTIC; this pyvisco table gives its moduli itself \(got Einf = 5e\+09\)"),
     ("no format", "notes.txt", "omega,E'\n1,2\n", "not a Prony table in any accepted format"),
     ("binary", "x.xls", None, "not a Prony table"),
     ("MPL-only fit", "fit.json", json.dumps({"mpl": {"E0": 1.4e6, "Einf": 3e9, "n": 0.22,
@@ -296,10 +314,42 @@ def test_bad_tables_give_one_line_naming_the_problem(tmp_path, case):
     else:
         spec = _write(tmp_path, name, content)
     with pytest.raises(InputError, match=fragment) as err:
-        read_prony(spec, nu=0.5)
+        read_prony(spec, nu=0.5, Einf=5e9 if case[0].startswith("Einf beside") else None)
     msg = str(err.value)
     assert "\n" not in msg
     assert (str(spec) in msg) if name is not None else msg.startswith("prony")
+
+
+def test_what_a_lab_file_carries_besides_the_table(tmp_path):
+    """A UTF-8 BOM (Excel's "CSV UTF-8") in every text format, a comment holding "=" in this
+    project's CSV, CRLF line ends: read as the table (the BOM had made each "not a Prony
+    table in any accepted format", the comment "unknown key")."""
+    ref = read_prony(DATA / FILES["visco-sweep"])
+    for name in FILES.values():
+        text = (DATA / name).read_text()
+        p = tmp_path / f"bom_{name}"
+        p.write_text("\ufeff" + text.replace("\n", "\r\n"), encoding="utf-8", newline="")
+        assert read_prony(p).content_hash() == ref.content_hash(), name
+    text = (DATA / FILES["visco-sweep"]).read_text().replace(
+        "# form", "# DMA master curve at T_ref = 20 C, shifted\n# form")
+    assert read_prony(_write(tmp_path, "c.csv", text)).content_hash() == ref.content_hash()
+    with pytest.raises(InputError, match=r"unknown key 'E_0' \(allowed: form, E0"):
+        read_prony(_write(tmp_path, "k.csv", text.replace("# E0", "# E_0")))
+
+
+def test_an_ansys_card_stating_its_units_takes_einf_in_pa(tmp_path):
+    """/UNITS,MPA: the card's numbers are MPa; an Einf given beside it is the table's
+    modulus as read, in Pa (it had been scaled by 1e6 again: 3e15 Pa); MP,EX in the card
+    and an Einf that differs are refused, in Pa."""
+    card = _write(tmp_path, "c.mpl", "/UNITS,MPA\nTB,PRONY,1,1,2,SHEAR\nTBDATA,1,0.5,0.001,0.3,0.1\n")
+    t = read_prony({"prony": str(card), "Einf": 3.0e9})
+    assert (t.Einf, t.modulus_unit) == (3.0e9, "Pa") and rel(t.E0, 0.2 * 3.0e9) < RTOL
+    with_ex = _write(tmp_path, "e.mpl", "/UNITS,MPA\nMP,EX,1,3000\n" + card.read_text())
+    assert read_prony(with_ex).Einf == 3.0e9
+    assert read_prony({"prony": str(with_ex), "Einf": 3.0e9}).Einf == 3.0e9
+    with pytest.raises(InputError, match=r"Einf = 3000 given with the card differs from its "
+                                         r"MP,EX = 3e\+09 Pa; give one"):
+        read_prony({"prony": str(with_ex), "Einf": 3000})
 
 
 def test_missing_file_and_bad_arguments(tmp_path):
