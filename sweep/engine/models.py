@@ -233,6 +233,9 @@ def wants_tip_following(scene, numerics) -> bool:
         return False
     if scene.machine_stiffness is not None:
         return False
+    if not BEM_MU_RANGE[0] <= scene.mu <= BEM_MU_RANGE[1]:
+        return False      # the BEM refuses it at once (problem.prepare); its graded mesh at
+        #                   mu 1e4 has 8e8 nodes, 12.6 GB built to be counted
     graded = bem_nodes_needed(scene, numerics)
     if graded > numerics.max_nodes:
         return True

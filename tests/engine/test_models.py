@@ -249,3 +249,21 @@ def test_auto_keeps_an_unresolved_bem_row_nearer_than_the_crack_front_model():
     assert res.error_estimate < 0.3 and math.isfinite(res.pull_off)
     crack = models.simulate(Scene(**{**scene.to_dict(), "model": "crack"}), Numerics.preset("fast"))
     assert crack.ok and crack.error_estimate > res.error_estimate
+
+
+@pytest.mark.parametrize("mu", [200.0, 1e4, 1e6])
+def test_a_bem_scene_beyond_its_tabor_range_is_refused_before_any_mesh(mu, monkeypatch):
+    """mu above the BEM's range with model bem: refused at once, naming the range. The
+    tip-following test had built the whole graded mesh first to count its nodes (mu 1e4:
+    8e8 nodes, 12.6 GB, 19 s; mu 1e6: a MemoryError as the reason; mu 200: "too many
+    steps ... raise max_steps", whose advice then met the range refusal)."""
+    def no_mesh(*args, **kwargs):
+        raise AssertionError("a mesh was sized for a scene the BEM refuses")
+
+    monkeypatch.setattr(models, "bem_nodes_needed", no_mesh)
+    for preset in ("fast", "balanced"):
+        res = models.simulate_model(Scene(n=0.8, k=0.1, mu=mu, a0=2.0, rate=1.0), "bem",
+                                    Numerics.preset(preset))
+        assert res.status == "failed" and res.steps == 0
+        assert res.reason.startswith(f"mu = {mu:g} is outside the hereditary BEM's range "
+                                     f"[{BEM_MU_RANGE[0]:g}, {BEM_MU_RANGE[1]:g}]"), res.reason
