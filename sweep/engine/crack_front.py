@@ -190,7 +190,8 @@ class GentSchultzLaw:
     def gamma(self, v):
         """``Gamma(v)``; ``c`` at ``v <= 0`` (a closing crack consumes no rate term)."""
         v = np.maximum(np.asarray(v, dtype=float), 0.0)
-        return (self.c * (1.0 + (v / self.v0) ** self.xi))[()]
+        with np.errstate(over="ignore"):        # inf beyond floats: a toughness no load meets
+            return (self.c * (1.0 + (v / self.v0) ** self.xi))[()]
 
     def speed(self, g):
         """``V(g)`` and ``dV/dg`` (0 where ``g <= c``; inf where ``V`` overflows: a trial
@@ -459,8 +460,14 @@ def _product_table(v0, xi, material, n, k, l0):
         if hi > hi_pb else np.empty(0)
     v = np.concatenate([below, v_pb, above])
     gb = np.concatenate([1.0 + q * below, g_pb, np.full(above.shape, g_pb[-1])])
-    g = (1.0 + (v / v0) ** xi) * gb
-    x, y = np.log(g - 1.0), np.log(v)
+    with np.errstate(over="ignore"):
+        g = (1.0 + (v / v0) ** xi) * gb
+        x, y = np.log(g - 1.0), np.log(v)
+    far = ~np.isfinite(x)
+    if far.any():    # (v/v0)^xi beyond floats (pz_v0 1e-30, xi 10): ln(Gamma - 1) in logs
+        with np.errstate(divide="ignore"):
+            x[far] = np.logaddexp(np.log(gb[far] - 1.0),
+                                  np.log(gb[far]) + xi * np.log(v[far] / v0))
     ok = np.concatenate([[True], np.diff(x) > 1e-12])     # strictly increasing abscissa
     x, y = x[ok], y[ok]
     spline = PchipInterpolator(x, y)

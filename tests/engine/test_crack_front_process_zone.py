@@ -192,6 +192,22 @@ def test_the_law_is_the_product_of_process_zone_and_bulk():
     assert law.speed(1.0)[0] == 0.0 and law.gamma(-1.0) == pytest.approx(1.0)
 
 
+def test_a_process_zone_beyond_floats_is_a_row():
+    """pz_v0 1e-30 a_ref/tau0 with pz_xi 10, both in their ranges: (v/pz_v0)^xi overflows
+    past 1e308 within the law's table, whose log then held inf and SciPy's PCHIP raised
+    ValueError out of simulate (status "error" in a sweep). The table's top now goes in logs:
+    the law there is the product law, ln(Gamma - 1) = ln(gb - 1 + gb (v/v0)^xi), and the
+    scene is a row."""
+    law = scene_law(0.8, 0.1, MU, "mpl", "gent-schultz", 1e-30, 10.0)
+    v = np.logspace(-29, -27, 5)                      # (v/v0)^10 from 1e10 to 1e30
+    want = np.asarray(gent_schultz(v, 1e-30, 10.0)) * pb_gamma_eff(0.8, 0.1, v / (1.6931 / MU**2))
+    np.testing.assert_allclose(law.gamma(v), want, rtol=1e-4)
+    np.testing.assert_allclose(law.speed(want)[0], v, rtol=1e-4)
+    res = simulate_crack(Scene(n=0.8, k=0.1, mu=MU, a0=2.0, rate=10.0, pz_law="gent-schultz",
+                               pz_v0=1e-30, pz_xi=10.0), Numerics.preset("balanced"))
+    assert res.status in ("ok", "failed") and res.reason is not None
+
+
 def test_pull_off_grows_with_the_process_zone_in_a_viscoelastic_bulk():
     kw = dict(n=0.8, k=0.1, mu=MU, a0=A0_HAT, model="crack")
     for rate in (0.1, 10.0, 1e3):
