@@ -1,6 +1,8 @@
 """`sweep run` / `sweep info` end to end, bad input, and SIGKILL at several moments + resume."""
 from __future__ import annotations
 
+import json
+
 import os
 import queue
 import re
@@ -140,10 +142,35 @@ def test_grow_a_sweep_runs_only_the_new_scenes(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "scenes: 9 finished of 9" in out and "grown: the grid is the union" in out
     assert "rate: 3 values in [1, 1e+04]" in out
-    # the smaller config again: nothing recomputed, nothing dropped, the file stays complete
-    again = run_sweep(cfg, jobs=1, simulate=_must_not_run, progress="none")
+    # the smaller config again: nothing recomputed, nothing dropped, the file stays complete;
+    # no "growing" line, and its own hash is not among the earlier configs (it had been)
+    lines = []
+    again = run_sweep(cfg, jobs=1, simulate=_must_not_run, progress="log",
+                      stream=_Lines(lines))
     assert (again.ran, again.skipped) == (0, 4)
     assert len(load("out/tiny.h5")) == 9 and read_attrs("out/tiny.h5")["n_scenes"] == 9
+    assert not any("growing" in ln for ln in lines), lines
+    history = json.loads(read_attrs("out/tiny.h5")["config_history"])
+    assert [e["config_hash"] for e in history] == [load_config(grown).config_hash]
+    capsys.readouterr()
+    assert main(["info", "out/tiny.h5"]) == 0
+    assert "union of this config and 1 earlier one" in capsys.readouterr().out
+
+
+class _Lines:
+    """A stream that keeps what is written to it, line by line."""
+
+    def __init__(self, lines):
+        self.lines = lines
+
+    def write(self, text):
+        self.lines.extend(ln for ln in text.splitlines() if ln.strip())
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return False
 
 
 @pytest.mark.parametrize("change, needle", [

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import socket
 import sys
 import tempfile
@@ -449,6 +450,22 @@ def _first_line(exc: BaseException) -> str:
     return text[0] if text else type(exc).__name__
 
 
+#: a dask scheduler's address: [protocol://]host:port (host a name, an IPv4 or a bracketed
+#: IPv6 address), or an in-process one
+_ADDRESS = re.compile(r"^(?:[a-z][a-z0-9+.-]*://)?(?:\[[0-9a-fA-F:.]+\]|[^\s/:\[\]]+):\d{1,5}$")
+
+
+def check_scheduler_address(address: str) -> str:
+    """``address`` if it is a dask scheduler's address (``tcp://host:8786``, ``host:8786``,
+    ``inproc://...``), else InputError naming it: a malformed one had waited out the
+    connection timeout, then dask's client cleanup 20 s more, with a traceback."""
+    text = str(address).strip()
+    if text.startswith("inproc://") or _ADDRESS.match(text):
+        return text
+    raise InputError(f"scheduler must be an address such as tcp://host:8786, host and port "
+                     f"(got {address!r})")
+
+
 def _connect_dask(scheduler, jobs, timeout):
     try:  # optional dependency (visco-sweep[cluster])
         from dask.distributed import Client, LocalCluster
@@ -522,6 +539,8 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
     if scheduler is not None and backend != "dask":
         raise InputError("scheduler: an address is only used with backend dask "
                          "(add --backend dask)")
+    if scheduler is not None:
+        check_scheduler_address(scheduler)
     if not callable(progress) and progress not in PROGRESS_MODES:
         raise InputError(f"progress must be one of {', '.join(PROGRESS_MODES)} "
                          f"(got {progress!r})")
@@ -558,20 +577,20 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
     if backend in ("local", "loky"):
         n_jobs = min(jobs or os.cpu_count() or 1, max(len(todo), 1))
         forked = backend == "local" and n_jobs > 1 and forked_workers_usable()
-        where = (f"{n_jobs} {'forked' if forked else 'loky'} worker"
-                 f"{'s' if n_jobs > 1 else ''}")
+        where = (f"on {n_jobs} {'forked' if forked else 'loky'} workers" if n_jobs > 1 else
+                 "in this process")
         backend = "fork" if forked else "loky"
     else:
         n_jobs = jobs or -1
-        where = f"dask cluster {scheduler or 'LocalCluster'}"
+        where = f"on dask cluster {scheduler or 'LocalCluster'}"
     if todo:
         prog.message(f"sweep {cfg.name}: {len(tasks)} scenes, {skipped} already done, "
-                     f"{len(todo)} to run on {where} -> {path}")
+                     f"{len(todo)} to run {where} -> {path}")
     else:
         prog.message(f"sweep {cfg.name}: all {len(tasks)} scenes already done -> {path}")
     if store.backup is not None:
         prog.message(f"previous results moved to {store.backup}")
-    if store.grown_from:
+    if store.grown_from and todo:
         prog.message(f"growing {path}: same numerics as the config that wrote it, so its "
                      f"finished scenes are kept and only new ones run ({len(done)} in the "
                      f"file, {store.meta['n_scenes']} in the grown grid)")

@@ -833,6 +833,9 @@ class ResultStore:
                     history.append({"config_hash": h, "config_text": text,
                                     "until": now_iso()})
             self._dirty = True   # consolidate now: the main file records the grown grid
+        # this config is the file's own now, not an earlier one (an earlier, smaller config
+        # run again on a grown file had listed itself among them)
+        history = [e for e in history if e["config_hash"] != self.config_hash]
         if history:
             self.meta["config_history"] = json.dumps(history)
         # the config's scenes that a row holds with other last bits count as finished

@@ -269,12 +269,34 @@ def test_unreachable_scheduler_fails_fast_and_writes_nothing(tmp_path):
     ({"jobs": 0}, "jobs must be an integer in [1, 4096]"),
     ({"scheduler": "tcp://x:1"}, "only used with backend dask"),
     ({"progress": "fancy"}, "progress must be one of"),
+    # a malformed address: one line at once (it had waited out the timeout, then 20 s of
+    # dask's client cleanup, with a traceback)
+    ({"backend": "dask", "scheduler": "notanaddress"},
+     "scheduler must be an address such as tcp://host:8786, host and port (got "
+     "'notanaddress')"),
+    ({"backend": "dask", "scheduler": "tcp://host/8786"}, "scheduler must be an address"),
 ])
 def test_bad_options(tmp_path, kw, needle):
     with pytest.raises(InputError) as info:
         run_sweep(cfg(), out=tmp_path / "r.h5", simulate=fake_simulate, **kw)
     assert needle in str(info.value)
     assert not (tmp_path / "r.h5").exists()
+
+
+@pytest.mark.parametrize("address", ["tcp://127.0.0.1:8786", "node7:8786", "tls://a.b.org:1",
+                                     "[::1]:8786", "tcp://[fe80::1]:8786", "inproc://10.0.0.1/1/2"])
+def test_a_dask_address_is_checked_before_connecting(address):
+    assert scheduler.check_scheduler_address(address) == address
+
+
+def test_one_job_runs_in_this_process(tmp_path):
+    """-j 1 runs the scenes in the sweep's own process: the first line says so (it had said
+    "on 1 loky worker")."""
+    buf = io.StringIO()
+    run_sweep(cfg(), jobs=1, out=tmp_path / "r.h5", simulate=fake_simulate, progress="log",
+              stream=buf)
+    first = buf.getvalue().splitlines()[0]
+    assert "4 to run in this process ->" in first, first
 
 
 def test_unwritable_output(tmp_path):
