@@ -237,7 +237,8 @@ def _read_data(path: Path) -> tuple:
     if not path.is_file():
         raise InputError(f"data: no such file {str(path)!r}")
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        # utf-8-sig: a byte-order mark (Excel's "CSV UTF-8") is not part of the header
+        lines = path.read_text(encoding="utf-8-sig").splitlines()
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{where}: not a readable CSV ({_one_line(exc)})") from None
     rows = [(number, [f.strip() for f in fields])
@@ -288,7 +289,7 @@ def load_calibration(path) -> Calibration:
 
 def _read_yaml(p: Path) -> dict:
     try:
-        text = p.read_text(encoding="utf-8")
+        text = p.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise InputError(f"calibration: no such file {str(p)!r}") from None
     except (IsADirectoryError, UnicodeDecodeError, OSError) as exc:

@@ -313,6 +313,18 @@ def test_data_comments_blank_lines_and_spaces_are_read():
     assert sigma.tolist() == [1e-3, 2e-3]
 
 
+def test_a_byte_order_mark_is_not_part_of_the_header(tmp_path):
+    """Excel's "CSV UTF-8" starts the file with a BOM: the data (and a YAML saved the same
+    way) read as without it; it had read as a column '\\ufeffspeed_m_s', "missing column"."""
+    path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED)
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    (tmp_path / "d.csv").write_bytes(b"\xef\xbb\xbfspeed_m_s,pull_off_N\r\n1e-6,0.01\r\n"
+                                     b"1e-5,0.02\r\n1e-4,0.03\r\n")
+    cal = cb.load_calibration(path)
+    assert cal.speed_m_s.tolist() == GOOD_DATA["speed_m_s"]
+    assert cal.pull_off_N.tolist() == GOOD_DATA["pull_off_N"]
+
+
 def test_missing_data_file_is_one_line(tmp_path, capsys):
     path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED)          # no CSV written
     assert main(["calibrate", str(path)]) == 2
