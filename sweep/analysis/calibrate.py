@@ -324,14 +324,40 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
     data : dict
     base : path
         Folder the ``data`` CSV path is relative to.
+    source : str
+        The file's name: every error starts with ``source: `` (as a sweep config's do).
     measurements : tuple, optional
         ``(speed_m_s, pull_off_N, sigma_N or None)`` instead of reading ``data``.
+
+    Raises
+    ------
+    InputError
+        One line, ``<source>: <the problem>``.
     """
+    try:
+        return _calibration_from_dict(data, base, source, measurements)
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}" if source else str(exc)) from None
+
+
+def _material(value) -> str:
+    """The calibration's material: mpl or sls (a Prony table's moduli are not SI fields)."""
+    if isinstance(value, dict) and "prony" in value:
+        raise InputError(f"material: a Prony table is not supported in a calibration file "
+                         f"(got {value!r}); material must be mpl or sls, its constants E0, "
+                         "Einf, n, tau0 fixed or fitted")
+    return check_choice("material", value, ("mpl", "sls"))
+
+
+def _calibration_from_dict(data, base, source, measurements) -> Calibration:
     if not isinstance(data, dict):
-        raise InputError(f"{source}: must be a mapping with keys name, data, fixed, fit, ...")
+        raise InputError("must be a mapping with keys name, data, fixed, fit, ...")
     for key in data:
         if key not in TOP_KEYS:
             raise InputError(f"{key}: unknown key (allowed: {', '.join(TOP_KEYS)})")
+    # the material first: a table given instead of the MPL/SLS constants is the problem,
+    # not the constants it leaves missing
+    material = _material(data.get("material", "mpl"))
     name = data.get("name")
     if not isinstance(name, str) or not name.strip():
         raise InputError("name: required, a short name such as pdms-lens")
@@ -385,7 +411,6 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
         raise InputError(f"fit.E0: upper bound must be <= Einf = {fixed['Einf']:.6g} Pa (got "
                          f"{by['E0'].hi:.6g})")
     model = check_choice("model", data.get("model", "auto"), CAL_MODELS)
-    material = check_choice("material", data.get("material", "mpl"), ("mpl", "sls"))
     num = data.get("numerics", {"preset": "fast"})
     if not isinstance(num, dict):
         raise InputError(f"numerics must be a mapping such as {{preset: fast}} (got {num!r})")
@@ -458,8 +483,7 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
         SIScene(**cal.values([0.5] * len(params)), speed=float(cal.speed_m_s[0]),
                 material=material)
     except InputError as exc:
-        raise InputError(f"{source}: the scene at the centre of the bounds is invalid: "
-                         f"{exc}") from None
+        raise InputError(f"the scene at the centre of the bounds is invalid: {exc}") from None
     return cal
 
 

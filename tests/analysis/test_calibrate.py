@@ -265,7 +265,7 @@ def test_bad_files_one_line_exit_2(tmp_path, capsys, change, words):
     path = _problem(tmp_path, fit, fixed, change.get("data", GOOD_DATA), **extra)
     assert main(["calibrate", str(path)]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("error: ") and "\n" not in err
+    assert err.startswith(f"error: {path}: ") and "\n" not in err, err   # as sweep run's
     assert words in err, err
 
 
@@ -294,7 +294,7 @@ def test_data_rows_must_match_the_header(tmp_path, capsys, csv, words):
     (tmp_path / "d.csv").write_text(csv)
     assert main(["calibrate", str(path)]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("error: data ") and "\n" not in err and "np." not in err
+    assert err.startswith(f"error: {path}: data ") and "\n" not in err and "np." not in err
     assert words in err, err
 
 
@@ -311,6 +311,22 @@ def test_data_comments_blank_lines_and_spaces_are_read():
         speed, po, sigma = cb._read_data(p)
     assert speed.tolist() == [1e-6, 1e-5] and po.tolist() == [0.01, 0.02]
     assert sigma.tolist() == [1e-3, 2e-3]
+
+
+def test_a_prony_table_is_refused_first_naming_the_file(tmp_path, capsys):
+    """A table as the material is the problem, not the MPL constants it leaves out: the
+    first error says so (it had said "E0, Einf, n, tau0: missing"), after the file's name."""
+    fixed = {k: v for k, v in GOOD_FIXED.items() if k not in ("E0", "Einf", "n")}
+    path = _problem(tmp_path, {"dg": [0.05, 0.5]}, fixed, GOOD_DATA,
+                    material={"prony": "lab.csv"})
+    assert main(["calibrate", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"error: {path}: material: a Prony table is not supported"), err
+    assert "missing" not in err and "\n" not in err
+    # a material that is neither: the choice, also with the file's name
+    path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED, GOOD_DATA, material="maxwell")
+    with pytest.raises(InputError, match=r"c\.yaml: material must be one of mpl, sls"):
+        cb.load_calibration(path)
 
 
 def test_a_byte_order_mark_is_not_part_of_the_header(tmp_path):
