@@ -45,7 +45,14 @@ Method (:func:`calibrate`):
    step on sqrt(D)); a side that reaches its bound without crossing is open. ``identifiable``
    is true only when both sides close within the bounds; ``status`` says "identifiable",
    "lower limit only", "upper limit only" or "not identifiable" (the profile is flat below the
-   threshold over the whole box: these data do not determine the parameter).
+   threshold over the whole box: these data do not determine the parameter). A profile
+   that finds a lower minimum than the local fits (SSR below the estimate's by more than
+   :data:`RECENTRE_D` in D) moves the estimate: a local fit from that point, then every
+   profile again about the new estimate, so that the estimate, the intervals, the statuses
+   and the profile curves are about one point (each interval holds its estimate, where
+   D = 0). At most :data:`MAX_RECENTRES` times (``recentred`` in the result lists each move,
+   the summary prints a note); a lower point found after that is reported in ``warnings``
+   (and printed) and the estimate stays at the centre of the profiles.
 4. Correlation matrix: the linearized one at the estimate, ``pinv(J^T J)`` in the unit
    coordinates (the same correlations as in the log/linear coordinates); not meaningful for
    parameters that are not identifiable.
@@ -110,6 +117,12 @@ TOP_KEYS = ("name", "description", "data", "fixed", "fit", "model", "numerics", 
 KEY_DIGITS = 10
 #: residual of a failed scene (log units: a factor e^10 off)
 FAILED_RESIDUAL = 10.0
+#: a profile point whose SSR is below the estimate's by more than this, in units of the
+#: profile statistic D, re-centres the fit there (a smaller drop is within the local fits'
+#: own tolerance: their ftol stops when a step changes D by < ~0.02)
+RECENTRE_D = 0.1
+#: at most this many re-centrings; a lower point found after them is reported as a warning
+MAX_RECENTRES = 2
 
 
 def _one_line(text) -> str:
@@ -237,7 +250,8 @@ def _read_data(path: Path) -> tuple:
     if not path.is_file():
         raise InputError(f"data: no such file {str(path)!r}")
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        # utf-8-sig: a byte-order mark (Excel's "CSV UTF-8") is not part of the header
+        lines = path.read_text(encoding="utf-8-sig").splitlines()
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{where}: not a readable CSV ({_one_line(exc)})") from None
     rows = [(number, [f.strip() for f in fields])
@@ -288,7 +302,7 @@ def load_calibration(path) -> Calibration:
 
 def _read_yaml(p: Path) -> dict:
     try:
-        text = p.read_text(encoding="utf-8")
+        text = p.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise InputError(f"calibration: no such file {str(p)!r}") from None
     except (IsADirectoryError, UnicodeDecodeError, OSError) as exc:
@@ -323,14 +337,40 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
     data : dict
     base : path
         Folder the ``data`` CSV path is relative to.
+    source : str
+        The file's name: every error starts with ``source: `` (as a sweep config's do).
     measurements : tuple, optional
         ``(speed_m_s, pull_off_N, sigma_N or None)`` instead of reading ``data``.
+
+    Raises
+    ------
+    InputError
+        One line, ``<source>: <the problem>``.
     """
+    try:
+        return _calibration_from_dict(data, base, source, measurements)
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}" if source else str(exc)) from None
+
+
+def _material(value) -> str:
+    """The calibration's material: mpl or sls (a Prony table's moduli are not SI fields)."""
+    if isinstance(value, dict) and "prony" in value:
+        raise InputError(f"material: a Prony table is not supported in a calibration file "
+                         f"(got {value!r}); material must be mpl or sls, its constants E0, "
+                         "Einf, n, tau0 fixed or fitted")
+    return check_choice("material", value, ("mpl", "sls"))
+
+
+def _calibration_from_dict(data, base, source, measurements) -> Calibration:
     if not isinstance(data, dict):
-        raise InputError(f"{source}: must be a mapping with keys name, data, fixed, fit, ...")
+        raise InputError("must be a mapping with keys name, data, fixed, fit, ...")
     for key in data:
         if key not in TOP_KEYS:
             raise InputError(f"{key}: unknown key (allowed: {', '.join(TOP_KEYS)})")
+    # the material first: a table given instead of the MPL/SLS constants is the problem,
+    # not the constants it leaves missing
+    material = _material(data.get("material", "mpl"))
     name = data.get("name")
     if not isinstance(name, str) or not name.strip():
         raise InputError("name: required, a short name such as pdms-lens")
@@ -384,7 +424,6 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
         raise InputError(f"fit.E0: upper bound must be <= Einf = {fixed['Einf']:.6g} Pa (got "
                          f"{by['E0'].hi:.6g})")
     model = check_choice("model", data.get("model", "auto"), CAL_MODELS)
-    material = check_choice("material", data.get("material", "mpl"), ("mpl", "sls"))
     num = data.get("numerics", {"preset": "fast"})
     if not isinstance(num, dict):
         raise InputError(f"numerics must be a mapping such as {{preset: fast}} (got {num!r})")
@@ -457,8 +496,7 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
         SIScene(**cal.values([0.5] * len(params)), speed=float(cal.speed_m_s[0]),
                 material=material)
     except InputError as exc:
-        raise InputError(f"{source}: the scene at the centre of the bounds is invalid: "
-                         f"{exc}") from None
+        raise InputError(f"the scene at the centre of the bounds is invalid: {exc}") from None
     return cal
 
 
@@ -757,6 +795,8 @@ def calibrate(cal: Calibration, jobs: int | None = None,
         ``parameters`` {name: estimate, interval [SI], identifiable, status, bounds, scale,
         truth}, ``correlation``, ``fit`` (ssr, chi2 or rms_log_residual, dof, threshold),
         ``profiles``, ``curve`` (speed_m_s, pull_off_N, band_lo_N, band_hi_N), ``data``,
+        ``recentred`` (each move of the estimate to a lower minimum a profile found: the
+        profile, the SSR and estimate before and after), ``warnings`` (text),
         ``scenes_run``, ``cache_hits``, ``failed_scenes``, ``models_used``, ``wall_s``.
         See the module docstring for the method.
     """
@@ -806,16 +846,43 @@ def calibrate(cal: Calibration, jobs: int | None = None,
     scale = 1.0 if cal.sigma_N is not None else max(ssr_best / max(dof, 1), 1e-300)
     thr, stat = _threshold(cal, max(dof, 1))
 
-    # 2. profiles
+    # 2. profiles, about the estimate: every profile, interval and status is about u_best
     prof = {}
-    if profiles:
-        for j in range(p):
-            prof[j] = _profile(obj, cal, j, u_best, ssr_best, scale, thr, log)
-        # a profile may find a lower minimum than the local fits: move the estimate there
-        for j, pr in prof.items():
-            i = int(np.argmin(pr["ssr"]))
-            if pr["ssr"][i] < ssr_best * (1 - 1e-9) - 1e-15:
-                u_best, ssr_best = pr["U"][i], pr["ssr"][i]
+    recentred, warnings = [], []
+    while profiles:
+        prof = {j: _profile(obj, cal, j, u_best, ssr_best, scale, thr, log) for j in range(p)}
+        # a profile may find a lower minimum than the local fits (they end at a local one):
+        # fit again from there and redo the profiles about the new estimate
+        j_low = min(prof, key=lambda j: min(prof[j]["ssr"]))
+        i_low = int(np.argmin(prof[j_low]["ssr"]))
+        s_low, u_low = prof[j_low]["ssr"][i_low], prof[j_low]["U"][i_low]
+        drop = (ssr_best - s_low) / scale
+        if not drop > RECENTRE_D:
+            break
+        name = cal.params[j_low].name
+        at = {cal.params[i].name: float(cal.params[i].value(u_low[i])) for i in range(p)}
+        if len(recentred) >= MAX_RECENTRES:
+            warnings.append(
+                f"after {len(recentred)} re-centrings the profile of {name} still found a "
+                f"lower minimum, SSR {s_low:.4g} against the estimate's {ssr_best:.4g} "
+                f"(D {drop:.3g} below), at "
+                f"{', '.join(f'{k} = {v:.4g}' for k, v in at.items())}: the estimates, "
+                "intervals and statuses are about the estimate, not that point; more "
+                "search starts, or `start:` there, may settle it")
+            log(f"warning: {warnings[-1]}")
+            break
+        u_new, s_new = obj.fit(u_low)
+        if not s_new <= s_low:
+            u_new, s_new = u_low, s_low
+        recentred.append({"profile": name, "ssr_from": ssr_best, "ssr_profile": s_low,
+                          "ssr": s_new, "estimate_from": {
+                              prm.name: float(prm.value(u_best[i]))
+                              for i, prm in enumerate(cal.params)},
+                          "estimate": {prm.name: float(prm.value(u_new[i]))
+                                       for i, prm in enumerate(cal.params)}})
+        log(f"the profile of {name} found a lower minimum (SSR {ssr_best:.4g} -> "
+            f"{s_low:.4g}, refitted {s_new:.4g}): the profiles again about it")
+        u_best, ssr_best = u_new, s_new
         scale = 1.0 if cal.sigma_N is not None else max(ssr_best / max(dof, 1), 1e-300)
 
     # 3. correlation (linearized at the estimate)
@@ -834,7 +901,7 @@ def calibrate(cal: Calibration, jobs: int | None = None,
         if j in prof:
             pr = prof[j]
             lo_u, hi_u = pr["ends"]
-            # with a moved minimum, D is re-read from the stored profile
+            # a point below the estimate by less than RECENTRE_D reads as D = 0
             D = np.maximum(np.array(pr["ssr"]) - ssr_best, 0.0) / scale
             d.update(interval=[float(prm.value(lo_u)), float(prm.value(hi_u))],
                      identifiable=not (pr["open"][0] or pr["open"][1]),
@@ -896,6 +963,7 @@ def calibrate(cal: Calibration, jobs: int | None = None,
                   "band_hi_N": np.asarray(band_hi).tolist(),
                   "band": "envelope of the parameter sets on the profiles below the "
                           "threshold" if prof else "none (no profiles)"},
+        "recentred": recentred, "warnings": warnings,
         "scenes_run": ev.scenes_run, "cache_hits": ev.cache_hits,
         "failed_scenes": ev.failed, "failure_reasons": dict(ev.reasons.most_common(5)),
         "models_used": dict(ev.models), "jobs": ev.jobs,
@@ -925,6 +993,11 @@ def summary_lines(result: dict) -> list:
          else f"RMS log residual {f['rms_log_residual']:.4g}")
     lines.append(f"{q}; {result['scenes_run']} scenes run ({result['failed_scenes']} failed, "
                  f"models {result['models_used']}) in {result['wall_s']:.1f} s")
+    for m in result.get("recentred", []):
+        lines.append(f"note: the profile of {m['profile']} found a lower minimum (SSR "
+                     f"{m['ssr_from']:.4g} -> {m['ssr']:.4g}); the estimate moved there and "
+                     "the profiles were redone about it")
+    lines += [f"warning: {w}" for w in result.get("warnings", [])]
     return lines
 
 

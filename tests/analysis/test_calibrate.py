@@ -181,8 +181,79 @@ def test_unidentifiable_parameter_is_flagged(degenerate):
     # tau0 is pinned only through h0's bounds, and its interval holds the truth
     tau = res["parameters"]["tau0"]
     assert tau["interval"][0] <= tau["truth"] <= tau["interval"][1]
+    # ... and the estimate: a point along the flat valley 5e-10 below in SSR had moved the
+    # estimate to tau0 = 0.18, outside its interval [0.0017, 0.089] about the first point
+    assert tau["interval"][0] <= tau["estimate"] <= tau["interval"][1]
+    assert not res["recentred"] and not res["warnings"]
     # the flat direction is tau0 ~ h0^2: the two are fully correlated
     assert abs(res["correlation"]["matrix"][0][1]) > 0.99
+
+
+# ------------------------------------------------------------------ a lower minimum on a profile
+# s48_A finding 1: the data of a 20-arm Prony table fitted with an SLS (a model that does
+# not match the data). The one local fit ends at dg = 0.37, tau0 = 1e-4 s (SSR 2.13); the
+# profile of tau0 finds SSR 0.72 at tau0 = 10 s, dg = 0.027. The estimate had moved there
+# while the intervals and statuses stayed those of the first point: dg 0.0266 was printed
+# with the interval [0.235, 0.5], "lower limit only", its profile's least D 11.75.
+SLS_PROBLEM = {
+    "name": "sls", "material": "sls", "model": "crack",
+    "fixed": {"R": 5.0e-3, "nu": 0.5, "h0": 30.0e-9, "preload": 1.0e-3, "E0": 1.5e6,
+              "Einf": 1.3547649e9, "n": 0.3},
+    "fit": {"dg": [0.005, 0.5], "tau0": [1.0e-4, 10.0]},
+    "search": {"points": 16, "starts": 1}, "profile": {"points": 6}}
+SLS_DATA = ([1e-6, 1e-6, 1e-5, 1e-5, 1e-4, 1e-4, 1e-3, 1e-3],
+            [0.0235247, 0.0204944, 0.0280127, 0.0271963, 0.0338494, 0.034091, 0.0398056,
+             0.0419992], None)
+
+
+def _assert_about_the_estimate(res):
+    """Every interval holds its estimate, and each profile is about the estimate: D = 0
+    there (its least value) and below the threshold wherever the interval says."""
+    thr = res["fit"]["threshold"]
+    for name, p in res["parameters"].items():
+        lo, hi = p["interval"]
+        assert lo <= p["estimate"] <= hi, (name, p)
+        vals, stat = (np.array(res["profiles"][name][k]) for k in ("values", "statistic"))
+        at = np.argmin(abs(np.log(vals) - math.log(p["estimate"])))
+        assert stat[at] == 0.0 and stat.min() == 0.0, (name, stat)
+        assert np.all(stat[(vals > lo * 1.0001) & (vals < hi * 0.9999)] <= thr), (name, stat)
+        assert p["identifiable"] == (p["status"] == "identifiable")
+        # a side flagged open stays below the threshold out to its bound
+        if p["status"] in ("lower limit only", "not identifiable"):
+            assert hi == pytest.approx(p["bounds"][1]) and stat[-1] <= thr
+        if p["status"] in ("upper limit only", "not identifiable"):
+            assert lo == pytest.approx(p["bounds"][0]) and stat[0] <= thr
+
+
+def test_a_lower_minimum_on_a_profile_recentres_the_fit():
+    cal = cb.calibration_from_dict(SLS_PROBLEM, measurements=SLS_DATA)
+    res = cb.calibrate(cal, jobs=1, curve_points=5)
+    _assert_about_the_estimate(res)
+    (move,) = res["recentred"]                       # the case happened, once
+    assert move["profile"] == "tau0" and move["ssr"] < 0.5 * move["ssr_from"]
+    assert res["fit"]["ssr"] == move["ssr"] and not res["warnings"]
+    assert res["parameters"]["dg"]["estimate"] == pytest.approx(move["estimate"]["dg"])
+    # dg is now closed about the new estimate (it was "lower limit only" about the old)
+    dg = res["parameters"]["dg"]
+    assert dg["status"] == "identifiable" and dg["interval"][1] < 0.2
+    assert any(line.startswith("note: the profile of tau0 found a lower minimum")
+               for line in cb.summary_lines(res))
+
+
+def test_a_lower_minimum_after_the_last_recentring_is_a_warning(monkeypatch):
+    """With no re-centring left, the estimate stays where the profiles are about (the local
+    fit's end), and the output says where the lower point is."""
+    monkeypatch.setattr(cb, "MAX_RECENTRES", 0)
+    cal = cb.calibration_from_dict(SLS_PROBLEM, measurements=SLS_DATA)
+    res = cb.calibrate(cal, jobs=1, curve_points=5)
+    assert not res["recentred"]
+    (warning,) = res["warnings"]
+    assert "the profile of tau0 still found a lower minimum" in warning
+    best = min(res["search"]["local_fits"], key=lambda f: f["ssr"])
+    assert res["fit"]["ssr"] == best["ssr"]
+    assert res["parameters"]["dg"]["estimate"] == pytest.approx(best["end"]["dg"])
+    _assert_about_the_estimate(res)
+    assert f"warning: {warning}" in cb.summary_lines(res)
 
 
 # ------------------------------------------------------------------ pieces
@@ -265,7 +336,7 @@ def test_bad_files_one_line_exit_2(tmp_path, capsys, change, words):
     path = _problem(tmp_path, fit, fixed, change.get("data", GOOD_DATA), **extra)
     assert main(["calibrate", str(path)]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("error: ") and "\n" not in err
+    assert err.startswith(f"error: {path}: ") and "\n" not in err, err   # as sweep run's
     assert words in err, err
 
 
@@ -294,7 +365,7 @@ def test_data_rows_must_match_the_header(tmp_path, capsys, csv, words):
     (tmp_path / "d.csv").write_text(csv)
     assert main(["calibrate", str(path)]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("error: data ") and "\n" not in err and "np." not in err
+    assert err.startswith(f"error: {path}: data ") and "\n" not in err and "np." not in err
     assert words in err, err
 
 
@@ -311,6 +382,34 @@ def test_data_comments_blank_lines_and_spaces_are_read():
         speed, po, sigma = cb._read_data(p)
     assert speed.tolist() == [1e-6, 1e-5] and po.tolist() == [0.01, 0.02]
     assert sigma.tolist() == [1e-3, 2e-3]
+
+
+def test_a_prony_table_is_refused_first_naming_the_file(tmp_path, capsys):
+    """A table as the material is the problem, not the MPL constants it leaves out: the
+    first error says so (it had said "E0, Einf, n, tau0: missing"), after the file's name."""
+    fixed = {k: v for k, v in GOOD_FIXED.items() if k not in ("E0", "Einf", "n")}
+    path = _problem(tmp_path, {"dg": [0.05, 0.5]}, fixed, GOOD_DATA,
+                    material={"prony": "lab.csv"})
+    assert main(["calibrate", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"error: {path}: material: a Prony table is not supported"), err
+    assert "missing" not in err and "\n" not in err
+    # a material that is neither: the choice, also with the file's name
+    path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED, GOOD_DATA, material="maxwell")
+    with pytest.raises(InputError, match=r"c\.yaml: material must be one of mpl, sls"):
+        cb.load_calibration(path)
+
+
+def test_a_byte_order_mark_is_not_part_of_the_header(tmp_path):
+    """Excel's "CSV UTF-8" starts the file with a BOM: the data (and a YAML saved the same
+    way) read as without it; it had read as a column '\\ufeffspeed_m_s', "missing column"."""
+    path = _problem(tmp_path, GOOD_FIT, GOOD_FIXED)
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    (tmp_path / "d.csv").write_bytes(b"\xef\xbb\xbfspeed_m_s,pull_off_N\r\n1e-6,0.01\r\n"
+                                     b"1e-5,0.02\r\n1e-4,0.03\r\n")
+    cal = cb.load_calibration(path)
+    assert cal.speed_m_s.tolist() == GOOD_DATA["speed_m_s"]
+    assert cal.pull_off_N.tolist() == GOOD_DATA["pull_off_N"]
 
 
 def test_missing_data_file_is_one_line(tmp_path, capsys):
