@@ -26,7 +26,7 @@ import multiprocessing
 import signal
 import sys
 import threading
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, as_completed, wait
 
 #: the calls of the pool being started, (function, [argument tuples]): read by the forked
 #: workers (their copy of the parent's memory), cleared in the parent once they are forked
@@ -79,6 +79,17 @@ class ForkedWorkers:
         for future in as_completed(list(self.pending)):
             self.pending.discard(future)
             yield future.result()           # BrokenProcessPool if a worker died
+
+    def ticking(self, seconds: float):
+        """As iterating, but yield ``None`` each time ``seconds`` pass without a result (a
+        caller's moment to look at what the workers write meanwhile)."""
+        while self.pending:
+            done, _ = wait(self.pending, timeout=seconds, return_when=FIRST_COMPLETED)
+            if not done:
+                yield None
+            for future in done:
+                self.pending.discard(future)
+                yield future.result()       # BrokenProcessPool if a worker died
 
     def close(self) -> None:
         """End the workers: at once (SIGKILL) if results are still unread, else when idle."""

@@ -57,6 +57,7 @@ from tqdm import tqdm
 from .config import SweepConfig, as_config
 from ..errors import InputError, check_int, check_range
 from ..scene import Result
+from . import spool
 from .store import ResultStore, StoreBusyError, plain_row
 from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
 from .forked import ForkedWorkers, usable as forked_workers_usable
@@ -569,6 +570,10 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
         _close_dask(client, cluster)
         raise
 
+    spool_dir = store.parts / SPOOL
+    # rows a killed sweep's workers had finished and it had not stored (sweep.campaign.spool)
+    task_ids = {sid for sid, _ in tasks}
+    done |= _unspool(store, spool_dir, task_ids - done, error_log_path(path))
     # a scene that hit an internal error (a bug, not a result) runs again on resume
     retry = {row["scene_id"] for row in store.rows if row.get("status") == "error"}
     todo = [(sid, scene) for sid, scene in tasks if sid not in done or sid in retry]
@@ -607,7 +612,8 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
             chunks = dispatch_chunks(todo, cfg.numerics, n_jobs)
             # forked workers start here, before the progress bar's thread (a fork copies
             # one thread only: sweep.campaign.forked)
-            results = _results(chunks, cfg, backend, n_jobs, client, simulate, warm)
+            results = _results(chunks, cfg, backend, n_jobs, client, simulate, warm,
+                               spool_dir if n_jobs > 1 else None)
             prog.start()
             try:
                 for row, traj in results:
@@ -630,15 +636,18 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
         completed = True
     except KeyboardInterrupt:
         prog.close()
+        _unspool(store, spool_dir, task_ids, error_log)
         _finish_store(store)
         raise SweepInterrupted(kept=len(store.rows), total=store.meta["n_scenes"],
                                output=path) from None
     except SystemExit:
         prog.close()
+        _unspool(store, spool_dir, task_ids, error_log)
         _finish_store(store)
         raise
     except Exception as exc:
         prog.close()
+        _unspool(store, spool_dir, task_ids, error_log)
         _finish_store(store)
         raise SweepRuntimeError(
             f"sweep stopped after {ran} of {len(todo)} scenes ({type(exc).__name__}: "
@@ -649,12 +658,34 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
     if completed:
         prog.close()
         store.finish()
+        spool.clear(spool_dir)
     report = SweepReport(output=path, name=cfg.name, total=len(tasks), skipped=skipped, ran=ran,
                          failed=failed, wall_s=time.monotonic() - t_start, backend=backend,
                          jobs=n_jobs, backup=store.backup, failed_ids=failed_ids,
                          errors=errors, error_ids=error_ids,
                          error_log=error_log if errors else None)
     return report
+
+
+#: the spool's folder in a results file's parts directory (:mod:`sweep.campaign.spool`)
+SPOOL = "spool"
+
+
+def _unspool(store: ResultStore, spool_dir: Path, wanted: set, error_log: Path) -> set:
+    """Store the spooled rows of ``wanted`` scenes that ``store`` lacks (an interrupted
+    chunk's finished scenes, or those of a sweep killed with its workers), then clear the
+    spool; an internal error's traceback goes to ``error_log``. Returns their ids."""
+    kept = set()
+    for row, traj in spool.read(spool_dir):
+        sid = row.get("scene_id")
+        if sid in wanted and not store.holds(sid) and sid not in kept:
+            tb = row.pop(TRACEBACK_KEY, None)
+            store.append(row, traj)
+            if row.get("status") == "error":
+                log_internal_error(error_log, row, tb or "(no traceback)\n")
+            kept.add(sid)
+    spool.clear(spool_dir)
+    return kept
 
 
 def _finish_store(store: ResultStore) -> None:
@@ -722,21 +753,44 @@ def needs_bem_kernels(scenes, numerics) -> bool:
 
 
 def run_chunk(scenes, numerics, trajectories: bool = False,
-              simulate: Callable | None = None, warm: bool = True) -> list:
+              simulate: Callable | None = None, warm: bool = True, spool_dir=None) -> list:
     """Worker task: :func:`run_scene` on each scene of a dispatch chunk, in order; returns
-    the list of their ``(row, trajectory or None)``."""
-    return [run_scene(scene, numerics, trajectories, simulate, warm=warm) for scene in scenes]
+    the list of their ``(row, trajectory or None)``. With ``spool_dir`` each is also written
+    there as its scene ends (:mod:`sweep.campaign.spool`: what an interrupt keeps)."""
+    out = []
+    for scene in scenes:
+        out.append(run_scene(scene, numerics, trajectories, simulate, warm=warm))
+        if spool_dir is not None:
+            spool.write(spool_dir, *out[-1])
+    return out
+
+
+#: seconds between two reads of the forked workers' spool while no chunk ends
+SPOOL_TICK = 0.2
 
 
 class _ForkedResults:
     """The rows of forked workers (:class:`sweep.campaign.forked.ForkedWorkers`), started on
-    creation: an iterator of ``(row, trajectory)`` with the generator's ``close``."""
+    creation: an iterator of ``(row, trajectory)`` with the generator's ``close``. With a
+    spool each row comes as its scene ends (read from the spool, :data:`SPOOL_TICK`), else
+    with its chunk."""
 
-    def __init__(self, chunks, cfg: SweepConfig, n_jobs: int, simulate, warm: bool):
-        calls = [([scene for _, scene in chunk], cfg.numerics, cfg.trajectories, simulate, warm)
-                 for chunk in chunks]
+    def __init__(self, chunks, cfg: SweepConfig, n_jobs: int, simulate, warm: bool,
+                 spool_dir=None):
+        calls = [([scene for _, scene in chunk], cfg.numerics, cfg.trajectories, simulate, warm,
+                  spool_dir) for chunk in chunks]
         self._workers = ForkedWorkers(run_chunk, calls, n_jobs)
-        self._rows = (row for rows in self._workers for row in rows)
+        self._rows = (self._streamed(spool.Reader(spool_dir)) if spool_dir is not None else
+                      (row for rows in self._workers for row in rows))
+
+    def _streamed(self, reader):
+        seen = set()
+        for rows in self._workers.ticking(SPOOL_TICK):
+            # the spool first: a chunk's rows are there before its result
+            for row, traj in reader.new() + (rows or []):
+                if row["scene_id"] not in seen:
+                    seen.add(row["scene_id"])
+                    yield row, traj
 
     def __iter__(self):
         return self
@@ -749,18 +803,20 @@ class _ForkedResults:
 
 
 def _results(chunks, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate,
-             warm: bool = True):
+             warm: bool = True, spool_dir=None):
     """``(row, trajectory)`` per scene: chunk by chunk in completion order. Forked workers
-    (backend "fork") start at this call; the others at the first row asked for."""
+    (backend "fork") start at this call; the others at the first row asked for. Local
+    workers also spool each row as its scene ends (``spool_dir``, :mod:`sweep.campaign.spool`)."""
     if backend == "fork":
-        return _ForkedResults(chunks, cfg, n_jobs, simulate, warm)
-    return _joblib_results(chunks, cfg, backend, n_jobs, client, simulate, warm)
+        return _ForkedResults(chunks, cfg, n_jobs, simulate, warm, spool_dir)
+    return _joblib_results(chunks, cfg, backend, n_jobs, client, simulate, warm,
+                           spool_dir if backend == "loky" else None)
 
 
 def _joblib_results(chunks, cfg: SweepConfig, backend: str, n_jobs: int, client, simulate,
-                    warm: bool = True):
+                    warm: bool = True, spool_dir=None):
     calls = (delayed(run_chunk)([scene for _, scene in chunk], cfg.numerics,
-                                cfg.trajectories, simulate, warm)
+                                cfg.trajectories, simulate, warm, spool_dir)
              for chunk in chunks)
     if backend == "loky" and n_jobs == 1:
         limits = limit_loaded_pools()

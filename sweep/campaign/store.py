@@ -9,6 +9,9 @@ Layout on disk for ``output = results/x.h5``::
         journal.jsonl       one JSON line per finished scene: its runs-table row
         traj/<id>.h5        trajectory of one scene (written to a temporary name, fsync-free,
                             then os.replace'd; always written *before* the scene's journal line)
+        spool/<pid>.rows    rows local workers finished in dispatch chunks the writer has not
+                            received yet (:mod:`sweep.campaign.spool`; scratch, read back
+                            after an interrupt or on resume)
     results/x.h5.lock       advisory lock (flock) held by the single writer
     results/x.h5.tmp        a consolidation in progress (a stale one is deleted on next open)
 
@@ -865,6 +868,10 @@ class ResultStore:
                     fh.truncate(data.rfind(b"\n") + 1)
         self._jfd = os.open(jp, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
         return set(self._ids) | set(twins)
+
+    def holds(self, scene_id: str) -> bool:
+        """Whether a row of ``scene_id`` is stored (read or appended)."""
+        return scene_id in self._ids
 
     def _add(self, row: dict) -> None:
         self._ids[row["scene_id"]] = len(self.rows)

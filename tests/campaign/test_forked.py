@@ -134,12 +134,13 @@ print(round(time.monotonic() - t0), len(multiprocessing.active_children()))
 
 def test_an_interrupted_sweep_leaves_no_forked_worker(tmp_path):
     """An exception in the parent's loop: the workers, busy with one-minute scenes, are
-    killed at once (not waited for) and the finished rows kept."""
+    killed at once (not waited for) and the finished rows kept: the three the loop saw, and
+    the fourth quick scene where a worker had spooled it by then (sweep.campaign.spool)."""
     lines = _fresh_python(_INTERRUPTED, str(tmp_path / "r.h5")).strip().splitlines()
     assert lines[-2] == "sweep stopped after 3 of 12 scenes"
     seconds, children = map(int, lines[-1].split())
     assert seconds < 30 and children == 0
-    assert len(load(tmp_path / "r.h5")) == 3
+    assert 3 <= len(load(tmp_path / "r.h5")) <= 4
 
 
 _CRASH = """
@@ -238,3 +239,79 @@ def test_forked_workers_return_every_result_and_keep_none_read():
     """Every call's result, in completion order; a result read is no longer held by the
     pool (a long sweep's rows are not all kept until its end)."""
     assert _fresh_python(_POOL).split() == ["True", "0"]
+
+
+_INTERRUPTED_CHUNK = """
+import sys
+from sweep.campaign.scheduler import dispatch_chunks, run_sweep
+from tests.campaign.test_forked import cfg, _slow_simulate
+c = cfg(n=(0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), rate=(1, 2, 3, 5, 10, 20, 30, 50))
+assert min(len(ch) for ch in dispatch_chunks(c.tasks(), c.numerics, 2)[:2]) > 2
+print("started", flush=True)
+run_sweep(c, jobs=2, backend=sys.argv[2], out=sys.argv[1], simulate=_slow_simulate,
+          progress="none")
+"""
+
+
+def _interrupt_after_quick_scenes(tmp_path, backend, sig):
+    """Run _INTERRUPTED_CHUNK (64 scenes of one start group: dispatch chunks of several
+    scenes, of which each worker finishes its first two at once and then sleeps a minute in
+    the third) and send ``sig`` to its process group once both workers have run theirs."""
+    import signal
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]))
+    out = tmp_path / "r.h5"
+    proc = subprocess.Popen([sys.executable, "-c", _INTERRUPTED_CHUNK, str(out), backend],
+                            env=env, cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=_default_sigint)
+    try:
+        assert proc.stdout.readline().strip() == "started"
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 120:
+            time.sleep(0.5)
+            kids = subprocess.run(["pgrep", "-P", str(proc.pid)], capture_output=True,
+                                  text=True).stdout.split()
+            if len(kids) >= 2 and out.exists():
+                break
+        time.sleep(4.0)                          # each worker's two quick scenes are done
+        os.killpg(proc.pid, getattr(signal, sig))
+        proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    t0 = time.monotonic()          # the workers end with their parent, within seconds
+    while time.monotonic() - t0 < 20:
+        left = subprocess.run(["pgrep", "-g", str(proc.pid)], capture_output=True, text=True)
+        if not left.stdout.split():
+            break
+        time.sleep(0.5)
+    assert not left.stdout.split(), "workers outlived the interrupted sweep"
+    return out
+
+
+@pytest.mark.parametrize("backend", ["local", "loky"])
+def test_an_interrupt_keeps_the_scenes_of_chunks_it_cut(tmp_path, backend):
+    """Ctrl-C while both workers are inside their first dispatch chunk: the scenes they had
+    finished are kept (sweep.campaign.spool); the rows came back only with a whole chunk,
+    and "0 of 64 scenes are kept" after each worker had finished two."""
+    out = _interrupt_after_quick_scenes(tmp_path, backend, "SIGINT")
+    assert len(load(out)) == 4
+
+
+def test_a_killed_sweeps_finished_scenes_are_kept_on_resume(tmp_path):
+    """SIGKILL to the sweep and its workers inside their first chunks: the scenes the
+    workers had finished are in the spool, and the resume stores them instead of running
+    them again."""
+    from sweep.campaign.scheduler import run_sweep
+
+    out = _interrupt_after_quick_scenes(tmp_path, "local", "SIGKILL")
+    ran = []
+
+    def progress(info):
+        ran.append(info["row"]["scene_id"])
+
+    c = cfg(n=(0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0), rate=(1, 2, 3, 5, 10, 20, 30, 50))
+    rep = run_sweep(c, jobs=1, out=out, simulate=fake_simulate, progress=progress)
+    assert (rep.skipped, rep.ran) == (4, 60) and len(ran) == 60
+    assert len(load(out)) == 64 and not (out.parent / "r.h5.parts" / "spool").exists()
