@@ -492,7 +492,10 @@ def _dedupe(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def load_trajectory(path, scene_id: str) -> dict:
-    """Trajectory arrays (``t``, ``delta``, ``P``, ``a``, ``a_inner``) of one scene."""
+    """Trajectory arrays of one scene: ``t`` (tau0), ``delta`` (d_ref), ``P`` (pi dg R),
+    ``a``, ``a_inner`` (a_ref), and with a test protocol ``phase`` (0 approach, 1 dwell, 2
+    retraction; :attr:`sweep.Result.trajectory`). KeyError if the file keeps none or not
+    this scene's; FileNotFoundError if there is no file."""
     path = Path(path)
     part = parts_dir(path) / "traj" / f"{scene_id}.h5"
     if part.exists():
