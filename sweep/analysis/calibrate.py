@@ -338,7 +338,7 @@ def calibration_from_dict(data, base=".", source="<dict>", measurements=None) ->
     base : path
         Folder the ``data`` CSV path is relative to.
     source : str
-        The file's name: every error starts with ``source: `` (as a sweep config's do).
+        The file's name: every error starts with it and a colon (as a sweep config's do).
     measurements : tuple, optional
         ``(speed_m_s, pull_off_N, sigma_N or None)`` instead of reading ``data``.
 
