@@ -36,9 +36,11 @@ def write(directory, row: dict, trajectory) -> None:
     """Append ``(row, trajectory)`` to this process's spool file in ``directory``."""
     global _OPEN
     directory = Path(directory)
-    if _OPEN is None or _OPEN[0] != directory or _OPEN[2] != os.getpid():
+    # a forked worker inherits its parent's handle, and a loky worker outlives a sweep whose
+    # end removed its file (the same output resumed in one session): open this process's own
+    if (_OPEN is None or _OPEN[0] != directory or _OPEN[2] != os.getpid()
+            or os.fstat(_OPEN[1].fileno()).st_nlink == 0):
         directory.mkdir(parents=True, exist_ok=True)
-        # a forked worker inherits its parent's handle: each process opens its own file
         _OPEN = (directory, open(directory / f"{os.getpid()}.rows", "ab"), os.getpid())
     data = pickle.dumps((row, trajectory), protocol=pickle.HIGHEST_PROTOCOL)
     fh = _OPEN[1]
