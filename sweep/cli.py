@@ -25,8 +25,8 @@ import click
 import numpy as np  # loaded anyway by sweep.scene
 from click.core import ParameterSource
 
-from .errors import (InputError, as_float, check_array, check_choice, check_int, check_positive,
-                     check_range, writing)
+from .errors import (InputError, as_float, check_array, check_choice, check_int, check_output,
+                     check_positive, check_range, writing)
 from ._version import __version__
 from .scene import AXES, PRESETS, REFINEMENTS_ON_REQUEST, Numerics, Scene
 
@@ -569,6 +569,7 @@ def info_cmd(results, slowest, as_si, csv_out):
     if as_si:
         df = si_table(results)
         if csv_out:
+            check_output("csv", csv_out, [results])
             # opened here, not by pandas: the operating system's reason in the error
             with writing("csv", csv_out), open(csv_out, "w", newline="") as fh:
                 df.to_csv(fh, index=False)
@@ -648,6 +649,8 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
         from .analysis.plots import figure_path
 
         figure_path("plot", plot_out)
+    if json_out is not None:
+        check_output("out", json_out, [csv_file])
     data = read_dma_csv(csv_file, T_ref=as_float("tref", tref), wlf=tuple(c))
     ctx = click.get_current_context()
     shifts = [f"--{name}" for name in ("tref", "wlf")

@@ -139,6 +139,33 @@ def check_array(name: str, values, lo=None, hi=None, lo_open=False, hi_open=Fals
     return arr
 
 
+#: the first bytes of every HDF5 file (a sweep's results file among them)
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def check_output(name: str, path, inputs=()) -> None:
+    """Refuse, in one line naming option ``name``, an output ``path`` that is one of the
+    command's ``inputs`` or an existing HDF5 file (a sweep's results): written over, it
+    would be lost (``sweep info R --si --csv R`` had replaced a results file by its table,
+    ``sweep fit-dma m.csv --out m.csv`` the DMA data by the fit)."""
+    import os
+
+    target = os.path.abspath(os.fspath(path))
+    for source in inputs:
+        if source is not None and os.path.exists(source) and os.path.exists(target) \
+                and os.path.samefile(source, target):
+            raise InputError(f"{name}: {path} is the input {source}; give another file")
+    if os.path.isfile(target):
+        try:
+            with open(target, "rb") as fh:
+                head = fh.read(len(_HDF5_SIGNATURE))
+        except OSError:
+            return                   # unreadable: writing() gives the reason
+        if head == _HDF5_SIGNATURE:
+            raise InputError(f"{name}: {path} is an HDF5 file (a sweep's results?); it is "
+                             f"not written over: give another file")
+
+
 @contextmanager
 def writing(name: str, path, verb: str = "write"):
     """Turn an ``OSError`` raised while writing ``path`` into a one-line :class:`InputError`.

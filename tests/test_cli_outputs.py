@@ -156,3 +156,29 @@ def test_info_csv_needs_si(results, si_results, tmp_path, capsys):
         assert not out.exists()
     assert main(["info", str(si_results), "--si", "--csv", str(out)]) == 0
     assert out.read_text().startswith("scene_id,")
+
+
+def test_an_output_never_replaces_the_input_or_a_results_file(results, si_results, tmp_path,
+                                                             capsys):
+    """`sweep info R --si --csv R` had replaced the results file by its CSV table (exit 0),
+    `--csv` onto another results file likewise, `sweep fit-dma m.csv --out m.csv` the DMA data
+    by the fit; `--out DIR/` had written DIR.png beside the directory. Each is one line naming
+    the option, exit 2, and the file is as it was."""
+    cases = [(["info", str(si_results), "--si", "--csv", str(si_results)], si_results,
+              f"error: csv: {si_results} is the input {si_results}; give another file"),
+             (["info", str(si_results), "--si", "--csv", str(results)], results,
+              f"error: csv: {results} is an HDF5 file (a sweep's results?); it is not written "
+              f"over"),
+             (["fit-dma", str(_master_curve(tmp_path)), "--maxwell", "0", "--out",
+               str(tmp_path / "m.csv")], tmp_path / "m.csv",
+              f"error: out: {tmp_path / 'm.csv'} is the input")]
+    for args, kept, needle in cases:
+        before = Path(kept).read_bytes()
+        capsys.readouterr()
+        assert main(args) == 2
+        assert one_error_line(capsys.readouterr().err).startswith(needle)
+        assert Path(kept).read_bytes() == before
+    (tmp_path / "figs").mkdir()
+    assert main(["plot", str(results), "--out", f"{tmp_path / 'figs'}/"]) == 2
+    assert "names a directory; give a file in it" in one_error_line(capsys.readouterr().err)
+    assert not (tmp_path / "figs.png").exists() and not any((tmp_path / "figs").iterdir())

@@ -75,7 +75,11 @@ def figure_path(name: str, out) -> Path:
         When matplotlib cannot write the format of the suffix (one line with the formats
         it can write).
     """
+    given = str(out)
     out = Path(out)
+    if given.endswith(("/", "\\")):        # Path drops the slash: DIR.png beside DIR
+        raise InputError(f"{name}: {given} names a directory; give a file in it, such as "
+                         f"{out / 'figure.png'} (a name without a suffix is a .png)")
     if not out.suffix:
         out = out.with_name(out.name + ".png")
     fmt = out.suffix[1:].lower()
