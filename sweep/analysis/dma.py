@@ -168,7 +168,7 @@ def read_dma_csv(path, T_ref: float = 20.0, wlf=WLF_PAPER) -> DMAData:
     Tg = check_range("wlf Tg", wlf[2], lo=-273.15)
     T_ref = check_range("tref", T_ref, lo=Tg - C2, lo_open=True)
     try:
-        with open(path, newline="") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:     # a BOM (Excel) dropped
             rows = [r for r in csv.reader(fh)]
     except OSError as exc:
         raise InputError(f"{path}: cannot read the file ({exc.strerror})") from None
@@ -214,7 +214,19 @@ def read_dma_csv(path, T_ref: float = 20.0, wlf=WLF_PAPER) -> DMAData:
             raise InputError(f"{path} line {line_no} (data row {bad[0] + 1}), column T_C: must be "
                              f"> Tg - C2 = {Tg - C2:g} C for the WLF shift (got {T[bad[0]]:g})")
         shift = wlf_log_shift(T, C1, C2, Tg) - wlf_log_shift(T_ref, C1, C2, Tg)
-        omega = 2.0 * math.pi * np.array(data["f_Hz"]) * 10.0 ** shift
+        with np.errstate(over="ignore"):
+            omega = 2.0 * math.pi * np.array(data["f_Hz"]) * 10.0 ** shift
+        bad = np.nonzero(~np.isfinite(omega) | (omega <= 0.0))[0]
+        if bad.size:           # a temperature just above the WLF pole: a shift of 10^500
+            line_no = lines[1 + bad[0]][0]
+            raise InputError(f"{path} line {line_no} (data row {bad[0] + 1}), column T_C: the "
+                             f"WLF shift to {T_ref:g} C at {T[bad[0]]:g} C is 10^{shift[bad[0]]:.4g}, "
+                             f"beyond the floats (T_C within a few degrees of Tg - C2 = "
+                             f"{Tg - C2:g} C: check wlf)")
+    distinct = np.unique(omega).size
+    if distinct < MIN_ROWS:
+        raise InputError(f"{path}: needs at least {MIN_ROWS} distinct frequencies for a "
+                         f"4-parameter fit (got {distinct} among {n_rows} rows)")
     order = np.argsort(omega, kind="stable")
     return DMAData(omega=omega[order], E_storage=E1[order], E_loss=E2[order], source=path,
                    kind=kind, T_ref=T_ref if kind == "temperature" else None,

@@ -33,7 +33,7 @@ import click
 import numpy as np
 import yaml
 
-from ..errors import InputError
+from ..errors import InputError, writing
 from .report import build_report
 
 PAPER_VALUES = Path(__file__).resolve().parents[2] / "tests" / "data" / "paper_values.yaml"
@@ -75,6 +75,17 @@ def _cost(df) -> dict:
             "scene_wall_s_max": float(df["wall_s"].max())}
 
 
+def _outdir(outdir) -> Path:
+    """The output directory OUTDIR, created: InputError (one line) where it is a file or
+    cannot be created (a FileExistsError traceback had ended the command)."""
+    out = Path(outdir)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"outdir: {outdir} is a file; give a directory")
+    with writing("outdir", out, "create"):
+        out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
 def _write_json(obj, path: Path) -> Path:
     from ..campaign.store import to_jsonable
 
@@ -95,7 +106,7 @@ def _fit_campaign(runs, outdir, analyze):
     df = _load_results(runs)
     fit = analyze(df)
     fit.update(provenance=_provenance(runs), cost=_cost(df), engine_check=_engine_check(runs))
-    out = Path(outdir)
+    out = _outdir(outdir)
     _write_json(fit, out / "fit.json")
     return df, fit, out
 
@@ -168,7 +179,7 @@ def fig3_cmd(runs, outdir):
             continue
     if not trajs:
         raise InputError(f"results: {runs!r} holds no trajectories (store: trajectories: true)")
-    out = Path(outdir)
+    out = _outdir(outdir)
     fig3_figure(df, trajs, out / "fig3.png")
     ok = df[df["status"] == "ok"]
     _write_json({"provenance": _provenance(runs), "cost": _cost(df),
@@ -186,7 +197,7 @@ def aconv_cmd(runs, outdir):
     from .figures import aconv_figure
 
     df = _load_results(runs)
-    out = Path(outdir)
+    out = _outdir(outdir)
     aconv_figure(df, out / "aconv.png")
     ok = df[df["status"] == "ok"].sort_values(["a0", "rate"])
     _write_json({"provenance": _provenance(runs), "cost": _cost(df),
@@ -205,7 +216,7 @@ def theory_cmd(outdir, vr_runs):
     from .figures import b1_figure, mplplot_figure, pb_bem_figure
     from ..theory import pb_gamma_eff
 
-    out = Path(outdir)
+    out = _outdir(outdir)
     mplplot_figure(out / "mplplot.png")
     k = 0.1
     v = np.logspace(-4, 8, 400)
@@ -245,7 +256,9 @@ def report_cmd(results_dir, out):
     if not root.is_dir():
         raise InputError(f"results: no such directory {results_dir!r}")
     path = Path(out) if out else root / "REPORT.md"
-    path.write_text(build_report(root, _paper(), _git_commit()))
+    text = build_report(root, _paper(), _git_commit())
+    with writing("out", path):
+        path.write_text(text)
     click.echo(str(path))
 
 

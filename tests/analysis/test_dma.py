@@ -220,6 +220,14 @@ BAD = {
                    "line 3 (data row 2), column E_storage_Pa: missing value"),
     "below_wlf_pole": ("T_C,f_Hz,E_storage_Pa,E_loss_Pa\n-170,1,2,3\n10,1,3,4\n20,1,4,5\n",
                        "line 2 (data row 1), column T_C: must be > Tg - C2"),
+    # 0.1 C above the pole (Tg - C2 = -166.6 C): a shift of 10^8700, which had overflowed to
+    # inf and ended the fit in "math domain error"
+    "at_wlf_pole": ("T_C,f_Hz,E_storage_Pa,E_loss_Pa\n-166.5,1,2,3\n10,1,3,4\n20,1,4,5\n",
+                    "line 2 (data row 1), column T_C: the WLF shift to 20 C at -166.5 C is 10^"),
+    # one frequency repeated: PCHIP had raised "x must contain at least 2 elements"
+    "one_frequency": ("omega_rad_s,E_storage_Pa,E_loss_Pa\n1,1e6,1e3\n1,1e6,1e3\n1,1e6,1e3\n"
+                      "1,1e6,1e3\n", "needs at least 3 distinct frequencies for a 4-parameter "
+                                     "fit (got 1 among 4 rows)"),
 }
 
 
@@ -233,6 +241,19 @@ def test_cli_bad_files_one_line_exit_2(tmp_path, capsys, case):
     assert code == 2 and out == ""
     assert err.count("\n") == 1 and err.startswith("error: ")
     assert message in err and str(p) in err
+
+
+def test_a_byte_order_mark_is_not_part_of_the_header(tmp_path, capsys):
+    """Excel's "CSV UTF-8" starts with a BOM: it had become part of the first column's name
+    ("missing column omega_rad_s")."""
+    p = tmp_path / "bom.csv"
+    w = np.logspace(0, 12, 25)
+    E = MPLRetardation(1e6, 1e8, 0.4, 1e-3).complex_modulus(w)
+    p.write_text("\ufeffomega_rad_s,E_storage_Pa,E_loss_Pa\n"
+                 + "".join(f"{a:.10g},{b:.10g},{c:.10g}\n" for a, b, c in zip(w, E.real, E.imag)),
+                 encoding="utf-8")
+    assert main(["fit-dma", str(p), "--maxwell", "0", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["points"] == 25
 
 
 def test_cli_bad_options(tmp_path, capsys):

@@ -54,3 +54,24 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys):
     assert err.startswith("error: results") and "\n" not in err
     assert main(["report", "--results", str(tmp_path / "nodir")]) == 2
     assert "\n" not in capsys.readouterr().err.strip()
+
+
+def test_an_output_that_cannot_be_a_directory_or_written_is_one_line(tmp_path, capsys):
+    """OUTDIR an existing file (theory, vr, fig3, ...) and report --out into a missing folder:
+    one line, exit 2 (they had ended in FileExistsError and FileNotFoundError tracebacks);
+    the file in the way is as it was."""
+    vr = tmp_path / "vr.h5"
+    write_results(vr, synthetic_vr_runs().assign(wall_s=2.0, reason=""))
+    before = vr.read_bytes()
+    for args in (["theory", str(vr)], ["vr", str(vr), str(vr)]):
+        capsys.readouterr()
+        assert main(args) == 2
+        err = capsys.readouterr().err.strip()
+        assert err == f"error: outdir: {vr} is a file; give a directory", err
+    assert vr.read_bytes() == before
+    root = tmp_path / "results"
+    assert main(["vr", str(vr), str(root / "vr")]) == 0
+    capsys.readouterr()
+    assert main(["report", "--results", str(root), "--out", str(tmp_path / "no" / "R.md")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"error: out: cannot write {tmp_path / 'no' / 'R.md'} (") and "\n" not in err
