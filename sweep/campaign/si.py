@@ -42,7 +42,7 @@ from dataclasses import asdict, dataclass
 from .. import units
 from ..engine.crack_front import scene_law, unload
 from ..engine.models import (MACHINE_REFUSALS, PROCESS_ZONE_REFUSALS, PROTOCOL_REFUSALS,
-                             choose_model, pb_estimate, simulate_model)
+                             TABLE_REFUSALS, choose_model, pb_estimate, simulate_model)
 from ..errors import InputError, as_float, check_choice, check_positive, check_range
 from ..materials.prony_files import hash_rounded
 from ..scene import (AXES, DWELL_HOLDS, MATERIALS, PZ_LAWS, SCENE_LIMITS, Axis, Scene,
@@ -425,6 +425,9 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
                "delta0": None}
     elif model in MACHINE_REFUSALS and si.machine_stiffness is not None:
         dim = {"status": "failed", "reason": MACHINE_REFUSALS[model], "a0": d["a0"],
+               "delta0": d["delta0"]}
+    elif model in TABLE_REFUSALS and si.table is not None:
+        dim = {"status": "failed", "reason": TABLE_REFUSALS[model], "a0": d["a0"],
                "delta0": d["delta0"]}
     elif model == "pb" and d["pz_law"] != "none":
         dim = {"status": "failed", "reason": PROCESS_ZONE_REFUSALS["pb"].format(**d),

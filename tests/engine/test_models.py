@@ -267,3 +267,33 @@ def test_a_bem_scene_beyond_its_tabor_range_is_refused_before_any_mesh(mu, monke
         assert res.status == "failed" and res.steps == 0
         assert res.reason.startswith(f"mu = {mu:g} is outside the hereditary BEM's range "
                                      f"[{BEM_MU_RANGE[0]:g}, {BEM_MU_RANGE[1]:g}]"), res.reason
+
+
+def test_the_pb_estimate_refuses_a_prony_table_whose_time_unit_it_would_depend_on():
+    """One 3-arm table written with its times in units 1, 1e3 and 1e-4 (the rate scaled to
+    match) is one material and one unloading: the pb estimate gave 3.674, 3.101 and 5.122
+    (its v-r fit's exponent applied in the table's arbitrary tau0), the BEM and the
+    crack-front model one value each. pb refuses a table with the reason; auto never picks
+    it for one."""
+    tab = {"tau": [0.01, 0.3, 5.0], "c": [0.3, 0.3, 0.25], "E0": 1.0, "form": "kelvin"}
+    crack = []
+    for t in (1.0, 1e3):
+        scene = dict(n=1.0, mu=3.0, a0=2.0, rate=30.0 / t,
+                     material=dict(tab, tau=[x * t for x in tab["tau"]]))
+        res = models.simulate_model(Scene(**scene), "pb", Numerics.preset("balanced"))
+        assert res.status == "failed" and res.reason == models.TABLE_REFUSALS["pb"]
+        assert models.model_choice(Scene(**scene), Numerics.preset("fast", pull_off_rtol=1.0)
+                                   ).model != "pb"
+        crack.append(models.simulate_model(Scene(**scene), "crack", Numerics.preset("fast")))
+    assert crack[0].ok and crack[1].pull_off == pytest.approx(crack[0].pull_off, rel=1e-8)
+
+
+@pytest.mark.parametrize("model", ["crack", "pb"])
+def test_a_cheaper_models_row_below_its_measured_range_says_its_error_is_unknown(model):
+    """mu 0.05, below the smallest Tabor parameter its error was measured at (2): the row
+    stays ok with error_estimate NaN (pb gave 9.0 against the BEM's 1.99), its reason now
+    saying the error is not measured and which model answers with its own."""
+    res = models.simulate_model(Scene(n=0.5, k=0.1, mu=0.05, a0=2.0, rate=10.0), model,
+                                Numerics.preset("balanced"))
+    assert res.ok and math.isnan(res.error_estimate)
+    assert "error is not measured below mu = 2 (error_estimate NaN)" in res.reason
