@@ -73,6 +73,10 @@ THRESHOLD_SLOPE = 0.1
 SATURATION_FRACTION = 0.9
 #: Bootstrap resamples and confidence level of every interval.
 N_BOOT = 2000
+#: the fewest points, and valid bootstrap resamples, from which :func:`power_law_fit` gives
+#: an interval (below, None: a percentile of a handful of resamples of 3-5 points is no 95 %
+#: interval)
+MIN_BOOT_POINTS, MIN_BOOT_RESAMPLES = 6, 100
 CONFIDENCE = 0.95
 
 _GROUP = ["material", "n", "k", "mu", "rate"]
@@ -131,7 +135,10 @@ def power_law_fit(x, y, n_boot: int = N_BOOT, seed: int = 0,
     .. math:: \ln y = \ln A + B \ln x
 
     The intervals are percentile intervals of ``n_boot`` refits on the points resampled
-    with replacement (resamples whose ``x`` are all equal are skipped).
+    with replacement (resamples whose ``x`` are all equal are skipped), given only from
+    :data:`MIN_BOOT_POINTS` points and :data:`MIN_BOOT_RESAMPLES` valid resamples: with 4
+    points (two near-equal x) the "interval" of B had been [2.2, 204], and ``--boot 1`` an
+    interval that excluded the estimate.
 
     Parameters
     ----------
@@ -148,7 +155,8 @@ def power_law_fit(x, y, n_boot: int = N_BOOT, seed: int = 0,
     -------
     dict
         ``prefactor`` A, ``exponent`` B, ``prefactor_ci``, ``exponent_ci`` ([lo, hi] or
-        None), ``n_points``, ``rms_log_residual`` (RMS of ``ln y - ln(A x^B)``).
+        None: no resampling, or too few points or resamples), ``n_points``,
+        ``rms_log_residual`` (RMS of ``ln y - ln(A x^B)``).
     """
     x = np.asarray(x, dtype=float).ravel()
     y = np.asarray(y, dtype=float).ravel()
@@ -173,7 +181,7 @@ def power_law_fit(x, y, n_boot: int = N_BOOT, seed: int = 0,
         "n_points": int(x.size),
         "rms_log_residual": float(np.sqrt(np.mean(resid**2))),
     }
-    if n_boot > 0:
+    if n_boot > 0 and x.size >= MIN_BOOT_POINTS:
         rng = np.random.default_rng(seed)
         idx = rng.integers(0, x.size, size=(int(n_boot), x.size))
         bx, by = lx[idx], ly[idx]
@@ -183,8 +191,9 @@ def power_law_fit(x, y, n_boot: int = N_BOOT, seed: int = 0,
         b = ((bx - mx[:, None]) * (by - my[:, None])).sum(axis=1)[ok] / var[ok]
         a = np.exp(my[ok] - b * mx[ok])
         q = [50.0 * (1.0 - confidence), 50.0 * (1.0 + confidence)]
-        out["prefactor_ci"] = [float(v) for v in np.percentile(a, q)]
-        out["exponent_ci"] = [float(v) for v in np.percentile(b, q)]
+        if b.size >= MIN_BOOT_RESAMPLES:
+            out["prefactor_ci"] = [float(v) for v in np.percentile(a, q)]
+            out["exponent_ci"] = [float(v) for v in np.percentile(b, q)]
     return out
 
 
@@ -905,6 +914,27 @@ def bem_power_law(df: pd.DataFrame, k: float = 0.1, lo: float = 0.25, hi: float 
     return out
 
 
+#: the models whose rows are "the BEM" of a comparison with the Persson-Brener theory (the
+#: elastic branch is the BEM's own k = 1 limit)
+BEM_MODELS = ("bem", "elastic")
+
+
+def bem_rows(df: pd.DataFrame, what: str = "the v-r fit") -> pd.DataFrame:
+    """The rows of ``df`` that the BEM answered (``model_used``; every row of a file written
+    before the column), an InputError (one line) if there are none. The crack-front model
+    *is* the Persson-Brener law: its rows in a comparison with PB were circular ("within 15 %:
+    100 %" on a file of crack-front and pb rows), and mixed into one power law."""
+    if "model_used" not in df:
+        return df
+    used = df["model_used"].fillna("").astype(str)
+    keep = used.isin(BEM_MODELS) | (used == "")
+    if not keep.any():
+        counts = ", ".join(f"{n} {m}" for m, n in used.value_counts().items())
+        raise InputError(f"results: no BEM rows for {what} ({counts}): it compares the BEM's "
+                         f"crack speed with Persson-Brener's; run the scenes with model bem")
+    return df[keep]
+
+
 def vr_analysis(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTION,
                 n_boot: int = N_BOOT, seed: int = 0,
                 paper_fit: tuple[float, float] | None = None) -> dict:
@@ -921,8 +951,11 @@ def vr_analysis(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTI
         ``failed``; beside them ``paper_range`` (the fit over the paper's rate grid,
         :func:`vr_paper_range`), ``local_slope`` (:func:`vr_local_slope`), ``alpha_per_k``
         (:func:`alpha_per_k`) and ``bem_power_law`` (beta, m of the BEM points,
-        :func:`bem_power_law`).
+        :func:`bem_power_law`). Only the BEM's rows count (:func:`bem_rows`; ``other_models``
+        says how many others the file held).
     """
+    others = int(len(df) - len(bem_rows(df)))
+    df = bem_rows(df)
     fits = vr_fit(df, saturation_fraction, n_boot=n_boot, seed=seed)
     a = fits["all"]
     _, comp = pb_comparison(df, a["prefactor"], a["exponent"])
@@ -945,6 +978,7 @@ def vr_analysis(df: pd.DataFrame, saturation_fraction: float = SATURATION_FRACTI
         "pb_vs_bem": comp,
         "alpha_best": alpha["alpha_best"], "alpha": alpha,
         "scenes": int(len(df)), "failed": int((df["status"] != "ok").sum()),
+        "other_models": others,
     }
 
 

@@ -103,9 +103,11 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
     used = table[table["in_fit"]]
     x = np.linspace(used["a0t"].min(), used["a0t"].max(), 100)
     A, B = fit["prefactor"], fit["exponent"]
+    ci = fit["exponent_ci"]
     ax.loglog(x, A * x**B, "k--",
               label=rf"fit $\hat P_{{po}} = {A:.3g}\,\hat a_{{0t}}^{{{B:.3g}}}$"
-                    rf" (B 95 % CI {fit['exponent_ci'][0]:.2f}-{fit['exponent_ci'][1]:.2f})")
+                    + (rf" (B 95 % CI {ci[0]:.2f}-{ci[1]:.2f})" if ci is not None else
+                       f" (no interval: {fit['n_points']} points)"))
     xp = np.linspace(1.0, interior["a0t"].max() * 1.05, 100)
     ax.loglog(xp, paper[0] * xp ** paper[1], ":", color="gray",
               label=rf"paper $\hat P_{{po}} = {paper[0]}\,\hat a_{{0t}}^{{{paper[1]}}}$")

@@ -216,6 +216,13 @@ def theory_cmd(outdir, vr_runs):
     from .figures import b1_figure, mplplot_figure, pb_bem_figure
     from ..theory import pb_gamma_eff
 
+    if vr_runs is not None:           # read first: a bad file writes no figure
+        pts = analysis.paper_variables(analysis.finished(
+            analysis.bem_rows(_load_results(vr_runs), "the BEM markers of pb_bem.png")))
+    else:
+        import pandas as pd
+
+        pts = pd.DataFrame(columns=["material", "n", "k", "vhat", "gamma_eff"])
     out = _outdir(outdir)
     mplplot_figure(out / "mplplot.png")
     k = 0.1
@@ -224,12 +231,6 @@ def theory_cmd(outdir, vr_runs):
     curves = {n: (v, np.asarray(pb_gamma_eff(n, k, v))) for n in ns}
     curves["sls"] = (v, np.asarray(analysis.pb_gamma_eff_scene("sls", 1.0, k, v)))
     laws = {n: analysis.pb_power_law(n, k) for n in ns}
-    if vr_runs is not None:
-        pts = analysis.paper_variables(analysis.finished(_load_results(vr_runs)))
-    else:
-        import pandas as pd
-
-        pts = pd.DataFrame(columns=["material", "n", "k", "vhat", "gamma_eff"])
     pb_bem_figure(curves, laws, pts, out / "pb_bem.png", k=k)
     p = _paper()["pdms_experiment"]
     k_b1 = float(p["k"])

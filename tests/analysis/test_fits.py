@@ -493,3 +493,38 @@ def test_threshold_analysis_without_enough_points_for_the_paper_protocol():
     out = an.threshold_analysis(df, n_boot=0)
     assert out["paper_protocol"] is None and out["n_points"] == 4
     assert not any(r["in_paper_fit"] for r in out["table"])
+
+
+def test_no_interval_from_a_handful_of_points_or_resamples():
+    """Four points (two near-equal x) had given B's "95 % interval" [2.2, 204], and one
+    resample an interval that excluded the estimate: below MIN_BOOT_POINTS points or
+    MIN_BOOT_RESAMPLES valid resamples there is none."""
+    from sweep.analysis.fits import MIN_BOOT_POINTS, MIN_BOOT_RESAMPLES, power_law_fit
+
+    x = np.array([1.955, 1.956, 2.6, 3.4])
+    y = 0.85 * x**2.5 * np.array([1.0, 1.02, 0.99, 1.01])
+    few = power_law_fit(x, y, n_boot=2000)
+    assert few["exponent"] == pytest.approx(2.5, abs=0.2)
+    assert few["exponent_ci"] is None and few["prefactor_ci"] is None
+    x6 = np.linspace(1.0, 4.0, MIN_BOOT_POINTS)
+    y6 = 0.85 * x6**2.5 * (1.0 + 0.01 * np.cos(7.0 * x6))
+    assert power_law_fit(x6, y6, n_boot=MIN_BOOT_RESAMPLES - 1)["exponent_ci"] is None
+    fit = power_law_fit(x6, y6, n_boot=2000)
+    lo, hi = fit["exponent_ci"]
+    assert lo <= fit["exponent"] <= hi and hi - lo < 0.1
+
+
+def test_the_vr_fit_takes_the_bems_rows_only():
+    """A file of crack-front and pb rows had given "Gamma_PB within 15 %: 100 %" (the
+    crack-front model is the PB law: circular) and one power law of two models; its rows are
+    refused, and the BEM's rows of a mixed file are the fit's."""
+    from sweep.analysis.fits import bem_rows, vr_analysis
+
+    df = synthetic_vr_runs()
+    other = df.assign(model_used="crack")
+    with pytest.raises(InputError, match=r"no BEM rows for the v-r fit \(\d+ crack\)"):
+        vr_analysis(other, n_boot=0)
+    mixed = pd.concat([df.assign(model_used="bem"), other.assign(pull_off=other.pull_off * 3)])
+    assert len(bem_rows(mixed)) == len(df)
+    a, b = vr_analysis(mixed, n_boot=0), vr_analysis(df, n_boot=0)
+    assert a["exponent"] == b["exponent"] and a["other_models"] == len(df)
