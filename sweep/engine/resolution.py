@@ -98,7 +98,7 @@ def zone_smoothing_error(res: Result) -> float:
     scene = res.scene
     if scene.pz_law == "none" or not (math.isfinite(res.crack_speed) and res.crack_speed > 0):
         return 0.0
-    from kernels.interface import ZONE_SMOOTH_TERM   # lazy: the kernels load numba
+    from ..kernels.interface import ZONE_SMOOTH_TERM   # lazy: the kernels load numba
 
     term = (res.crack_speed / scene.pz_v0) ** scene.pz_xi
     return term if term < ZONE_SMOOTH_TERM else 0.0
