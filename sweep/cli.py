@@ -114,8 +114,12 @@ def pb(n_text, k_text, v_text, as_json):
     """Persson-Brener effective surface energy Gamma_eff(vhat) of the MPL spectrum."""
     from .theory import pb_gamma_eff
 
+    from .theory import VHAT_MAX
+
     n, k = as_float("n", n_text), as_float("k", k_text)
     v = _floats_in("v", v_text, lo=0.0)
+    if v.max() > VHAT_MAX:       # named by its option (theory names its argument, vhat)
+        raise InputError(f"v must be <= {VHAT_MAX:g} (got {v.max():g})")
     g = np.atleast_1d(pb_gamma_eff(n, k, v))
     if as_json:
         echo_json({"n": n, "k": k, "vhat": v, "gamma_eff": g})
@@ -158,6 +162,8 @@ def material(n_text, k_text, t_text, model, rtol_text, as_json):
             raise InputError("n must be given for model mpl (--n, a number > 0)")
         mat = materials.MPLRetardation.from_k(n_text, k_text)
     else:
+        if n_text is not None:
+            raise InputError("n: the SLS has no exponent (model mpl only); leave --n out")
         mat = materials.SLS.from_k(k_text)
     t = _floats_in("t", t_text, lo=0.0, lo_open=True)
     if not t.max() > t.min():
@@ -549,7 +555,7 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
 
 @cli.command("info")
 @click.argument("results")
-@click.option("--slowest", type=int, default=5, show_default=True,
+@click.option("--slowest", type=click.IntRange(min=0), default=5, show_default=True,
               help="How many of the slowest scenes to list.")
 @click.option("--si", "as_si", is_flag=True,
               help="A file of a `units: si` config: one line per scene in SI units (speed, "

@@ -90,6 +90,9 @@ def test_run_then_info_real_solver(tmp_path):
     assert info.returncode == 0, info.stderr
     assert "scenes: 4 finished of 4" in info.stdout and "status:" in info.stdout
     assert "n: 2 values in [0.4, 1.6]" in info.stdout and "slowest 4:" in info.stdout
+    # a negative count had listed all but the last (pandas' head(-1))
+    neg = run_cli(["info", str(out), "--slowest", "-1"], cwd=tmp_path)
+    assert neg.returncode == 2 and "'--slowest': -1 is not in the range x>=0" in neg.stderr
     again = run_cli(["run", str(cfg)], cwd=tmp_path)   # resume: nothing left to do
     assert again.returncode == 0 and "(0 ran, 4 already done" in again.stdout
 

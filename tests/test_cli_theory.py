@@ -169,3 +169,16 @@ def test_extreme_values_are_one_line_errors(capsys, argv, message):
     code, out, err = run(capsys, *argv)
     assert code == 2 and out == ""
     assert err.startswith(message) and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("args, message", [
+    # the option's name, not theory's argument's ("vhat must be <= 1e+100")
+    (["pb", "--n", "0.4", "--k", "0.1", "--v", "1e300"], "error: v must be <= 1e+100 (got 1e+300)"),
+    # an exponent given to the SLS had been ignored without a word
+    (["material", "--model", "sls", "--n", "0.5", "--k", "0.1", "--t", "1,10"],
+     "error: n: the SLS has no exponent (model mpl only); leave --n out"),
+])
+def test_options_named_and_not_ignored(capsys, args, message):
+    assert main(args) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert err == [message]

@@ -75,6 +75,20 @@ def _cost(df) -> dict:
             "scene_wall_s_max": float(df["wall_s"].max())}
 
 
+def _links_from(text: str, root: Path, where: Path) -> str:
+    """The report's relative links (figures, sub-reports: relative to the results directory
+    ``root``) as seen from ``where``, the folder it is written to (written elsewhere with
+    --out they had pointed nowhere)."""
+    import os
+    import re
+
+    prefix = os.path.relpath(root.resolve(), where.resolve())
+    if prefix == ".":
+        return text
+    return re.sub(r"\]\((?![a-z][a-z0-9+.-]*:|#|/)([^)\s]+)\)",
+                  lambda m: f"]({Path(prefix, m.group(1)).as_posix()})", text)
+
+
 def _outdir(outdir) -> Path:
     """The output directory OUTDIR, created: InputError (one line) where it is a file or
     cannot be created (a FileExistsError traceback had ended the command)."""
@@ -257,7 +271,7 @@ def report_cmd(results_dir, out):
     if not root.is_dir():
         raise InputError(f"results: no such directory {results_dir!r}")
     path = Path(out) if out else root / "REPORT.md"
-    text = build_report(root, _paper(), _git_commit())
+    text = _links_from(build_report(root, _paper(), _git_commit()), root, path.parent)
     with writing("out", path):
         path.write_text(text)
     click.echo(str(path))

@@ -46,6 +46,13 @@ def test_pipeline_writes_fits_figures_and_report(tmp_path, capsys):
     assert "](threshold/threshold.png)" in report and "](vr/pb_vs_bem.png)" in report
     assert "`make fig3` | `configs/fig3.yaml` | not run" in report
     assert "Failures: " in report and "failed" in report
+    # written elsewhere, its links lead to the same files (they had pointed nowhere)
+    other = tmp_path / "elsewhere" / "R.md"
+    other.parent.mkdir()
+    assert main(["report", "--results", str(root), "--out", str(other)]) == 0
+    moved = other.read_text()
+    assert "](../results/threshold/threshold.png)" in moved
+    assert (other.parent / "../results/threshold/threshold.png").exists()
 
 
 def test_bad_input_one_line_exit_2(tmp_path, capsys):
