@@ -541,6 +541,27 @@ def plot_sweep(path, out=None) -> Path:
         raise InputError(f"results: {path} holds no finished scene")
     ok = df[df["status"] == "ok"]
     out = figure_path("out", out if out is not None else path.with_suffix(".png"))
-    fig = sweep_figure(df, f"{path.name}: {len(ok)} ok, {len(df) - len(ok)} failed",
-                       _trajectory_reader(path, ok))
+    constant = ", ".join(constant_axes(df))
+    fig = sweep_figure(df, f"{path.name}: {len(ok)} ok, {len(df) - len(ok)} failed"
+                       + (f"\n{constant}" if constant else ""), _trajectory_reader(path, ok))
     return save_figure(fig, out)
+
+
+def constant_axes(df) -> list[str]:
+    """``k = 0.1``, ``mu = 3.24`` ... for each scene axis with one value over the results
+    frame ``df`` (the figure's suptitle: what was run, which no panel or legend says); not
+    ``n`` for a Prony table's scenes, where it is unused, nor an axis no row sets, nor a
+    category at its default but the model and the material (``stop = pulloff``)."""
+    table = "material" in df and df["material"].astype(str).str.startswith("prony:").all()
+    out = []
+    for axis in AXES:
+        if axis not in df or (axis == "n" and table):
+            continue
+        values = df[axis].dropna()
+        if len(values) and values.nunique() == 1:
+            value = values.iloc[0]
+            if (not _is_numeric(axis) and value == AXIS_INFO[axis].default
+                    and axis not in ("model", "material")):
+                continue
+            out.append(_text(axis, float(value) if _is_numeric(axis) else value))
+    return out

@@ -229,3 +229,21 @@ def test_a_protocol_campaign_draws_its_load_cycles(tmp_path):
     drawn = sum(len(ln.get_xdata()) for ln in lines[:2])
     assert drawn == len(traj["P"])                          # every record, every phase
     pyplot().close(fig)
+
+
+def test_the_figure_names_what_was_held_constant():
+    """A reader of `sweep plot`'s figure could not tell k, mu or a0 (`sweep info` lists them
+    as fixed): the suptitle names each scene axis with one value, n not for a table's scenes
+    (unused), a category at its default not at all."""
+    import pandas as pd
+
+    from sweep.analysis.plots import constant_axes
+
+    df = pd.DataFrame({"n": [0.4, 0.8], "k": [0.1, 0.1], "mu": [3.24, 3.24], "a0": [2.5, 2.5],
+                       "rate": [1.0, 10.0], "material": ["mpl", "mpl"], "model": ["bem", "bem"],
+                       "stop": ["pulloff", "pulloff"], "pz_law": ["none", "none"]})
+    assert constant_axes(df) == ["model = bem", "material = mpl", "k = 0.1", "mu = 3.24",
+                                 "a0 = 2.5"]
+    table = df.assign(material="prony:gmm:a06e69d9b019ec0e", n=1.0)
+    assert "n = 1" not in constant_axes(table)
+    assert "material = prony:gmm:a06e69d9b019ec0e" in constant_axes(table)
