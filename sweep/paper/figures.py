@@ -50,6 +50,27 @@ def _rate_label(rate):
     return f"$10^{{{e:.3g}}}$" if abs(e - round(e)) > 1e-6 else f"$10^{{{round(e)}}}$"
 
 
+def _held(d: pd.DataFrame, *columns) -> str:
+    """``k = 0.1, mu = 3.24``: the values of ``columns`` over the rows ``d`` (a range
+    where one varies): a title says what the data hold, not the paper's campaign."""
+    names = {"mu": r"$\mu$", "a0": r"$\hat a_0$"}
+    parts = []
+    for c in columns:
+        v = d[c].dropna().unique() if c in d else []
+        if len(v) == 1:
+            parts.append(f"{names.get(c, c)} = {float(v[0]):g}")
+        elif len(v) > 1:
+            parts.append(f"{names.get(c, c)} = {float(min(v)):g}-{float(max(v)):g}")
+    return ", ".join(parts)
+
+
+def _rates(d: pd.DataFrame) -> str:
+    """The rates of ``d``: ``every rate 10^0-10^6`` from its rows."""
+    r = d["rate"].dropna()
+    return (f"rate {_rate_label(r.min())}" if r.nunique() == 1 else
+            f"rates {_rate_label(r.min())}-{_rate_label(r.max())}") if len(r) else "no rate"
+
+
 def _spline_curve(ax, g, a0t, color, label, marker, **kw):
     """Markers of P_po(a0) and their spline: dotted below a0t, solid above (the paper's style)."""
     a, p = g["a0"].to_numpy(float), g["pull_off"].to_numpy(float)
@@ -87,7 +108,7 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
     ax.plot([], [], "o", mfc="white", mec="black", label=r"$\hat a_{0t}$ ($d\hat P_{po}/d\hat a_0 = 0.1$)")
     ax.set_xlabel(r"initial contact radius $\hat a_0$")
     ax.set_ylabel(r"pull-off force $\hat P_{po}$")
-    ax.set_title(rf"(a) $\hat r = ${_rate_label(reference_rate)}, k = 0.1, $\mu$ = 3.24")
+    ax.set_title(rf"(a) $\hat r = ${_rate_label(reference_rate)}, {_held(ok, 'k', 'mu')}")
     ax.legend(fontsize=8, loc="center right")
 
     ax = axes[1]
@@ -116,7 +137,7 @@ def threshold_figure(runs: pd.DataFrame, fit: dict, out, reference_rate=10**0.5,
     _plain_log_ticks(ax, x=[1, 1.5, 2, 3, 4, 5, 6], y=[1, 2, 3, 5, 10, 15, 20])
     ax.set_xlabel(r"threshold contact radius $\hat a_{0t}$")
     ax.set_ylabel(r"pull-off force at the threshold $\hat P_{po}(\hat a_{0t})$")
-    ax.set_title(rf"(b) collapse, every rate $10^0$-$10^6$; open: not fitted ($\geq$ "
+    ax.set_title(rf"(b) collapse, {_rates(table)}; open: not fitted ($\geq$ "
                  rf"{fit['saturation_fraction']:g} x 1.5/k)", fontsize=10)
     ax.legend(fontsize=8, loc="lower right")
 
@@ -194,8 +215,8 @@ def vr_figure(points: pd.DataFrame, fit: dict, out, paper=(2.887, 1.171)) -> Pat
               label=rf"paper: $\hat v = {paper[0]}\,\hat r_{{PB}}^{{{paper[1]}}}$")
     ax.set_xlabel(r"unloading rate $\hat r_{PB} = r\tau_0/d_{ref} = \hat r\,\hat h_0$")
     ax.set_ylabel(r"crack speed at pull-off $\hat v = v\tau_0/l_0$")
-    ax.set_title(r"crack speed vs unloading rate ($\mu$ = 3.24; edge: k = 0.01 blue, 0.05 black, 0.1 none)",
-                 fontsize=9)
+    ax.set_title(rf"crack speed vs unloading rate ({_held(d, 'mu')}; edge: k = 0.01 blue, 0.05 "
+                 rf"black, 0.1 none)", fontsize=9)
     ax.legend(fontsize=6.5, ncol=2)
     return _save(fig, out)
 
@@ -263,7 +284,8 @@ def fig3_figure(runs: pd.DataFrame, trajectories: dict, out) -> Path:
         ax.axhline(0, color="gray", lw=0.5)
         ax.set_xlabel(r"contact radius $\hat a$")
         ax.set_ylabel(r"load $\hat P$ (positive compressive)")
-        ax.set_title(title + ", k = 0.1, $\\mu$ = 3.24", fontsize=10)
+        ax.set_title(", ".join(t for t in (title, _held(ok[sel(ok)], "k", "mu")) if t),
+                     fontsize=10)
         ax.set_xlim(0, 4.2)
         ax.legend(fontsize=7)
     fig.tight_layout()
@@ -275,14 +297,16 @@ def aconv_figure(runs: pd.DataFrame, out) -> Path:
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 5))
     ok = runs[runs["status"] == "ok"]
-    for a0, g in ok.groupby("a0"):
+    several_n = ok["n"].nunique() > 1          # one line per (n, a0), not one zig-zag per a0
+    for (n, a0), g in ok.groupby(["n", "a0"]):
         g = g.sort_values("rate")
-        ax.semilogx(g["rate"], g["pull_off"], "D-", ms=5, label=rf"$\hat a_0$ = {a0:g}")
+        ax.semilogx(g["rate"], g["pull_off"], "D-", ms=5,
+                    label=(f"n = {n:g}, " if several_n else "") + rf"$\hat a_0$ = {a0:g}")
     k = float(ok["k"].iloc[0])
     ax.axhline(1.5 / k, color="tab:blue", lw=1, ls="--", label=f"$1.5/k$ = {1.5 / k:g}")
     ax.set_xlabel(r"unloading rate $\hat r = r\tau_0/h_0$")
     ax.set_ylabel(r"pull-off force $\hat P_{po}$")
-    ax.set_title(rf"n = {ok['n'].iloc[0]:g}, k = {k:g}, $\mu$ = {ok['mu'].iloc[0]:g}, relaxed start")
+    ax.set_title(f"{_held(ok, 'n', 'k', 'mu')}, relaxed start")
     ax.legend(fontsize=8)
     return _save(fig, out)
 

@@ -144,11 +144,15 @@ def threshold_cmd(runs, outdir):
                                  lambda d: analysis.threshold_analysis(d, paper_fit=paper))
     threshold_figure(df, fit, out / "threshold.png", paper=paper)
     pp = fit["paper_protocol"]
+
+    def ci(c):                         # no interval: too few points (fits.MIN_BOOT_POINTS)
+        return "[-]" if c is None else f"[{c[0]:.4g}, {c[1]:.4g}]"
+
     paper_text = ("paper protocol: fewer than 3 points" if pp is None else
-                  f"paper protocol: A = {pp['A']:.4g} {pp['A_ci']}, B = {pp['B']:.4g} "
-                  f"{pp['B_ci']}, A_no_pi = {pp['A_no_pi']:.4g}, {pp['n_points']} points")
-    click.echo(f"{out / 'fit.json'}: A = {fit['prefactor']:.4g} {fit['prefactor_ci']}, "
-               f"B = {fit['exponent']:.4g} {fit['exponent_ci']}, {fit['n_points']} points; "
+                  f"paper protocol: A = {pp['A']:.4g} {ci(pp['A_ci'])}, B = {pp['B']:.4g} "
+                  f"{ci(pp['B_ci'])}, A_no_pi = {pp['A_no_pi']:.4g}, {pp['n_points']} points")
+    click.echo(f"{out / 'fit.json'}: A = {fit['prefactor']:.4g} {ci(fit['prefactor_ci'])}, "
+               f"B = {fit['exponent']:.4g} {ci(fit['exponent_ci'])}, {fit['n_points']} points; "
                f"{paper_text}")
 
 

@@ -82,3 +82,18 @@ def test_an_output_that_cannot_be_a_directory_or_written_is_one_line(tmp_path, c
     assert main(["report", "--results", str(root), "--out", str(tmp_path / "no" / "R.md")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"error: out: cannot write {tmp_path / 'no' / 'R.md'} (") and "\n" not in err
+
+
+def test_figure_titles_say_what_the_data_hold(tmp_path):
+    """The threshold figure's titles were the paper campaign's ("k = 0.1, mu = 3.24", "every
+    rate 10^0-10^6") whatever the file held; aconv joined several n into one line per a0.
+    Titles now come from the rows."""
+    from sweep.paper.figures import _held, _rates
+
+    import pandas as pd
+
+    d = pd.DataFrame({"k": [0.1, 0.1], "mu": [2.9, 2.9], "n": [0.4, 1.6],
+                      "rate": [10**0.5, 100.0]})
+    assert _held(d, "k", "mu") == r"k = 0.1, $\mu$ = 2.9"
+    assert _held(d, "n") == "n = 0.4-1.6"
+    assert _rates(d) == r"rates $10^{0.5}$-$10^{2}$"
