@@ -1035,8 +1035,11 @@ def summary(path, slowest: int = 5) -> str:
         counts = df["status"].value_counts()
         lines.append("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
     varying, fixed = [], []
+    # n is unused where every material is a Prony table (its value is bookkeeping)
+    tables = (len(df) and "material" in df
+              and df["material"].astype(str).str.startswith(f"{TABLE_MATERIAL}:").all())
     for c in list(SCENE_PARAMS) + [c for c in df.columns if c.startswith("num_")]:
-        if c not in df or not len(df):
+        if c not in df or not len(df) or (c == "n" and tables):
             continue
         col = df[c]
         if col.dtype.kind in "fiu":

@@ -410,7 +410,9 @@ def test_si_config_with_a_pyvisco_table_runs_and_info_names_it(tmp_path, capsys,
     assert "material" in out[0].split() and len(out) == 4
     assert all(label in ln for ln in out[1:])
     assert main(["info", str(tmp_path / "g.h5")]) == 0
-    assert f"material={label}" in capsys.readouterr().out
+    info = capsys.readouterr().out
+    assert f"material={label}" in info
+    assert " n=" not in info                      # unused with a table (it had said n=1)
 
 
 def test_bad_table_in_an_si_config_exits_2_one_line(tmp_path, capsys):
