@@ -360,7 +360,7 @@ def collapse_sensitivity(table: pd.DataFrame, rules=SENSITIVITY_RULES, n_boot: i
     """The collapse fit under each point selection of ``rules`` (label, fraction, min rate,
     ordinate); one dict per rule: ``rule``, ``prefactor``, ``exponent``, their ``_ci``,
     ``n_points``, ``prefactor_inner`` (A for the h = h0 radius). Rules with fewer than 3
-    points give NaN."""
+    points give NaN, with the points they have (it said 0 where 2 qualified)."""
     out = []
     for label, frac, min_rate, ordinate in rules:
         row = {"rule": label}
@@ -372,8 +372,9 @@ def collapse_sensitivity(table: pd.DataFrame, rules=SENSITIVITY_RULES, n_boot: i
                        n_points=f["n_points"], prefactor_inner=fi["prefactor"],
                        exponent_inner=fi["exponent"])
         except InputError:
+            have = len(_collapse_points(table, frac, min_rate, ordinate, "a0t"))
             row.update(prefactor=math.nan, exponent=math.nan, prefactor_ci=None,
-                       exponent_ci=None, n_points=0, prefactor_inner=math.nan,
+                       exponent_ci=None, n_points=int(have), prefactor_inner=math.nan,
                        exponent_inner=math.nan)
         out.append(row)
     return out

@@ -528,3 +528,19 @@ def test_the_vr_fit_takes_the_bems_rows_only():
     assert len(bem_rows(mixed)) == len(df)
     a, b = vr_analysis(mixed, n_boot=0), vr_analysis(df, n_boot=0)
     assert a["exponent"] == b["exponent"] and a["other_models"] == len(df)
+
+
+def test_a_sensitivity_rule_with_too_few_points_says_how_many_it_has():
+    """A rule of the collapse sensitivity with 2 qualifying points gives NaN and said
+    n_points 0; it says 2."""
+    from sweep.analysis.fits import collapse_sensitivity
+
+    table = pd.DataFrame({"status": ["interior"] * 3, "rate": [1.0, 100.0, 1000.0],
+                          "saturation": [15.0] * 3, "a0t": [1.5, 2.0, 2.5],
+                          "a0t_inner": [1.4, 1.9, 2.4], "pull_off_at_a0t": [2.0, 4.0, 8.0],
+                          "pull_off_plateau": [2.1, 4.1, 8.1]})
+    rules = [("rate >= 10", 0.9, 10.0, "pull_off_at_a0t"), ("all", 0.9, 0.0, "pull_off_at_a0t")]
+    few, every = collapse_sensitivity(table, rules, n_boot=0)
+    assert math.isnan(few["exponent"]) and few["n_points"] == 2
+    assert every["n_points"] == 3 and every["exponent"] == pytest.approx(
+        math.log(4.0) / math.log(2.5 / 1.5), rel=0.05)
