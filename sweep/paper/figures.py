@@ -252,22 +252,31 @@ def pb_vs_bem_figure(points: pd.DataFrame, comp: dict, out) -> Path:
     return _save(fig, out)
 
 
+#: Fig. 3's panels: title, the rows a panel draws, the axis its curves differ in, their label
+FIG3_PANELS = [
+    ("(a) n = 0.8, $\\hat a_0$ = 3.61", lambda d: np.isclose(d.n, 0.8) & np.isclose(d.a0, 3.61),
+     "rate", lambda v: rf"$\hat r$ = {_rate_label(v)}"),
+    ("(b) $\\hat a_0$ = 3.61, $\\hat r = 10^{2.5}$",
+     lambda d: np.isclose(d.a0, 3.61) & np.isclose(d.rate, 10**2.5), "n", lambda v: f"n = {v:g}"),
+    ("(c) n = 1.6, $\\hat r = 10^{2.5}$",
+     lambda d: np.isclose(d.n, 1.6) & np.isclose(d.rate, 10**2.5), "a0",
+     lambda v: rf"$\hat a_0$ = {v:g}"),
+]
+
+
+def fig3_panels(ok: pd.DataFrame) -> list[int]:
+    """How many of the rows ``ok`` each panel of Fig. 3 draws (a file without its scenes
+    had drawn three empty panels and exited 0)."""
+    return [int(sel(ok).sum()) for _, sel, _, _ in FIG3_PANELS]
+
+
 def fig3_figure(runs: pd.DataFrame, trajectories: dict, out) -> Path:
     """The paper's Fig. 3: ``P(a)`` during unloading; panels (a) rates (n = 0.8, a0 = 3.61),
     (b) n (rate 10^2.5), (c) a0 (n = 1.6, rate 10^2.5); the JKR curve for reference.
     ``trajectories`` maps scene_id to the dict of :func:`sweep.load_trajectory`."""
     plt = _pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(16, 5))
-    r25 = 10**2.5
-    panels = [
-        ("(a) n = 0.8, $\\hat a_0$ = 3.61", lambda d: np.isclose(d.n, 0.8) & np.isclose(d.a0, 3.61),
-         "rate", lambda v: rf"$\hat r$ = {_rate_label(v)}"),
-        ("(b) $\\hat a_0$ = 3.61, $\\hat r = 10^{2.5}$",
-         lambda d: np.isclose(d.a0, 3.61) & np.isclose(d.rate, r25), "n", lambda v: f"n = {v:g}"),
-        ("(c) n = 1.6, $\\hat r = 10^{2.5}$",
-         lambda d: np.isclose(d.n, 1.6) & np.isclose(d.rate, r25), "a0",
-         lambda v: rf"$\hat a_0$ = {v:g}"),
-    ]
+    panels = FIG3_PANELS
     ok = runs[runs["status"] == "ok"]
     a = np.linspace(0.05, 4.5, 300)
     for ax, (title, sel, key, lab) in zip(axes, panels):

@@ -185,7 +185,7 @@ def vr_cmd(runs, outdir):
 @click.argument("outdir")
 def fig3_cmd(runs, outdir):
     """fig3.png: the P(a) trajectories of the Fig. 3 sweep RUNS."""
-    from .figures import fig3_figure
+    from .figures import fig3_figure, fig3_panels
     from ..campaign.store import load_trajectory
 
     df = _load_results(runs)
@@ -196,7 +196,13 @@ def fig3_cmd(runs, outdir):
         except (KeyError, FileNotFoundError):
             continue
     if not trajs:
-        raise InputError(f"results: {runs!r} holds no trajectories (store: trajectories: true)")
+        n_ok = int((df["status"] == "ok").sum())
+        raise InputError(f"results: {runs!r} holds no trajectory of an ok scene ({n_ok} ok of "
+                         f"{len(df)}; a sweep keeps them with store: {{trajectories: true}})")
+    panels = fig3_panels(df[df["status"] == "ok"])
+    if not any(panels):
+        raise InputError(f"results: {runs!r} holds none of Fig. 3's scenes (n 0.8 at a0 3.61, "
+                         f"a0 3.61 at rate 10^2.5, n 1.6 at rate 10^2.5: configs/fig3.yaml)")
     out = _outdir(outdir)
     fig3_figure(df, trajs, out / "fig3.png")
     ok = df[df["status"] == "ok"]

@@ -97,3 +97,20 @@ def test_figure_titles_say_what_the_data_hold(tmp_path):
     assert _held(d, "k", "mu") == r"k = 0.1, $\mu$ = 2.9"
     assert _held(d, "n") == "n = 0.4-1.6"
     assert _rates(d) == r"rates $10^{0.5}$-$10^{2}$"
+
+
+def test_fig3_refuses_a_file_without_its_scenes(tmp_path, capsys):
+    """A file without Fig. 3's scenes had drawn three empty panels and exited 0."""
+    import pandas as pd
+
+    from sweep.paper.figures import fig3_panels
+
+    vr = tmp_path / "vr.h5"
+    write_results(vr, synthetic_vr_runs().assign(wall_s=2.0, reason=""))
+    assert main(["fig3", str(vr), str(tmp_path / "f3")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "holds no trajectory of an ok scene" in err and "\n" not in err
+    d = pd.DataFrame({"n": [0.8, 0.8, 1.6, 0.4], "a0": [3.61, 3.61, 2.0, 3.61],
+                      "rate": [10.0, 10**2.5, 10**2.5, 1.0]})
+    assert fig3_panels(d) == [2, 1, 1]
+    assert fig3_panels(d.assign(a0=2.5, n=0.4, rate=1.0)) == [0, 0, 0]
