@@ -146,8 +146,8 @@ def _mark_failed(ax, df, x: str) -> int:
         ax.plot(xs[has], po[has], "x", color="red", ms=7, mew=1.5, ls="none", label=label)
         label = None
     if (~has).any():
-        # no pull-off: at the bottom edge, x in data units, y in axes units
-        ax.plot(xs[~has], np.full((~has).sum(), 0.03), "x", color="red", ms=7, mew=1.5,
+        # no pull-off: on the x axis itself (not a load), x in data units, y in axes units
+        ax.plot(xs[~has], np.zeros((~has).sum()), "x", color="red", ms=7, mew=1.5,
                 ls="none", transform=ax.get_xaxis_transform(), clip_on=False,
                 label=label or "_failed_no_pull_off")
     return len(failed)
@@ -393,9 +393,13 @@ def sweep_figure(df, title: str = "", trajectory=None):
         for skey, (ls, marker) in style_of.items():
             handles[", ".join(_text(a, v) for a, v in zip(lay.styles, skey))] = \
                 _line("0.3", ls, marker)
-    n_failed = int((df["status"] != "ok").sum())
-    if n_failed:
-        handles[f"failed ({n_failed})"] = _line("red", "none", "x")
+    failed = df[df["status"] != "ok"]
+    if len(failed):
+        # a failure without a pull-off sits on the x axis (not a load); several at one place
+        # are one cross
+        bare = int((~np.isfinite(failed["pull_off"].astype(float))).sum())
+        handles[f"failed ({len(failed)}" + (f"; {bare} without a pull-off, on the x axis"
+                                            if bare else "") + ")"] = _line("red", "none", "x")
     if right is not None:
         _trajectories(right, ok, lay, colour_of, trajectory, handles)
     fig.suptitle(title, fontsize=10)

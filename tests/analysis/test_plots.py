@@ -183,8 +183,13 @@ def test_every_campaign_renders_without_warning(config):
     fig = render(df, synthetic_trajectory if cfg.trajectories else None)
     assert_legend_outside_the_data_inside_the_figure(fig)
     n_failed = int((df["status"] != "ok").sum())
+    bare = int((df["status"] != "ok").sum() - np.isfinite(
+        df.loc[df["status"] != "ok", "pull_off"].astype(float)).sum())
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert (f"failed ({n_failed})" in labels) == (n_failed > 0)
+    # a failure without a pull-off is drawn on the x axis, and the legend says so
+    want = f"failed ({n_failed}" + (f"; {bare} without a pull-off, on the x axis" if bare
+                                    else "") + ")"
+    assert (want in labels) == (n_failed > 0), labels
     pyplot().close(fig)
 
 
