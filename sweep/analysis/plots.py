@@ -163,6 +163,27 @@ def _is_numeric(axis: str) -> bool:
     return AXIS_INFO[axis].numeric
 
 
+#: short names of the axes whose help text is long or technical (the others: their help's
+#: first words)
+_AXIS_NAMES = {"a0": "initial contact radius", "delta0": "initial indentation",
+               "k": "modulus ratio E0/Einf", "preload": "preload", "pz_v0": "process-zone speed",
+               "pz_xi": "process-zone exponent", "machine_stiffness": "machine stiffness"}
+
+
+def axis_label(axis: str) -> str:
+    """An axis's label for an abscissa: its name, symbol and unit (``initial contact radius
+    $\\hat a_0$ (a_ref)``); the short symbol of a colour bar or legend alone (``$\\hat
+    a_0$``) had said neither what nor in what."""
+    info = AXIS_INFO[axis]
+    label = info.label
+    if label.startswith("$") and label.endswith("$"):       # a bare symbol: name it
+        name = _AXIS_NAMES.get(axis) or info.help.split(";")[0].split("(")[0].strip()
+        label = f"{name} {label}"
+    if info.unit and info.unit not in label:
+        label += f" ({info.unit})"
+    return label
+
+
 def _text(axis: str, value) -> str:
     """``n = 0.4``, ``model = crack`` (a plain name: panel titles and legend entries)."""
     return f"{axis} = {value:g}" if isinstance(value, (float, int)) and not isinstance(
@@ -368,7 +389,7 @@ def sweep_figure(df, title: str = "", trajectory=None):
         # column; each panel keeps its y ticks: the panels of different k differ in range)
         spec = ax.get_subplotspec()
         if spec.is_last_row() or keys[spec.num1 + ncols] is None:
-            ax.set_xlabel(AXIS_INFO[lay.x].label, fontsize=8)
+            ax.set_xlabel(axis_label(lay.x), fontsize=8)
         else:
             ax.tick_params(labelbottom=False)
         if spec.is_first_col():

@@ -252,3 +252,12 @@ def test_the_figure_names_what_was_held_constant():
     table = df.assign(material="prony:gmm:a06e69d9b019ec0e", n=1.0)
     assert "n = 1" not in constant_axes(table)
     assert "material = prony:gmm:a06e69d9b019ec0e" in constant_axes(table)
+
+
+def test_an_abscissa_says_what_it_is_and_in_what():
+    """With a0 as the abscissa its label had been a bare symbol (no name, no unit)."""
+    from sweep.analysis.plots import axis_label
+
+    assert axis_label("a0") == r"initial contact radius $\hat a_0$ (a_ref)"
+    assert axis_label("preload") == r"preload $\hat P_0$ (pi dg R)"
+    assert axis_label("rate") == r"unloading rate $\hat r = r\tau_0/h_0$"
