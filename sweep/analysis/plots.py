@@ -521,15 +521,17 @@ def _trajectories(fig, ok, lay: PlotLayout, colour_of: dict, trajectory, handles
             ax.plot(tr["delta"][back], tr["P"][back], lw=1, alpha=shade, color=colour)
         else:
             ax.plot(tr["a"], tr["P"], lw=1, alpha=shade, color=colour)
+    # the panels' axes are not told apart here: the title says which are drawn together
+    together = (f"; every {', '.join(lay.panels)} together" if lay.panels else "")
     if cycles:
-        ax.set_xlabel(r"indentation $\hat\delta$", fontsize=8)
-        ax.set_title("load cycles P(delta); dotted: approach, dwell", fontsize=8)
+        ax.set_xlabel(r"indentation $\hat\delta$ ($d_{ref}$)", fontsize=8)
+        ax.set_title("load cycles P(delta); dotted: approach, dwell" + together, fontsize=8)
     else:
         a = np.linspace(0.5, float(ok["a0_result"].max()), 200)
         ax.plot(a, jkr_load(a), color="black", ls="--", lw=1.0)
-        ax.set_xlabel(r"contact radius $\hat a$", fontsize=8)
-        ax.set_title("trajectories P(a)" + ("; darker: faster unloading" if span > 0 else ""),
-                     fontsize=8)
+        ax.set_xlabel(r"contact radius $\hat a$ ($a_{ref}$)", fontsize=8)
+        ax.set_title("trajectories P(a)" + ("; darker: faster unloading" if span > 0 else "")
+                     + together, fontsize=8)
     ax.set_ylabel(r"load $\hat P$ ($\pi\Delta\gamma_0 R$)", fontsize=8)
     ax.tick_params(labelsize=7)
     jkr = f"JKR relaxed pull-off, {JKR_PULL_OFF:g}"      # one entry for both dashed lines
