@@ -160,7 +160,7 @@ def test_material_bad_input(capsys, argv, message):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["pb", "--n", "0.4", "--k", "0.1", "--v", "1e300"], "error: vhat must be <= 1e+100"),
+    (["pb", "--n", "0.4", "--k", "0.1", "--v", "1e300"], "error: v must be <= 1e+100"),
     (["material", "--n", "0.4", "--k", "0.1", "--t", "1e-200,1e200"],
      "error: t_max/t_min must be at most 1e100"),
 ])
