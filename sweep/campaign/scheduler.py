@@ -382,7 +382,8 @@ def dispatch_order(todo: list, numerics, costs: dict | None = None) -> list:
 #: a dispatch chunk holds at most this fraction of the grid's estimated cost per worker
 #: (1/4: at most a quarter of a worker's share, so the largest chunks still balance) ...
 CHUNK_COST_FRACTION = 0.25
-#: ... and at most this many scenes (progress, and the work a crashed worker loses)
+#: ... and at most this many scenes (a dask worker's rows come per chunk: its progress, and
+#: what its crash loses; a local worker's rows come per scene, sweep.campaign.spool)
 CHUNK_SCENES = 24
 
 
