@@ -644,7 +644,7 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
     FILE.csv holds a master curve (omega_rad_s,E_storage_Pa,E_loss_Pa) or a temperature
     sweep (T_C,f_Hz,E_storage_Pa,E_loss_Pa), shifted to --tref with the WLF equation.
     """
-    from .analysis.dma import (KK_FLOOR, KK_NOISE_FACTOR, fit_maxwell, fit_mpl,
+    from .analysis.dma import (KK_FLOOR, KK_NOISE_FACTOR, fit_maxwell, fit_mpl, storage_fall,
                                kramers_kronig_check, plot_dma, read_dma_csv)
 
     c = parse_floats("wlf", wlf)
@@ -671,16 +671,10 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
                                                       0.0, 0.5))
     if plot_out is not None:
         plot_out = str(plot_dma(data, mpl, mx, plot_out, "plot"))    # the path written
-    # what a linear viscoelastic solid's data cannot do, and a fit that misses its data
-    noise_level = float(kk.noise)
-    e1 = np.asarray(data.E_storage, float)
-    drops = (e1[:-1] - e1[1:]) / e1[:-1]          # by ascending omega
-    worst = int(np.argmax(drops)) if drops.size else 0
-    # two noisy points differ by sqrt(2) noise: a fall beyond 4 of those (and 2 %) is data's
-    fall_limit = KK_FLOOR + 4.0 * math.sqrt(2.0) * noise_level
-    falls = bool(drops.size and drops[worst] > fall_limit)
-    tolerance = KK_FLOOR + KK_NOISE_FACTOR * noise_level
-    fit_misses = max(mpl.quality["rms_rel_storage"], mpl.quality["rms_rel_loss"]) > tolerance
+    # what a linear viscoelastic solid's data cannot do, and a fit that misses its data (by
+    # the Kramers-Kronig check's own tolerance)
+    fall = storage_fall(data, kk.noise)
+    fit_misses = max(mpl.quality["rms_rel_storage"], mpl.quality["rms_rel_loss"]) > kk.threshold
     out = {"source": csv_file, "kind": data.kind, "points": int(data.omega.size),
            "omega_min_rad_s": float(data.omega.min()),
            "omega_max_rad_s": float(data.omega.max()),
@@ -688,7 +682,7 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
            "E0": mpl.E0, "Einf": mpl.Einf, "n": mpl.n, "tau0": mpl.tau0, "k": mpl.k,
            "mpl": mpl.to_dict(), "maxwell": None if mx is None else mx.to_dict(),
            "kramers_kronig": kk.to_dict(), "plot": plot_out,
-           "storage_falls": falls, "mpl_fit_within_noise": not fit_misses}
+           "storage_falls": fall is not None, "mpl_fit_within_noise": not fit_misses}
     if json_out is not None:
         with writing("out", json_out), open(json_out, "w") as fh:   # numpy scalars as numbers
             fh.write(json.dumps(out, indent=1, default=lambda x: x.item()) + "\n")
@@ -717,12 +711,12 @@ def fit_dma_command(csv_file, tref, wlf, arms, plot_out, noise, as_json, json_ou
                f" E'' {q['rms_rel_loss']:.3g}; converged {mpl.success}{bound}")
     if fit_misses:
         click.echo(f"  WARNING: the MPL misses these data (rms relative residual above "
-                   f"{tolerance:.3g} = {KK_FLOOR:g} + {KK_NOISE_FACTOR:g} x the stated noise "
-                   f"{noise_level:g}): its constants describe another material")
-    if falls:
-        click.echo(f"WARNING: E' falls with frequency, by {drops[worst]:.2g} of it from "
-                   f"{data.omega[worst]:.3g} to {data.omega[worst + 1]:.3g} rad/s (more than "
-                   f"{fall_limit:.2g}, what the stated noise {noise_level:g} explains): a linear "
+                   f"{kk.threshold:.3g} = {KK_FLOOR:g} + {KK_NOISE_FACTOR:g} x the stated noise "
+                   f"{kk.noise:g}): its constants describe another material")
+    if fall is not None:
+        click.echo(f"WARNING: E' falls with frequency, by {fall['fall']:.2g} of it from "
+                   f"{fall['omega_from']:.3g} to {fall['omega_to']:.3g} rad/s (more than "
+                   f"{fall['limit']:.2g}, what the stated noise {kk.noise:g} explains): a linear "
                    f"viscoelastic solid's storage modulus does not; check the columns and units")
     if mx is not None:
         q = mx.quality

@@ -10,6 +10,7 @@ The CLI turns an ``InputError`` into that line on stderr and exit code 2.
 from __future__ import annotations
 
 import math
+import os
 from contextlib import contextmanager
 from typing import Iterable
 
@@ -148,8 +149,6 @@ def check_output(name: str, path, inputs=()) -> None:
     command's ``inputs`` or an existing HDF5 file (a sweep's results): written over, it
     would be lost (``sweep info R --si --csv R`` had replaced a results file by its table,
     ``sweep fit-dma m.csv --out m.csv`` the DMA data by the fit)."""
-    import os
-
     target = os.path.abspath(os.fspath(path))
     for source in inputs:
         if source is not None and os.path.exists(source) and os.path.exists(target) \

@@ -580,6 +580,31 @@ def _smooth_log(lw, ly, x, width):
     return out
 
 
+def storage_fall(data, noise: float = 0.01) -> dict | None:
+    """The largest fall of the storage modulus between neighbouring frequencies, where it
+    exceeds what the data's relative noise explains (two noisy points differ by sqrt(2)
+    noise: 4 of those, and :data:`KK_FLOOR`); None otherwise. A linear viscoelastic solid's
+    E' does not fall with frequency: such data are not what they claim (columns or units).
+
+    Returns
+    -------
+    dict or None
+        ``fall`` (relative to the lower frequency's E'), ``omega_from``, ``omega_to``
+        [rad/s] and ``limit``.
+    """
+    data = _as_data(data)
+    e1 = np.asarray(data.E_storage, float)
+    drops = (e1[:-1] - e1[1:]) / e1[:-1]          # by ascending omega
+    limit = KK_FLOOR + 4.0 * math.sqrt(2.0) * float(noise)
+    if not drops.size:
+        return None
+    i = int(np.argmax(drops))
+    if not drops[i] > limit:
+        return None
+    return {"fall": float(drops[i]), "omega_from": float(data.omega[i]),
+            "omega_to": float(data.omega[i + 1]), "limit": limit}
+
+
 def kramers_kronig_check(data, threshold: float | None = None, per_decade: float = 4.0,
                          noise: float = 0.01) -> KKCheck:
     """Linear Kramers-Kronig test of a measured complex modulus (module docstring).

@@ -25,6 +25,8 @@ Bad input: one line ``error: ...`` and exit 2.
 from __future__ import annotations
 
 import json
+import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -79,9 +81,6 @@ def _links_from(text: str, root: Path, where: Path) -> str:
     """The report's relative links (figures, sub-reports: relative to the results directory
     ``root``) as seen from ``where``, the folder it is written to (written elsewhere with
     --out they had pointed nowhere)."""
-    import os
-    import re
-
     prefix = os.path.relpath(root.resolve(), where.resolve())
     if prefix == ".":
         return text
