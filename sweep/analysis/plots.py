@@ -498,18 +498,28 @@ def _reference_lines(axes: list, frames: list, handles: dict) -> None:
         handles["JKR glassy pull-off, 1.5/k"] = _line("black", ":", "none")
 
 
+#: the most panels whose trajectories get an axes each (more: drawn together on one)
+TRAJECTORY_PANELS = 4
+
+
 def _trajectories(fig, ok, lay: PlotLayout, colour_of: dict, trajectory, handles: dict):
-    """P(a) of every ok scene on one panel of ``fig`` (a subfigure): the colour of its line
+    """P(a) of every ok scene on the right of ``fig`` (a subfigure): the colour of its line
     on the pull-off panels, darker for faster unloading; the relaxed JKR curve dashed. Scenes
     with a test protocol (a ``phase`` in their trajectory) draw their load cycle P(delta)
-    instead: approach and dwell dotted, retraction solid."""
-    ax = fig.subplots()
+    instead: approach and dwell dotted, retraction solid. Each panel of the pull-offs has an
+    axes of its own, titled as the panel is (up to :data:`TRAJECTORY_PANELS`; beyond, all
+    are drawn on one axes and its title says so)."""
+    keys = _panel_keys(ok, lay.panels)
+    apart = 1 < len(keys) <= TRAJECTORY_PANELS
+    axes = fig.subplots(len(keys) if apart else 1, 1, squeeze=False)[:, 0]
     rates = np.log10(ok["rate"].astype(float))
     span = float(rates.max() - rates.min())
     cycles = False
     for _, row in ok.sort_values("rate").iterrows():
         tr = trajectory(str(row["scene_id"]))
         key = row[lay.colour] if lay.colour else None
+        ax = axes[keys.index(tuple(None if _missing(row[a]) else row[a] for a in lay.panels))
+                  if apart else 0]
         shade = 0.35 + 0.65 * (math.log10(float(row["rate"])) - float(rates.min())) / span \
             if span > 0 else 1.0              # one rate: every line at full strength
         colour = colour_of[str(None if _missing(key) else key)]
@@ -521,19 +531,25 @@ def _trajectories(fig, ok, lay: PlotLayout, colour_of: dict, trajectory, handles
             ax.plot(tr["delta"][back], tr["P"][back], lw=1, alpha=shade, color=colour)
         else:
             ax.plot(tr["a"], tr["P"], lw=1, alpha=shade, color=colour)
-    # the panels' axes are not told apart here: the title says which are drawn together
-    together = (f"; every {', '.join(lay.panels)} together" if lay.panels else "")
+    # beyond TRAJECTORY_PANELS the panels' axes are not told apart: the title says so
+    together = (f"; every {', '.join(lay.panels)} together"
+                if lay.panels and len(keys) > 1 and not apart else "")
     if cycles:
-        ax.set_xlabel(r"indentation $\hat\delta$ ($d_{ref}$)", fontsize=8)
-        ax.set_title("load cycles P(delta); dotted: approach, dwell" + together, fontsize=8)
+        head = "load cycles P(delta); dotted: approach, dwell" + together
     else:
-        a = np.linspace(0.5, float(ok["a0_result"].max()), 200)
-        ax.plot(a, jkr_load(a), color="black", ls="--", lw=1.0)
-        ax.set_xlabel(r"contact radius $\hat a$ ($a_{ref}$)", fontsize=8)
-        ax.set_title("trajectories P(a)" + ("; darker: faster unloading" if span > 0 else "")
-                     + together, fontsize=8)
-    ax.set_ylabel(r"load $\hat P$ ($\pi\Delta\gamma_0 R$)", fontsize=8)
-    ax.tick_params(labelsize=7)
+        head = ("trajectories P(a)" + ("; darker: faster unloading" if span > 0 else "")
+                + together)
+    for i, ax in enumerate(axes):
+        if not cycles:
+            a = np.linspace(0.5, float(ok["a0_result"].max()), 200)
+            ax.plot(a, jkr_load(a), color="black", ls="--", lw=1.0)
+        panel = (", ".join(_text(a, v) for a, v in zip(lay.panels, keys[i])) if apart else "")
+        ax.set_title("\n".join(t for t in (head if i == 0 else "", panel) if t), fontsize=8)
+        if i == len(axes) - 1:
+            ax.set_xlabel(r"indentation $\hat\delta$ ($d_{ref}$)" if cycles
+                          else r"contact radius $\hat a$ ($a_{ref}$)", fontsize=8)
+        ax.set_ylabel(r"load $\hat P$ ($\pi\Delta\gamma_0 R$)", fontsize=8)
+        ax.tick_params(labelsize=7)
     jkr = f"JKR relaxed pull-off, {JKR_PULL_OFF:g}"      # one entry for both dashed lines
     merged = {(f"JKR relaxed: pull-off {JKR_PULL_OFF:g}, P(a)" if k == jkr and not cycles
                else k): h for k, h in handles.items()}

@@ -261,3 +261,44 @@ def test_an_abscissa_says_what_it_is_and_in_what():
     assert axis_label("a0") == r"initial contact radius $\hat a_0$ (a_ref)"
     assert axis_label("preload") == r"preload $\hat P_0$ (pi dg R)"
     assert axis_label("rate") == r"unloading rate $\hat r = r\tau_0/h_0$"
+
+
+def test_each_panel_has_its_own_trajectory_axes():
+    """The trajectory panel had drawn the scenes of every pull-off panel on one axes in the
+    same colours (test D of session 48: the load cycles of n 0.4 and 0.8 could not be told
+    apart): up to TRAJECTORY_PANELS panels, each has an axes of its own, titled with the
+    panel's value and holding its scenes' lines only; beyond, one axes says "together"."""
+    import pandas as pd
+
+    from sweep.analysis.plots import TRAJECTORY_PANELS
+    from sweep.scene import Scene
+
+    def frame(a0s, ns=(0.4, 0.8)):          # x: rate; colour: n, a panel per a0
+        rows = []
+        for a0 in a0s:
+            for n in ns:
+                for rate in (1.0, 10.0):
+                    sc = Scene(n=n, k=0.1, mu=3.24, a0=a0, rate=rate)
+                    rows.append({"scene_id": f"{a0}-{n}-{rate}", **sc.to_dict(),
+                                 "status": "ok", "pull_off": 2.0 + n, "a0_result": a0})
+        return pd.DataFrame(rows)
+
+    def trajectory_axes(fig):
+        found = [ax for ax in all_axes(fig) if ax.get_ylabel().startswith("load")]
+        return list(dict.fromkeys(found))   # a subfigure's axes are also the figure's
+
+    fig = render(frame([2.0, 3.0]), synthetic_trajectory)
+    traj = trajectory_axes(fig)
+    assert [ax.get_title().splitlines()[-1] for ax in traj] == ["a0 = 2", "a0 = 3"]
+    for ax in traj:                         # four scenes' lines and the JKR curve
+        assert len(ax.get_lines()) == 5
+    assert traj[-1].get_xlabel().startswith("contact radius")
+    pyplot().close(fig)
+
+    ns = [0.4 + 0.2 * i for i in range(TRAJECTORY_PANELS + 1)]     # a panel per n
+    a0s = [2.0 + 0.5 * i for i in range(TRAJECTORY_PANELS + 2)]    # colour: a0
+    fig = render(frame(a0s, ns), synthetic_trajectory)
+    (one,) = trajectory_axes(fig)
+    assert "every n together" in one.get_title()
+    assert len(one.get_lines()) == 2 * len(ns) * len(a0s) + 1
+    pyplot().close(fig)
