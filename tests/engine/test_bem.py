@@ -290,3 +290,23 @@ def test_a_run_past_its_prony_window_fails_where_the_series_is_not_the_material(
     assert pb.prony_t_max < 1e6
     check_prony_window(pb, relaxed)
     assert relaxed.status == "ok" and relaxed.error_estimate == 1e-3
+
+
+def test_the_lennard_jones_tail_beyond_the_mesh_is_in_the_load():
+    # the relaxed limit (rate 1e-6: the elastic pull-off of the relaxed modulus) at the
+    # accurate preset against the quasi-static elastic branch at fine resolution (its own
+    # mesh and solver; converged 1.54622, an independent solver 1.54622). Without the
+    # attraction beyond the mesh edge the BEM gave 1.545805 (tail_gap 60) and 1.546238
+    # (tail_gap 600): low by about (1/tail_gap)^2, 2.8e-4 apart; with it both agree with
+    # the branch within the row's own estimate, and the domain no longer moves the pull-off
+    from sweep.engine.quasistatic import elastic_pull_off
+    scene = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=1e-6)
+    ref = elastic_pull_off(3.24, a_start=2.0, zone_resolution=64, coarse=0.0025)
+    assert ref.converged
+    assert ref.pull_off == pytest.approx(1.5462247, abs=2e-7)
+    near = simulate(scene, Numerics.preset("accurate"))
+    far = simulate(scene, Numerics.preset("accurate", tail_gap=600.0))
+    for res in (near, far):
+        assert res.status == "ok", res.reason
+        assert abs(res.pull_off / ref.pull_off - 1.0) <= res.error_estimate
+    assert abs(far.pull_off / near.pull_off - 1.0) <= 2e-5

@@ -312,7 +312,7 @@ def test_newton_with_a_compliant_machine_is_the_rigid_solve_at_d_minus_p_over_k(
     hs = h_start.copy()
     assert ks.newton_machine(hs, -D + h0 + 0.5 * r**2, A, ceff, H,
                              lennard_jones(h0, c, N), 1e-11 * h0, 40, cache, stats,
-                             1.0 / stiffness, wP)
+                             1.0 / stiffness, wP, np.inf)     # inf: no LJ tail, as P below
     lj_traction_and_stiffness(hs, h0, c, sig, d)
     P = 2.0 * np.pi * wP @ sig
     delta = D - P / stiffness

@@ -52,7 +52,7 @@ def test_the_held_step_carries_the_load_at_the_indentation_it_found(extra):
     h = h_start.copy()
     cache, stats = ks.new_jacobian_cache(N), np.zeros(ks.N_STATS, np.int64)
     law = lennard_jones(h0, c, N)
-    ok, shift = newton_at_load(h, g, A, wP, ceff, H, law, force,
+    ok, shift = newton_at_load(h, g, A, wP, np.inf, ceff, H, law, force,   # inf: no tail
                                np.array([TOL * h0, 1e-9 * abs(force)]), 40, cache, stats)
     assert ok
     assert np.sign(shift) == np.sign(extra)           # more load, more indentation
