@@ -124,17 +124,17 @@ def _bordered_update(h, F, A, ceff, law, P, force, wP, cache, stats, y, out):
 
 
 @njit(cache=True)
-def newton_at_load(h, g, A, wP, tail, ceff, H, law, force, tols, max_iter, cache, stats):
+def newton_at_load(h, g, mesh, ceff, H, law, force, tols, max_iter, cache, stats):
     """Solve F(h, s) = 0 and G(h) = 0 (module docstring) in place of ``h`` from ``h`` and
-    s = 0, the gap g of the guessed indentation, the load that of the mesh's weights ``wP``
-    and ``tail`` (:data:`kernels.solve.MeshArrays`, :func:`kernels.solve.load`: the
-    Lennard-Jones tail beyond the mesh included); ``tols`` = (``max |F|`` in units of d_ref,
-    ``|G|`` in units of pi dg R). Returns (converged, s): the step's indentation is the
-    guess plus s. The cache's factorization is kept and made again where its iteration
-    contracts the residual by less than HELD_SLOW_CONTRACTION (not with the drift-scaled chord,
-    ``state[STATE_SCALED]``: :func:`kernels.solve.newton`); a residual growing by
-    HELD_DIVERGENCE ends the solve unconverged."""
-    N = h.size
+    s = 0, the gap g of the guessed indentation, on the mesh ``mesh``
+    (:data:`kernels.solve.MeshArrays`: the load :func:`kernels.solve.load` of its weights and
+    tail, the Lennard-Jones attraction beyond the mesh included); ``tols`` = (``max |F|`` in
+    units of d_ref, ``|G|`` in units of pi dg R). Returns (converged, s): the step's
+    indentation is the guess plus s. The cache's factorization is kept and made again where
+    its iteration contracts the residual by less than HELD_SLOW_CONTRACTION (not with the
+    drift-scaled chord, ``state[STATE_SCALED]``: :func:`kernels.solve.newton`); a residual
+    growing by HELD_DIVERGENCE ends the solve unconverged."""
+    N, A = h.size, mesh.A
     sig, w, F, dh, y = np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.full(N, np.nan)
     gs = g.copy()
     s = 0.0
@@ -143,11 +143,11 @@ def newton_at_load(h, g, A, wP, tail, ceff, H, law, force, tols, max_iter, cache
     norm = residual(h, gs, A, ceff, H, law, sig, w, F)
     stats[STAT_RESIDUALS] += 1
     for _ in range(max_iter):
-        P = load(sig, wP, h, tail, law.h0, law.c)
+        P = load(sig, mesh.wP, h, mesh.tail, law.h0, law.c)
         if norm <= tols[0] and abs(P - force) <= tols[1]:
             return True, s
         stats[STAT_ITER] += 1
-        ds, ok = _bordered_update(h, F, A, ceff, law, P, force, wP, cache, stats, y, dh)
+        ds, ok = _bordered_update(h, F, A, ceff, law, P, force, mesh.wP, cache, stats, y, dh)
         if not ok:
             return False, s
         lam = positive_step(h, dh)
@@ -346,8 +346,8 @@ def dwell_steps(mesh, physics, law, control, state, out, cache, stats):
         ceff = _step_start(mesh, physics, law, control, state, out.starts, dt, delta,
                            (e, b, H, g, hs), control.origin)
         if control.hold_force:
-            ok, shift = newton_at_load(hs, g, mesh.A, mesh.wP, mesh.tail, ceff, H, law,
-                                       control.force, control.tols, control.max_iter, cache, stats)
+            ok, shift = newton_at_load(hs, g, mesh, ceff, H, law, control.force, control.tols,
+                                       control.max_iter, cache, stats)
             delta = delta + shift
         else:
             ok = newton(hs, g, mesh.A, ceff, H, law, control.tols[0], control.max_iter,

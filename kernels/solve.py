@@ -105,6 +105,11 @@ N_STATS = 13
 #: r_end = 2 r_last - r_(last-1) (``sweep.engine.mesh.Mesh.tail_rise``; inf: no tail)
 MeshArrays = namedtuple("MeshArrays", ["A", "r", "wP", "tail"])
 
+#: the machine a solve loads the sphere through: its compliance (1/K, 0 a rigid machine) and
+#: what the load the spring carries needs, the mesh's weights wP and tail (:data:`MeshArrays`,
+#: :func:`load`); one argument of :func:`newton_machine`, :func:`relax_machine`
+Machine = namedtuple("Machine", ["compliance", "wP", "tail"])
+
 #: the scene's laws and loading (dimensionless, docs/design.md section 2): h0 and c of the
 #: Lennard-Jones law, the Prony modes (weights, times) of Chat (times may be inf: a lumped
 #: glassy constant), rate = r-hat (d D/dt = -rate h0, D the machine's displacement: the
@@ -389,15 +394,16 @@ def residual(h, g, A, ceff, H, law, sig, w, F):
 
 
 @njit(cache=True, inline='always')
-def machine_residual(h, g, A, ceff, H, law, compliance, wP, tail, sig, w, F):
-    """:func:`residual` with a compliant machine: F - compliance P(h), P = 2 pi wP . sigma
-    + the Lennard-Jones tail beyond the mesh (:func:`load`; ``tail`` the mesh's
-    :data:`MeshArrays` tail) (the indentation is D - compliance P, ``g`` that of D); exactly
-    :func:`residual` for ``compliance`` 0. Returns max |F|."""
+def machine_residual(h, g, A, ceff, H, law, machine, sig, w, F):
+    """:func:`residual` with a compliant machine (:data:`Machine`): F - compliance P(h),
+    P = 2 pi wP . sigma + the Lennard-Jones tail beyond the mesh (:func:`load`) (the
+    indentation is D - compliance P, ``g`` that of D); exactly :func:`residual` for
+    compliance 0. Returns max |F|."""
     norm = residual(h, g, A, ceff, H, law, sig, w, F)
+    compliance = machine.compliance
     if compliance == 0.0:
         return norm
-    cP = compliance * load(sig, wP, h, tail, law.h0, law.c)
+    cP = compliance * load(sig, machine.wP, h, machine.tail, law.h0, law.c)
     norm = 0.0
     for i in range(h.size):
         F[i] -= cP
@@ -462,7 +468,7 @@ def _refactorize(h, A, ceff, law, cache, stats, reason):
 
 
 @njit(cache=True, inline='always')
-def _direction(h, F, A, ceff, law, compliance, wP, sig, d, dr, cache, stats):
+def _direction(h, F, A, ceff, law, machine, sig, d, dr, cache, stats):
     """Newton's direction at ``h`` (residual ``F``) with the cached factorization, made again
     once when it no longer fits (the crack tip left the zone), corrected for a compliant
     machine (:func:`machine_direction`). Returns (dh, ok, refactorized); ok is False when
@@ -474,8 +480,8 @@ def _direction(h, F, A, ceff, law, compliance, wP, sig, d, dr, cache, stats):
         _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_ZONE)
         dh, ok = newton_direction(F, d, dr, A, ceff, cache, stats, STAT_ZONE)
         refactorized = True
-    if ok and compliance != 0.0:
-        ok = machine_direction(dh, d, A, compliance, wP, cache)
+    if ok and machine.compliance != 0.0:
+        ok = machine_direction(dh, d, A, machine.compliance, machine.wP, cache)
     return dh, ok, refactorized
 
 
@@ -494,16 +500,16 @@ def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
     """Solve F(h) = 0 in place, starting from ``h``, with the interface law ``law``
     (:data:`kernels.interface.Interface`) and a rigid machine: :func:`newton_machine` with
     compliance 0. Returns True on convergence."""
-    return newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, 0.0,
-                          np.zeros(h.size), np.inf)
+    return newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats,
+                          Machine(0.0, np.zeros(h.size), np.inf))
 
 
 @njit(cache=True)
-def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, compliance, wP, tail):
+def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, machine):
     """Solve F(h) = 0 in place from ``h`` with the interface law ``law``
-    (:data:`kernels.interface.Interface`) and a machine of compliance ``compliance`` (1/K;
-    0 rigid), load weights ``wP`` and the mesh's ``tail`` (:data:`MeshArrays`; the load
-    :func:`load`) (:func:`machine_residual`, :func:`machine_direction`).
+    (:data:`kernels.interface.Interface`) and the :data:`Machine` ``machine``: its compliance
+    (1/K; 0 rigid), the load's weights and the mesh's tail (:func:`load`)
+    (:func:`machine_residual`, :func:`machine_direction`).
     True on convergence; False past the cache's deadline (read before every iteration,
     :func:`kernels.jacobian.set_deadline`). The cache's factorization is reused, its crack-tip
     zone kept exact (:func:`kernels.jacobian.newton_direction`); it is rebuilt when the crack
@@ -521,7 +527,7 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
     N = h.size
     sig, d, dr, w = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
     F, Ft, ht = np.empty(N), np.empty(N), np.empty(N)
-    norm = machine_residual(h, g, A, ceff, H, law, compliance, wP, tail, sig, w, F)
+    norm = machine_residual(h, g, A, ceff, H, law, machine, sig, w, F)
     stats[STAT_RESIDUALS] += 1
     if norm <= tol:
         return True
@@ -536,8 +542,8 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
         if state[STATE_EXACT] == 1 and not fresh:
             _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_RETRY)
             fresh = True
-        dh, ok, refactorized = _direction(h, F, A, ceff, law, compliance, wP, sig, d, dr,
-                                          cache, stats)
+        dh, ok, refactorized = _direction(h, F, A, ceff, law, machine, sig, d, dr, cache,
+                                          stats)
         fresh = fresh or refactorized
         if not ok:       # singular even on a fresh factorization: give up
             return False
@@ -554,7 +560,7 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
         for _ls in range(LINE_SEARCH_STEPS):
             for i in range(N):
                 ht[i] = h[i] + lam * dh[i]
-            nt = machine_residual(ht, g, A, ceff, H, law, compliance, wP, tail, sig, w, Ft)
+            nt = machine_residual(ht, g, A, ceff, H, law, machine, sig, w, Ft)
             stats[STAT_RESIDUALS] += 1
             nt2 = _norm2(Ft)
             if nt2 < (1.0 - ARMIJO * lam) * n2:
@@ -583,12 +589,12 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
 @njit(cache=True, inline='always')
 def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
     """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success."""
-    return relax_machine(h, g, A, ceff, H, law, 0.0, np.zeros(h.size), np.inf, tol, max_iter,
-                         stats, np.inf)
+    return relax_machine(h, g, A, ceff, H, law, Machine(0.0, np.zeros(h.size), np.inf), tol,
+                         max_iter, stats, np.inf)
 
 
 @njit(cache=True, inline='always')
-def relax_machine(h, g, A, ceff, H, law, compliance, wP, tail, tol, max_iter, stats, deadline):
+def relax_machine(h, g, A, ceff, H, law, machine, tol, max_iter, stats, deadline):
     """Pseudo-transient continuation to a *stable* equilibrium, in place; True on success.
 
     Integrates the relaxation dh/dtau = -F(h) with linearly implicit Euler steps,
@@ -598,10 +604,11 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tail, tol, max_iter, st
     stable equilibria. Used where the discrete equilibrium path folds (the crack tip
     snapping from one node to the next), as the physical system would. One dense
     factorization per iteration: a fallback, not the main path. A compliant machine
-    (``compliance`` = 1/K, load weights ``wP``, the mesh's ``tail``) adds -compliance 2 pi
-    wP_j sigma'_j to every row of J (:func:`machine_residual`; the tail's derivative left out,
-    as in :func:`machine_direction`). False once ``deadline`` (the kernels' clock,
-    :mod:`kernels.clock`; inf: none) has passed, read before every iteration.
+    (:data:`Machine` ``machine``: compliance = 1/K, the load's weights wP and the mesh's
+    tail) adds -compliance 2 pi wP_j sigma'_j to every row of J (:func:`machine_residual`;
+    the tail's derivative left out, as in :func:`machine_direction`). False once
+    ``deadline`` (the kernels' clock, :mod:`kernels.clock`; inf: none) has passed, read before
+    every iteration.
     """
     N = h.size
     sig = np.empty(N)
@@ -610,7 +617,7 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tail, tol, max_iter, st
     F = np.empty(N)
     Ft = np.empty(N)
     ht = np.empty(N)
-    norm = machine_residual(h, g, A, ceff, H, law, compliance, wP, tail, sig, w, F)
+    norm = machine_residual(h, g, A, ceff, H, law, machine, sig, w, F)
     n2 = _norm2(F)
     dtau = RELAX_DTAU_START
     J = np.empty((N, N))
@@ -629,9 +636,9 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tail, tol, max_iter, st
             for j in range(N):
                 J[i, j] = -ceff * A[i, j] * d[j]
             J[i, i] += 1.0 + 1.0 / dtau
-        if compliance != 0.0:
+        if machine.compliance != 0.0:
             for j in range(N):
-                spring = compliance * 2.0 * np.pi * wP[j] * d[j]
+                spring = machine.compliance * 2.0 * np.pi * machine.wP[j] * d[j]
                 for i in range(N):
                     J[i, j] -= spring
         # LAPACK's LU through kernels.blas (np.linalg.solve: 5 s of a cold compile)
@@ -643,7 +650,7 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tail, tol, max_iter, st
         lam = positive_step(h, dh)
         for i in range(N):
             ht[i] = h[i] + lam * dh[i]
-        nt = machine_residual(ht, g, A, ceff, H, law, compliance, wP, tail, sig, w, Ft)
+        nt = machine_residual(ht, g, A, ceff, H, law, machine, sig, w, Ft)
         nt2 = _norm2(Ft)
         if not np.isfinite(nt2) or nt2 > RELAX_DIVERGENCE * n2:
             dtau *= RELAX_DTAU_CUT
@@ -683,7 +690,7 @@ def snap(mesh, physics, work, ceff, tol, max_iter, hm, cache, stats):
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
         if newton_machine(hp, work.g, mesh.A, ceff, work.H,
                           Interface(physics.h0, physics.c, work.ref, work.zone), tol, max_iter,
-                          cache, stats, physics.compliance, mesh.wP, mesh.tail):
+                          cache, stats, Machine(physics.compliance, mesh.wP, mesh.tail)):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
@@ -1059,7 +1066,7 @@ def settle_tip(h, g, A, ceff, H, law, lo, hi, iters, wall=0.0):
 
 
 @njit(cache=True)
-def zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, compliance, wP, tail):
+def zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, machine):
     """A process zone's first step by continuation in the zone's strength (ZONE_RAMP_START,
     ZONE_RAMP_FACTOR, ZONE_RAMP_SOLVES): Newton at the opening rate's scale
     ``work.zone[ZONE_RATE]`` times s, s rising from ZONE_RAMP_START to 1, each solve from the
@@ -1075,7 +1082,7 @@ def zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, compliance, w
         _copy(good, hp)
         cache[CACHE_STATE][STATE_VALID] = 0
         if newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
-                          compliance, wP, tail):
+                          machine):
             if s == 1.0:
                 ok = True
                 break
@@ -1109,12 +1116,11 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     max_iter = control.max_iter
     if not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0:
         max_iter *= FIRST_ZONE_ITER
-    compliance, wP, tail = physics.compliance, mesh.wP, mesh.tail
+    machine = Machine(physics.compliance, mesh.wP, mesh.tail)
     if run[RUN_ZONE_RAMP] == 1.0 and not run[RUN_DT_PREV] > 0.0:
         run[RUN_ZONE_RAMP] = 2.0
         stats[STAT_FAILED_SOLVES] += 1
-        if zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, compliance, wP,
-                     tail):
+        if zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, machine):
             cache[CACHE_STATE][STATE_EXACT] = 0
             return SOLVED
         return FAILED
@@ -1123,14 +1129,14 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
         settle_tip(hp, work.g, A, ceff, work.H, law, max(tip - ZONE_SETTLE_NODES, 0),
                    min(tip + ZONE_SETTLE_NODES, hp.size), ZONE_SETTLE_ITER)
     ok = newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
-                        compliance, wP, tail)
+                        machine)
     if not ok and cubic:
         # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
         # cubic start can overshoot: again from the quadratic one before the step halves
         stats[STAT_FAILED_SOLVES] += 1
         _copy(work.h_pred, hp)
         ok = newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
-                            compliance, wP, tail)
+                            machine)
     if ok:
         return SOLVED
     stats[STAT_FAILED_SOLVES] += 1
@@ -1148,7 +1154,7 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     if snap(mesh, physics, work, ceff, tol, control.max_iter, hm, cache, stats):
         return SNAPPED
     _copy(work.h, hp)
-    if relax_machine(hp, work.g, A, ceff, work.H, law, compliance, wP, tail, tol, RELAX_MAX_ITER,
+    if relax_machine(hp, work.g, A, ceff, work.H, law, machine, tol, RELAX_MAX_ITER,
                      stats, cache[CACHE_DEADLINE][0]):
         return SNAPPED
     if (not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0

@@ -617,8 +617,9 @@ class Numerics:
         it. 0 skips the estimate and its second solve (then ``error_estimate`` is NaN).
     domain : float or None
         Mesh radius in a_ref units. ``None`` (default) chooses it from the scene: large
-        enough that the gap at the mesh edge is ``tail_gap`` h0 at the start of unloading,
-        so the truncated Lennard-Jones tail is negligible (see ``tail_gap``).
+        enough that the gap at the mesh edge is ``tail_gap`` h0 at the start of unloading;
+        the Lennard-Jones attraction beyond the edge is added to the load in closed form
+        (the gap continued rigidly: :func:`sweep.kernels.interface.tail_load`).
     tail_gap : float
         Gap at the mesh edge, in units of h0, used by the automatic domain (>= 10).
     step : float

@@ -31,7 +31,8 @@ def unload_exact(pb, h_init, delta0, material, min_travel, out, stats):
     min_travel : crack-tip recession after the load minimum required to stop (a_ref).
     out : the five record arrays (t, delta, P, a, a_inner); ``stats`` the solver counters.
     """
-    A, r, wP, tail, scene, numerics = pb.A, pb.mesh.r, pb.wP, pb.tail, pb.scene, pb.numerics
+    A, r, wP, tail = pb.A, pb.mesh.r, pb.wP, pb.tail
+    scene, numerics = pb.scene, pb.numerics
     h0, c, hm, stop_mode = pb.h0, pb.c, pb.hm, pb.stop_mode
     t_out, d_out, P_out, a_out, ai_out = out
     N = h_init.size

@@ -233,7 +233,7 @@ class _March:
         self._settle(h, g, ceff, H)
         self._ahead(h, ceff)
         tols = np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * force])
-        ok, shift = newton_at_load(h, g, pb.A, pb.wP, pb.tail, ceff, H, self.law, force, tols,
+        ok, shift = newton_at_load(h, g, pb.mesh_arrays(), ceff, H, self.law, force, tols,
                                    MAX_ITER, self.cache, self.stats)
         if not ok:
             invalidate(self.cache)
