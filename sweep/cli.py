@@ -426,6 +426,11 @@ def scene_text(res, preset: str) -> list[str]:
     initial = _finite(a0=res.a0_result, a0_inner=res.a0_inner, delta0=res.delta0_result)
     if initial:
         lines.append(f"initial    {initial}")
+    unresolved = (not res.ok and res.reason.startswith("unresolved")
+                  and math.isfinite(res.pull_off))
+    if unresolved:      # the finest value reached, marked (it had been in the reason only)
+        lines.append(f"pull-off   P={res.pull_off:.6g} (pi dg R), unresolved: "
+                     f"error_estimate={res.error_estimate:.3g} > pull_off_rtol")
     if res.ok:
         lines.append(f"pull-off   P={res.pull_off:.6g} (pi dg R)  " + _finite(
             a=res.a_pulloff, a_inner=res.a_inner_pulloff, delta=res.delta_pulloff,
@@ -480,9 +485,11 @@ def _scene_si(axes, as_json, values, numerics):
                    f"rate={out['rate']:.4g} l0={out['l0_m']:.4g} m a_ref={out['a_ref_m']:.4g} m")
         click.echo(f"model      {out['model']}  status {out['status']}"
                    f"{' (' + out['reason'] + ')' if out['reason'] else ''}")
-        if out["status"] == "ok":
+        if out["status"] == "ok" or (str(out["reason"]).startswith("unresolved")
+                                     and out.get("pull_off_N") is not None):
+            mark = "" if out["status"] == "ok" else ", unresolved"
             click.echo(f"pull-off   {out['pull_off_N']:.6g} N = {out['pull_off']:.6g} pi dg R "
-                       f"(relaxed JKR {out['jkr_pull_off_N']:.6g} N)")
+                       f"(relaxed JKR {out['jkr_pull_off_N']:.6g} N){mark}")
             if out["crack_speed_m_s"] is not None:
                 click.echo(f"crack      v={out['crack_speed_m_s']:.6g} m/s  vhat={out['vhat']:.6g}")
     if out["status"] != "ok":

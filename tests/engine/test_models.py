@@ -297,3 +297,23 @@ def test_a_cheaper_models_row_below_its_measured_range_says_its_error_is_unknown
                                 Numerics.preset("balanced"))
     assert res.ok and math.isnan(res.error_estimate)
     assert "error is not measured below mu = 2 (error_estimate NaN)" in res.reason
+
+
+def test_auto_answers_a_negligible_zone_on_an_elastic_bulk_as_the_plain_scene():
+    """pz_v0 = 1e20 on k = 1 had sent "auto" to the hereditary BEM, unresolved at balanced
+    (estimate 0.0103) where the plain scene is ok on the elastic branch: the branch answers,
+    its estimate carries the zone's term, the row keeps the zone's scene (its id); a zone
+    that counts still runs the zone's models."""
+    from sweep.engine.crack_front import NEGLIGIBLE_PROCESS_ZONE
+
+    kw = dict(n=0.5, k=1.0, mu=3.24, a0=3.0, rate=10.0, model="auto")
+    plain = models.simulate(Scene(**kw))
+    zone = Scene(**kw, pz_law="gent-schultz", pz_v0=1e20, pz_xi=0.5)
+    res = models.simulate(zone)
+    assert plain.ok and res.ok and res.model_used == "elastic"
+    assert res.pull_off == plain.pull_off and res.scene_id == models.simulate(zone).scene_id
+    assert res.scene == zone and res.scene_id != plain.scene_id
+    term = res.error_estimate - plain.error_estimate
+    assert 0 < term <= NEGLIGIBLE_PROCESS_ZONE and "negligible" in res.reason
+    strong = models.simulate(Scene(**kw, pz_law="gent-schultz", pz_v0=1e3, pz_xi=0.5))
+    assert strong.model_used != "elastic" and strong.pull_off > 1.01 * plain.pull_off
