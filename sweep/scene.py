@@ -933,8 +933,10 @@ class Result:
         1, the elastic branch's sqrt 2 - 1); NaN without a protocol or an estimate. Not part
         of ``error_estimate``, which is the pull-off's, nor of the row's status.
     trajectory : dict of arrays
-        ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0); with
-        a protocol also ``phase`` (0 approach, 1 dwell, 2 retraction).
+        ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0; the
+        elastic branch's per scanned radius, fewer than its ``steps``, which count every
+        equilibrium solve); with a protocol also ``phase`` (0 approach, 1 dwell, 2
+        retraction).
     """
 
     scene: Scene
