@@ -572,10 +572,12 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
 
 
 @njit(cache=True, inline='always')
-def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
-    """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success."""
+def relax(h, g, A, ceff, H, law, tol, max_iter, stats, deadline):
+    """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success.
+    ``deadline``: the kernels' clock time past which it gives up (a Jacobian cache's
+    ``cache[CACHE_DEADLINE][0]``; inf: none)."""
     return relax_machine(h, g, A, ceff, H, law, 0.0, np.zeros(h.size), tol, max_iter, stats,
-                         np.inf)
+                         deadline)
 
 
 @njit(cache=True, inline='always')
