@@ -408,8 +408,8 @@ def _fallback(scene, failed: Result, model: str) -> Choice | None:
     fixed-grip limit it refuses, for that physical reason); None where it cannot answer
     either (mu below its measurement)."""
     if (is_physical_refusal(failed.reason) or math.isnan(measured_error("crack", scene.mu))
-            or scene.protocol() is not None):
-        return None
+            or scene.protocol() is not None or scene.machine_stiffness is not None):
+        return None             # (the crack-front model refuses protocols and machines)
     return Choice("crack", f"auto: crack-front model: the {NAMES[model]} failed "
                            f"({shortened(failed.reason, 160)})")
 
@@ -533,8 +533,12 @@ def simulate_model(scene, model: str = "bem", numerics=None):
     "crack" or "pb" row's ``error_estimate`` is the model's :func:`measured_error`."""
     check_choice("model", model, (*MODELS, "auto"))
     numerics = Numerics.preset("balanced") if numerics is None else numerics
+    t0 = time.perf_counter()
     with budget.scene_budget(numerics.time_budget_s):
-        return _simulate_model(scene, model, numerics)
+        res = _simulate_model(scene, model, numerics)
+    if model == "auto":     # every model auto ran (a fallback's row had counted its own only)
+        res.wall_s = time.perf_counter() - t0
+    return res
 
 
 def _negligible_zone(scene, numerics) -> Result | None:

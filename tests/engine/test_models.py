@@ -317,3 +317,23 @@ def test_auto_answers_a_negligible_zone_on_an_elastic_bulk_as_the_plain_scene():
     assert 0 < term <= NEGLIGIBLE_PROCESS_ZONE and "negligible" in res.reason
     strong = models.simulate(Scene(**kw, pz_law="gent-schultz", pz_v0=1e3, pz_xi=0.5))
     assert strong.model_used != "elastic" and strong.pull_off > 1.01 * plain.pull_off
+
+
+def test_auto_keeps_the_bem_row_of_a_compliant_machine_and_counts_every_model_s_wall():
+    """A compliant machine's BEM failure had been replaced by the crack-front model's refusal
+    (which told the user to use auto) with wall_s 0; a fallback's row counted only the
+    crack-front model's time (0.09 s of a 1.31 s scene; 0.01 s of 0.18 s here): the BEM row
+    stays with its advice,
+    and an auto row's wall_s is the whole scene's."""
+    import time
+
+    machine = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0, machine_stiffness=1e-6,
+                    model="auto")
+    res = models.simulate(machine, Numerics.preset("fast", max_steps=200))
+    assert res.model_used == "bem" and res.reason.startswith("step limit"), res.reason
+    scene = Scene(n=0.8, k=0.1, mu=3.24, a0=50.0, rate=1e-4, model="auto")
+    t0 = time.perf_counter()
+    res = models.simulate(scene, Numerics.preset("fast", max_steps=500))
+    wall = time.perf_counter() - t0
+    assert res.model_used == "crack" and "the BEM failed (too many steps" in res.model_reason
+    assert 0.95 * wall <= res.wall_s <= wall
