@@ -320,7 +320,7 @@ def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, a_start=None,
         end of the scanned span.
     """
     t0 = time.perf_counter()
-    mu = check_range("mu", mu, lo=0.01, hi=100.0)
+    mu = check_range("mu", mu, lo=ELASTIC_MU_RANGE[0], hi=ELASTIC_MU_RANGE[1])
     a_g = pull_off_radius_guess(mu)
     a_lo, a_hi = span[0] * a_g, span[1] * a_g
     br = ElasticBranch(mu, a_g, a_lo, **mesh)
@@ -437,6 +437,12 @@ def simulate_elastic(scene, numerics=None):
     res = Result(scene=scene, numerics=numerics)
     if scene.k != 1.0:
         res.reason = f"the quasi-static elastic solver needs k = 1 (got k = {scene.k})"
+        return res
+    lo, hi = ELASTIC_MU_RANGE
+    if not lo <= scene.mu <= hi:
+        res.reason = (f"mu = {scene.mu:g} is beyond the elastic branch's range [{lo:g}, "
+                      f"{hi:g}]: the crack-front model (model crack or auto), the mu -> "
+                      f"infinity limit, answers it")
         return res
     if scene.stop != "pulloff":
         res.reason = ("the quasi-static elastic branch ends at its displacement-controlled "
@@ -695,5 +701,7 @@ def _estimate_error(res, a_start: float) -> None:
                       f"{res.error_estimate:.2g} > pull_off_rtol = {tol:g}")
 
 
+#: the Tabor parameters of the branch (:func:`elastic_pull_off`)
+ELASTIC_MU_RANGE = (0.01, 100.0)
 #: resolution ratio of the elastic branch's error check (:func:`_estimate_error`)
 ELASTIC_CHECK_FACTOR = math.sqrt(2.0)

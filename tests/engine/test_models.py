@@ -337,3 +337,18 @@ def test_auto_keeps_the_bem_row_of_a_compliant_machine_and_counts_every_model_s_
     wall = time.perf_counter() - t0
     assert res.model_used == "crack" and "the BEM failed (too many steps" in res.model_reason
     assert 0.95 * wall <= res.wall_s <= wall
+
+
+def test_out_of_range_refusals_name_the_limit_not_an_exception():
+    """A crack-front scene below its fixed-grip indentation and an elastic-branch scene beyond
+    its Tabor range had failed with the text of an InputError ("delta0 must be >= -0.75",
+    "mu must be in [0.01, 100]"): the first is a physical refusal, the second names the
+    model that answers it."""
+    from sweep.errors import is_physical_refusal
+
+    crack = models.simulate(Scene(n=0.8, k=0.1, mu=2.9e5, delta0=-5.0, rate=1.0, model="auto"))
+    assert crack.status == "failed" and is_physical_refusal(crack.reason), crack.reason
+    elastic = models.simulate(Scene(n=0.8, k=1.0, mu=21120.0, a0=3.0, rate=1.0,
+                                    model="elastic"))
+    assert elastic.reason.startswith("mu = 21120 is beyond the elastic branch's range")
+    assert "model crack or auto" in elastic.reason
