@@ -52,10 +52,11 @@ from ..kernels.interface import TIP_GAP, lj_traction_and_stiffness
 from .. import units
 from ..errors import check_range
 from ..scene import Numerics, Result
+from . import budget
 from ..theory import jkr_contact_radius, jkr_indentation, maugis_dugdale_pull_off, maugis_lambda
 from .initial import jkr_gap_guess
 from .postprocess import cycle_work
-from .resolution import hysteresis_error
+from .resolution import hysteresis_error, unresolved
 from .problem import derive
 
 #: the branch mesh's defaults: uniform elements of l0 / ZONE_RESOLUTION at the tip, growing to
@@ -430,7 +431,43 @@ def simulate_elastic(scene, numerics=None):
     (:func:`_protocol_start`): an elastic bulk has no memory, so the approach follows the
     branch from first contact up to the preload, the dwell (held at force or at depth) changes
     nothing, and the retraction is the branch's unloading from the preload's radius.
+
+    The branch's resolution follows the numerics: the tip zone's spacing l0 /
+    (``ZONE_RESOLUTION`` s) and the coarse spacing ``COARSE`` / s, s = ``band_resolution`` /
+    ``ZONE_RESOLUTION`` and at least 1 (1 at the fast and balanced presets); where the estimate exceeds
+    ``pull_off_rtol`` and ``numerics.refinements`` allows, it solves again with s times f =
+    1.2 sqrt(estimate / tolerance), f in [sqrt 2, 2] (``refinements``,
+    ``band_resolution_used`` record it), within the scene's time budget.
     """
+    if numerics is None:
+        numerics = Numerics.preset("balanced")
+    t0 = time.perf_counter()
+    # never coarser than the default (at fast's 9 spacings per l0 the error grew 14-fold, to
+    # 8e-4 at mu 3.24, and the estimate to 1.9e-2: the branch costs a fraction of a second)
+    scale = max(numerics.band_resolution / ZONE_RESOLUTION, 1.0)
+    res = _simulate_elastic(scene, numerics, scale)
+    done = 0
+    while (done < numerics.refinements and unresolved(res) and budget.remaining() > 0
+           and math.isfinite(res.error_estimate)):
+        f = min(max(1.2 * math.sqrt(res.error_estimate / numerics.pull_off_rtol),
+                    math.sqrt(2.0)), 2.0)
+        if res.nodes_used * f > numerics.max_nodes:       # its dense solves: N^3
+            res.reason += (f"; not refined further: the branch would need about "
+                           f"{int(res.nodes_used * f)} nodes, above max_nodes = "
+                           f"{numerics.max_nodes}")
+            break
+        scale *= f
+        done += 1
+        res = _simulate_elastic(scene, numerics, scale)
+    res.refinements = done
+    res.band_resolution_used = ZONE_RESOLUTION * scale
+    res.wall_s = time.perf_counter() - t0
+    return res
+
+
+def _simulate_elastic(scene, numerics, scale: float):
+    """:func:`simulate_elastic` at the resolution ``scale`` times the branch's default."""
+    mesh = {"zone_resolution": ZONE_RESOLUTION * scale, "coarse": COARSE / scale}
     if numerics is None:
         numerics = Numerics.preset("balanced")
     t0 = time.perf_counter()
@@ -452,7 +489,7 @@ def simulate_elastic(scene, numerics=None):
     protocol = scene.protocol()
     if protocol is not None:
         try:
-            a_start, approach = _protocol_start(scene, protocol)
+            a_start, approach = _protocol_start(scene, protocol, mesh)
         except RuntimeError as err:
             res.reason = f"protocol: {err}"
             res.wall_s = time.perf_counter() - t0
@@ -462,7 +499,7 @@ def simulate_elastic(scene, numerics=None):
         return res
     else:
         a_start, approach = scene.a0, None
-    po = elastic_pull_off(scene.mu, a_start=a_start)
+    po = elastic_pull_off(scene.mu, a_start=a_start, **mesh)
     res.nodes_used, res.steps = po.nodes, po.solves
     res.newton_iterations = res.factorizations = po.newton_iterations
     if approach is not None:
@@ -510,7 +547,7 @@ def simulate_elastic(scene, numerics=None):
                       "a_inner": np.full(a_tr.size, np.nan)}
     if approach is not None:
         _join_protocol(res, approach)
-    _estimate_error(res, a_start)
+    _estimate_error(res, a_start, mesh)
     res.wall_s = time.perf_counter() - t0
     return res
 
@@ -525,7 +562,7 @@ APPROACH_RECORDS = 24
 TAIL_RECORDS = 64
 
 
-def _protocol_start(scene, protocol):
+def _protocol_start(scene, protocol, mesh: dict):
     """(the preload's radius, the approach's records) of an elastic scene with a test protocol,
     on the branch's mesh of :func:`elastic_pull_off` (so that the retraction starts from the same
     state). The approach starts where the BEM's does (:func:`sweep.engine.protocol.first_contact`:
@@ -536,7 +573,7 @@ def _protocol_start(scene, protocol):
     fails or the branch is not stable (the indentation not growing with the radius)."""
     mu = scene.mu
     a_g = pull_off_radius_guess(mu)
-    br = _branch(mu)
+    br = _branch(mu, **mesh)
     a_first = _first_contact(br, mu)
     a_pre = float(jkr_contact_radius(load=protocol.preload))
     a_end = _branch_root(br, lambda a, h, d: br.load(a, h), protocol.preload, a_pre, a_g)
@@ -670,7 +707,7 @@ def _join_protocol(res, approach) -> None:
     res.hysteresis_energy = cycle_work(joined)
 
 
-def _estimate_error(res, a_start: float) -> None:
+def _estimate_error(res, a_start: float, mesh: dict) -> None:
     """The error estimate of an ok elastic result, in place: the pull-off change on the
     branch's mesh at 1/f of the resolution (f times the tip-zone and the coarse spacing)
     over f - 1, as the BEM's (:func:`sweep.engine.resolution.estimate_error`), with
@@ -681,8 +718,8 @@ def _estimate_error(res, a_start: float) -> None:
     if tol <= 0:
         return
     check = elastic_pull_off(res.scene.mu, a_start=a_start,
-                             zone_resolution=ZONE_RESOLUTION / ELASTIC_CHECK_FACTOR,
-                             coarse=COARSE * ELASTIC_CHECK_FACTOR)
+                             zone_resolution=mesh["zone_resolution"] / ELASTIC_CHECK_FACTOR,
+                             coarse=mesh["coarse"] * ELASTIC_CHECK_FACTOR)
     if not check.converged:
         res.reason = (f"{res.reason}; " if res.reason else "") + (
             f"no error estimate: the branch at half the resolution failed ({check.reason})")
@@ -690,8 +727,9 @@ def _estimate_error(res, a_start: float) -> None:
     change = abs(res.pull_off - check.pull_off) / res.pull_off
     res.error_estimate = change / (ELASTIC_CHECK_FACTOR - 1.0)
     if res.scene.protocol() is not None:
-        coarse = _branch(res.scene.mu, zone_resolution=ZONE_RESOLUTION / ELASTIC_CHECK_FACTOR,
-                         coarse=COARSE * ELASTIC_CHECK_FACTOR)
+        coarse = _branch(res.scene.mu,
+                         zone_resolution=mesh["zone_resolution"] / ELASTIC_CHECK_FACTOR,
+                         coarse=mesh["coarse"] * ELASTIC_CHECK_FACTOR)
         res.hysteresis_error = hysteresis_error(res, _cycle_work(coarse, res.scene.mu, check),
                                                 ELASTIC_CHECK_FACTOR - 1.0)
     if res.error_estimate > tol:
