@@ -200,7 +200,9 @@ def _protocols_section(thr, paper) -> list[str]:
                   + f" against the paper's {pt['prefactor']}. The paper states a_ref = "
                   "(pi R^2 dg0/E0*)^(1/3) (its eq. main) and our a0 uses it; that its Fig. "
                   "Threshold (b) was drawn in the unit without pi is inferred from this "
-                  "factor only.", ""]
+                  "factor only. Against it: the paper's own PDMS estimate converts a0t = 30.9 "
+                  "to 5.8 mm, which is 30.9 a_ref with pi (0.188 mm; without pi it would be "
+                  "4.0 mm), so the paper's PDMS text uses the unit with pi.", ""]
     return lines + [""]
 
 
@@ -272,9 +274,12 @@ def _vr_protocol_lines(vr, theory=None) -> list[str]:
         rates = sorted({r["rate"] for r in vr.get("local_slope") or ()})
         below = [r for r in rates if r < pr["rate_range"][0] * (1 - 1e-9)]
         if below:
+            def rate(r):
+                return f"{r:.3g}".replace("e+0", "e").replace("e+", "e")
+
             lines += ["", f"The project's headline fit takes every rate of its campaign "
-                      f"({rates[0]:.3g} to {rates[-1]:.3g}); the slowest "
-                      f"({', '.join(f'{r:.3g}' for r in below)}), which the paper's grid does "
+                      f"({rate(rates[0])} to {rate(rates[-1])}); the slowest "
+                      f"({', '.join(rate(r) for r in below)}), which the paper's grid does "
                       "not have, lift the prefactor."]
     ls = vr.get("local_slope")
     if ls:
@@ -417,9 +422,12 @@ def _pdms_section(root: Path) -> list[str]:
         f"| threshold radius for 1.5/k, our collapse fit [a_ref / mm] | {_g(res['a0t_hat'])} / "
         f"{_g(res['a0t_mm'], 3)} | 30.9 / 5.8 ({_g(pp.get('a0t_hat', math.nan))} / "
         f"{_g(pp.get('a0t_mm', math.nan), 3)}) |",
-        f"| unloading speed for the full amplification, our v-r fit [m/s] | "
-        f"{_g(res['speed_full_amplification_m_s'], 3)} | 31.4 "
-        f"({_g(pp.get('speed_full_amplification_m_s', math.nan), 3)}) |",
+        f"| unloading speed for the full amplification, our v-r fit read as the paper's "
+        f"text does, rhat = r tau0/l0 [m/s] | {_g(res['speed_full_amplification_m_s'], 3)}"
+        + (f" ({_g(res['speed_full_amplification_dref_m_s'], 3)} with this project's "
+           f"rhat = r tau0/d_ref, docs/design.md section 2)"
+           if res.get("speed_full_amplification_dref_m_s") is not None else "")
+        + f" | 31.4 ({_g(pp.get('speed_full_amplification_m_s', math.nan), 3)}) |",
         f"| same at the PDMS's own k (PB Gamma = 0.9/k at vhat = "
         f"{res['vhat_full_amplification_pdms_k']:.2g}) [m/s] | "
         f"{res['speed_full_amplification_pdms_k_m_s']:.2g} | -- |"]
