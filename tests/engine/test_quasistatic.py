@@ -240,3 +240,14 @@ def test_the_branch_follows_the_numerics_and_refines_on_request():
                       Numerics.for_tolerance(1e-4, max_nodes=1100))
     assert capped.status == "failed" and capped.reason.startswith("unresolved")
     assert "not refined further" in capped.reason and "max_nodes = 1100" in capped.reason
+
+
+def test_a_start_far_beyond_the_pull_off_radius_names_the_cause():
+    """At mu 100 from a0 >= 20 the branch's Newton fails (its mesh scales with the radius):
+    the reason had been "Newton did not converge" alone; it now says why and what answers."""
+    from sweep import simulate
+
+    res = simulate(Scene(n=0.8, k=1.0, mu=100.0, a0=20.0, rate=1.0, model="elastic"))
+    assert res.status == "failed" and res.reason.startswith("Newton did not converge")
+    assert "under-resolved" in res.reason and "model auto" in res.reason
+    assert simulate(Scene(n=0.8, k=1.0, mu=100.0, a0=15.0, rate=1.0, model="elastic")).ok
