@@ -587,10 +587,12 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, machine):
 
 
 @njit(cache=True, inline='always')
-def relax(h, g, A, ceff, H, law, tol, max_iter, stats):
-    """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success."""
+def relax(h, g, A, ceff, H, law, tol, max_iter, stats, deadline):
+    """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success.
+    ``deadline``: the kernels' clock time past which it gives up (a Jacobian cache's
+    ``cache[CACHE_DEADLINE][0]``; inf: none)."""
     return relax_machine(h, g, A, ceff, H, law, Machine(0.0, np.zeros(h.size), np.inf), tol,
-                         max_iter, stats, np.inf)
+                         max_iter, stats, deadline)
 
 
 @njit(cache=True, inline='always')

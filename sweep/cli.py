@@ -283,8 +283,11 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "a0_si", "indentatio
 @click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
+@click.option("--shares", is_flag=True,
+              help="With a process zone: also the bulk's and the process zone's shares of the "
+                   "pull-off amplification (two more rows: without the zone, relaxed).")
 def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, max_nodes,
-                  max_steps, time_budget_s, exact, as_json, trajectory, si, **values):
+                  max_steps, time_budget_s, exact, as_json, trajectory, shares, si, **values):
     """Simulate one scene and print pull-off force, contact radius and crack speed."""
     from .engine.models import simulate
 
@@ -312,6 +315,9 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, m
         raise InputError(f"{', '.join(meshless)}: model {axes['model']} has no mesh and no "
                          f"time steps (the BEM's and the elastic branch's options)")
     num = _scene_numerics(preset, pull_off_rtol, overrides)
+    if shares and (si or axes["pz_law"] in (None, "none")):
+        raise InputError("--shares: a dimensionless scene with a process zone (--pz-law "
+                         "gent-schultz, --pz-v0, --pz-xi)" + (", not --si" if si else ""))
     if si:
         _scene_si(axes, as_json, si_values, num)
         return
@@ -324,8 +330,15 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, m
         raise InputError(f"{', '.join(missing)} must be given (or use --si)")
     sc = scene_from_options(axes)
     res = simulate(sc, num)
+    split = None
+    if shares:
+        from .analysis.shares import process_zone_shares
+
+        split = process_zone_shares(sc, num, both=res)
     if as_json:
-        echo_json(res.to_dict(trajectory=trajectory))
+        echo_json({**res.to_dict(trajectory=trajectory),
+                   **({"shares": {k: v for k, v in split.items() if k != "both"}}
+                      if split else {})})
     else:
         if sc.protocol() is not None:
             start = (f"approach_rate={sc.approach_rate:g} preload={sc.preload:g} "
@@ -338,8 +351,22 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, m
                    f" material={sc.material} model={sc.model}{machine}")
         for line in scene_text(res, preset):
             click.echo(line)
+        if split:
+            click.echo(shares_text(split))
     if not res.ok:
         raise SystemExit(1)
+
+
+def shares_text(split: dict) -> str:
+    """``sweep scene --shares``'s line (:func:`sweep.analysis.shares.process_zone_shares`)."""
+    rows = ", ".join(f"{name} P={split[name]['pull_off']:.6g} ({split[name]['model']}, "
+                     f"{split[name]['status']})" for name in ("bulk", "relaxed"))
+    if not math.isfinite(split["bulk_share"]):
+        return f"shares     none: {split['note']} [{rows}]"
+    head = (f"shares     bulk {split['bulk_share']:.4g}, process zone "
+            f"{split['process_zone_share']:.4g} of ln(P/P_relaxed), amplification "
+            f"{split['amplification']:.6g}, share error {split['share_error']:.2g}")
+    return head + (f"; {split['note']}" if split["note"] else "") + f" [{rows}]"
 
 
 #: `sweep scene`'s numerics options that only a model with a mesh reads (bem, elastic)
@@ -426,6 +453,11 @@ def scene_text(res, preset: str) -> list[str]:
     initial = _finite(a0=res.a0_result, a0_inner=res.a0_inner, delta0=res.delta0_result)
     if initial:
         lines.append(f"initial    {initial}")
+    unresolved = (not res.ok and res.reason.startswith("unresolved")
+                  and math.isfinite(res.pull_off))
+    if unresolved:      # the finest value reached, marked (it had been in the reason only)
+        lines.append(f"pull-off   P={res.pull_off:.6g} (pi dg R), unresolved: "
+                     f"error_estimate={res.error_estimate:.3g} > pull_off_rtol")
     if res.ok:
         lines.append(f"pull-off   P={res.pull_off:.6g} (pi dg R)  " + _finite(
             a=res.a_pulloff, a_inner=res.a_inner_pulloff, delta=res.delta_pulloff,
@@ -480,9 +512,11 @@ def _scene_si(axes, as_json, values, numerics):
                    f"rate={out['rate']:.4g} l0={out['l0_m']:.4g} m a_ref={out['a_ref_m']:.4g} m")
         click.echo(f"model      {out['model']}  status {out['status']}"
                    f"{' (' + out['reason'] + ')' if out['reason'] else ''}")
-        if out["status"] == "ok":
+        if out["status"] == "ok" or (str(out["reason"]).startswith("unresolved")
+                                     and out.get("pull_off_N") is not None):
+            mark = "" if out["status"] == "ok" else ", unresolved"
             click.echo(f"pull-off   {out['pull_off_N']:.6g} N = {out['pull_off']:.6g} pi dg R "
-                       f"(relaxed JKR {out['jkr_pull_off_N']:.6g} N)")
+                       f"(relaxed JKR {out['jkr_pull_off_N']:.6g} N){mark}")
             if out["crack_speed_m_s"] is not None:
                 click.echo(f"crack      v={out['crack_speed_m_s']:.6g} m/s  vhat={out['vhat']:.6g}")
     if out["status"] != "ok":

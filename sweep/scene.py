@@ -18,8 +18,10 @@ import dataclasses
 import hashlib
 import json
 import math
+import os
 from dataclasses import dataclass, field
 from functools import lru_cache
+from types import MappingProxyType
 
 import numpy as np
 
@@ -218,10 +220,20 @@ class SceneTable:
         return mine
 
 
+def check_material_name(name: str) -> str:
+    """``name`` if it names a material (:data:`MATERIALS`); else InputError (one line, saying
+    how a Prony table is given: a plain string is never read as a file's path)."""
+    if name not in MATERIALS:
+        raise InputError(f"material must be {', '.join(MATERIALS)} or a Prony table: a file "
+                         "as {'prony': path} or a pathlib.Path, inline as {'tau': [...], "
+                         f"'E': [...], 'E0': ...}} (got {name!r})")
+    return name
+
+
 def scene_table(value, *, base_dir=None, nu=None) -> SceneTable:
     """The :class:`SceneTable` of a table: a :class:`SceneTable`, a
-    :class:`~sweep.materials.PronyTable`, or a mapping :func:`~sweep.materials.read_prony`
-    reads (``{"prony": path, ...}`` or inline ``{"tau": [...], "E": [...], "E0": ...}``),
+    :class:`~sweep.materials.PronyTable`, a file's path (path-like) or a mapping
+    :func:`~sweep.materials.read_prony` reads (``{"prony": path, ...}`` or inline ``{"tau": [...], "E": [...], "E0": ...}``),
     with an optional ``"tau0"`` key (the scene's time unit in the table's, s where the table
     states its units (it was converted to s), > 0, default 1).
 
@@ -236,7 +248,7 @@ def scene_table(value, *, base_dir=None, nu=None) -> SceneTable:
     if isinstance(value, dict) and "tau0" in value:
         value = dict(value)
         tau0 = check_range("tau0", value.pop("tau0"), 0.0, lo_open=True)
-    if isinstance(value, dict):
+    if isinstance(value, (dict, os.PathLike)):
         value = read_prony(value, base_dir=base_dir, nu=nu)
     if not isinstance(value, PronyTable):
         raise InputError(f"material must be {', '.join(MATERIALS)} or a Prony table "
@@ -295,8 +307,9 @@ class Scene:
     material : {"mpl", "sls"} or a Prony table
         "mpl": MPL retardation spectrum, Chat = 1 - (1-k) 2 t^(n/2) K_n(2 sqrt t)/Gamma(n);
         "sls": standard linear solid, Chat = 1 - (1-k) exp(-t);
-        a Prony table (a :class:`~sweep.materials.PronyTable`, anything
-        :func:`~sweep.materials.read_prony` reads, ``{"prony": path}`` or an inline
+        a Prony table (a :class:`~sweep.materials.PronyTable`, a file that
+        :func:`~sweep.materials.read_prony` reads given as ``{"prony": path}`` or a
+        :class:`pathlib.Path` (a plain string names "mpl" or "sls" only), or an inline
         ``{"tau": [...], "E": [...], "E0": ...}``, optionally with ``"tau0"``, the time unit
         of the scene in the table's time unit, s where the table states its units, default
         1), normalized on construction into a
@@ -408,7 +421,9 @@ class Scene:
         info = _axes_of(type(self))
         protocol = check_protocol(self.approach_rate, self.preload, self.dwell, self.dwell_hold)
         table = None
-        if not isinstance(self.material, str):
+        if isinstance(self.material, str):
+            check_material_name(self.material)
+        else:
             table = scene_table(self.material)
             object.__setattr__(self, "material", table)
             object.__setattr__(self, "k", table.fixed_k(self.k, info["k"].default))
@@ -547,7 +562,8 @@ SCENE_LIMITS = {a.name: a.limits for a in AXES.values() if a.limits}
 #: speeds within 3e-3 (docs/performance.md, issue 24 item 1). The larger indentation steps
 #: that are cheaper on the tradeoff's three scenes (balanced 0.2 h0, fast 0.5 h0) are
 #: refused on scenes beyond them (``tradeoff.REFUSED_BEYOND_THE_SCENES``, session 25).
-PRESETS = {
+#: (read-only: a preset is changed by overrides, ``Numerics.preset("fast", step=0.5)``)
+PRESETS = MappingProxyType({name: MappingProxyType(values) for name, values in {
     "fast": dict(mesh="graded", band_resolution=9.0, grading=1.1, step=0.25, da_max=1.0,
                  prony_rtol=1e-3, tol=1e-6, pull_off_rtol=0.03, max_nodes=400),
     "balanced": dict(mesh="graded", band_resolution=16.0, grading=1.1, step=0.1, da_max=1.0,
@@ -555,7 +571,7 @@ PRESETS = {
                      max_nodes=1000),
     "accurate": dict(mesh="graded", band_resolution=36.0, grading=1.05, step=0.2, da_max=0.6,
                      prony_rtol=1e-6, tol=1e-7, pull_off_rtol=0.003, max_nodes=2500),
-}
+}.items()})
 
 
 #: the most refinements a scene may ask for
@@ -839,9 +855,14 @@ def scene_id(scene: Scene, numerics: Numerics) -> str:
     return hashlib.sha1(text.encode()).hexdigest()[:16]
 
 
-@dataclass
+@dataclass(eq=False)
 class Result:
     """Outcome of one scene. Scalars are NaN when a run failed before reaching them.
+
+    Results compare by identity (``==`` is ``is``): two runs of one scene differ in
+    ``wall_s``, NaN never equals NaN and the trajectory holds arrays. To compare two runs'
+    numbers, compare :meth:`scalars` (NaN-aware, e.g. with ``numpy.testing``) or
+    :meth:`to_row` less ``wall_s``.
 
     Attributes
     ----------
@@ -850,7 +871,9 @@ class Result:
         "error": an internal error (a bug, e.g. a TypeError) that ``sweep run`` caught and
         logged with its traceback in ``<out>.errors.log``.
     reason : str
-        Empty when ``ok``; otherwise why the run failed (Newton failure, step limit, ...).
+        Why the run failed (Newton failure, step limit, ...); on an ``ok`` row empty or a
+        note on how it was reached (e.g. "tip-following mesh: 20 meshes of at most 324
+        nodes"): select good rows by ``status``, never by an empty reason.
     pull_off : float
         |min P| over the unloading, in units of pi dg R.
     a_pulloff, a_inner_pulloff : float
@@ -911,8 +934,10 @@ class Result:
         1, the elastic branch's sqrt 2 - 1); NaN without a protocol or an estimate. Not part
         of ``error_estimate``, which is the pull-off's, nor of the row's status.
     trajectory : dict of arrays
-        ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0); with
-        a protocol also ``phase`` (0 approach, 1 dwell, 2 retraction).
+        ``t``, ``delta``, ``P``, ``a``, ``a_inner`` per accepted step (including t = 0; the
+        elastic branch's per scanned radius, fewer than its ``steps``, which count every
+        equilibrium solve); with a protocol also ``phase`` (0 approach, 1 dwell, 2
+        retraction).
     """
 
     scene: Scene

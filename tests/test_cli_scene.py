@@ -233,3 +233,17 @@ def test_scene_refuses_mesh_options_for_a_model_without_a_mesh(capsys):
         "the elastic branch's options)")
     assert main(base + ["--model", "pb", "--band-resolution", "20"]) == 2
     assert main(base + ["--model", "crack", "--time-budget", "30", "--json"]) == 0
+
+
+def test_an_unresolved_row_prints_its_pull_off_marked(capsys):
+    """A failed, unresolved row's finest pull-off had been only inside the reason's text (and
+    in --json): the text output prints it on the pull-off line, marked unresolved."""
+    argv = ["scene", "--n", "0.5", "--k", "1", "--mu", "2", "--a0", "2", "--rate", "1",
+            "--pz-law", "gent-schultz", "--pz-v0", "1000", "--pz-xi", "0.5", "--model", "bem"]
+    assert main(argv + ["--json"]) == 1
+    row = json.loads(capsys.readouterr().out)
+    assert row["status"] == "failed" and row["reason"].startswith("unresolved")
+    assert main(argv) == 1
+    line = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("pull-off")]
+    assert line == [f"pull-off   P={row['pull_off']:.6g} (pi dg R), unresolved: "
+                    f"error_estimate={row['error_estimate']:.3g} > pull_off_rtol"]

@@ -38,3 +38,50 @@ def test_a_failed_result_prints_its_reason_shortened():
 def test_a_result_in_a_list_prints_short():
     res = _result(2000, status="ok", pull_off=2.0)
     assert len(repr([res, res])) < 2 * 200
+
+
+def test_results_compare_by_identity_and_presets_are_read_only():
+    """A Result's copy had compared unequal after pickling (NaN fields, ``wall_s``) and
+    raised after deepcopy (the trajectory's arrays): results compare by identity, their
+    numbers through ``scalars``. ``sweep.PRESETS["fast"]["step"] = 5`` had changed
+    ``Numerics.preset("fast")`` for the session."""
+    import copy
+    import pickle
+
+    import pytest
+
+    from sweep.scene import PRESETS
+
+    res = Result(scene=Scene(n=0.5, k=0.1, mu=3.0, a0=2.0, rate=1.0),
+                 numerics=Numerics.preset("fast"), status="ok", pull_off=2.0,
+                 trajectory={"t": np.arange(3.0), "P": np.ones(3)})
+    twin = copy.deepcopy(res)
+    assert res == res and res != twin                      # no ValueError from the arrays
+    back = pickle.loads(pickle.dumps(res))
+    np.testing.assert_equal(back.scalars(), res.scalars())  # NaN-aware, field by field
+    with pytest.raises(TypeError):
+        PRESETS["fast"]["step"] = 5.0
+    with pytest.raises(TypeError):
+        PRESETS["mine"] = {}
+    assert Numerics.preset("fast").step == 0.25
+    assert Numerics.preset("fast", step=0.5).step == 0.5
+
+
+def test_a_material_string_is_a_name_and_a_path_object_a_file(tmp_path):
+    """``Scene(material="df_prony.csv")`` had been refused with "must be one of mpl, sls"
+    only, though the docstring promised any input read_prony reads: a plain string names a
+    material, and the refusal says how a file is given; a pathlib.Path is read as a file."""
+    from pathlib import Path
+
+    import pytest
+
+    from sweep.errors import InputError
+
+    table = Path(__file__).parent / "data" / "prony" / "pdms_prony.csv"
+    kw = dict(n=0.5, k=0.1, mu=3.0, a0=2.0, rate=1.0)
+    with pytest.raises(InputError, match=r"material must be mpl, sls or a Prony table: a file "
+                                         r"as \{'prony': path\} or a pathlib.Path"):
+        Scene(material=str(table), **kw)
+    by_path = Scene(material=table, **kw)
+    by_dict = Scene(material={"prony": str(table)}, **kw)
+    assert by_path == by_dict and by_path.material.label == by_dict.material.label

@@ -66,7 +66,7 @@ def test_mpl_and_sls_scenes_keep_their_form():
     mpl/sls scenes are pinned by tests/test_scene_id.py)."""
     s = scene("sls", k=0.3)
     assert s.material == "sls" and s.table is None and s.to_dict()["material"] == "sls"
-    with pytest.raises(InputError, match="material must be one of mpl, sls"):
+    with pytest.raises(InputError, match="material must be mpl, sls or a Prony table: a file as"):
         scene("tests/data/prony/pdms_prony.csv")
 
 

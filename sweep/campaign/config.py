@@ -554,16 +554,26 @@ def config_from_dict(data, text: str | None = None, source: str = "<dict>") -> S
     elif output.endswith(("/", os.sep)):
         problems.append(f"output: must name a file, not a directory (got {output!r})")
 
-    if not problems and grids:
-        total = 0
-        for g in grids:
-            size = 1
-            for v in g.values():
-                size *= len(v)
-            total += size
-        if total > MAX_SCENES:
-            problems.append(f"grid: {total} scenes is more than the maximum {MAX_SCENES}; "
-                            f"split the campaign into several configs")
+    total = 0
+    for g in grids:
+        size = 1
+        for v in g.values():
+            size *= len(v)
+        total += size
+    if not problems and total > MAX_SCENES:
+        problems.append(f"grid: {total} scenes is more than the maximum {MAX_SCENES}; "
+                        f"split the campaign into several configs")
+    if problems and grids and total <= MAX_SCENES:
+        # the grid points' own checks (a protocol's keys together, two initial states, an
+        # SI grid's derived scenes), so that every problem is reported at once: they had
+        # come only after the others were fixed
+        try:
+            SweepConfig(name="check", grids=tuple(grids),
+                        numerics=numerics or Numerics.preset("balanced"), trajectories=False,
+                        output="", description="", text="", source=source,
+                        units=units).tasks()
+        except InputError as exc:
+            problems.append(str(exc))
 
     if problems:
         head = f"{source}: " if source else ""

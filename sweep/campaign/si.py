@@ -45,8 +45,9 @@ from ..engine.models import (MACHINE_REFUSALS, PROCESS_ZONE_REFUSALS, PROTOCOL_R
                              TABLE_REFUSALS, choose_model, pb_estimate, simulate_model)
 from ..errors import InputError, as_float, check_choice, check_positive, check_range
 from ..materials.prony_files import hash_rounded
-from ..scene import (AXES, DWELL_HOLDS, MATERIALS, PZ_LAWS, SCENE_LIMITS, Axis, Scene,
-                     SceneTable, check_process_zone, scene_table)
+from ..scene import (AXES, DWELL_HOLDS, PZ_LAWS, SCENE_LIMITS, Axis, Numerics,
+                     Scene, SceneTable, check_material_name, check_process_zone,
+                     scene_table)
 from ..theory import jkr_contact_radius, jkr_pull_off
 from ..units import PhysicalScale
 
@@ -133,7 +134,7 @@ class SIScene:
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
         set_("nu", check_range("nu", self.nu, 0.0, 0.5))
         if isinstance(self.material, str):
-            check_choice("material", self.material, MATERIALS)
+            check_material_name(self.material)
             missing = [f for f in TABLE_FIELDS if getattr(self, f) is None]
             if missing:
                 raise InputError(f"{', '.join(missing)}: required for material "
@@ -382,7 +383,7 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
         at any Tabor parameter; "auto" is :func:`sweep.engine.models.choose_model` within the Scene's
         ranges and "crack" beyond them (``model`` in the output says which ran).
     numerics : sweep.Numerics, optional
-        BEM discretization.
+        BEM discretization (default: the balanced preset); read by "bem" and "auto" only.
 
     Returns
     -------
@@ -394,6 +395,9 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
         ``hysteresis_error``) with ``mu``, ``l0_m``, ``jkr_pull_off_N``.
     """
     model = check_choice("model", model, SI_MODELS)
+    if numerics is not None and not isinstance(numerics, Numerics):
+        raise TypeError("numerics must be a sweep.Numerics (e.g. Numerics.preset('fast')), "
+                        f"got {type(numerics).__name__}")
     d = si.dimensionless()
     if model == "auto":
         lo, hi = SCENE_LIMITS["mu"]

@@ -495,7 +495,11 @@ def load_trajectory(path, scene_id: str) -> dict:
     """Trajectory arrays of one scene: ``t`` (tau0), ``delta`` (d_ref), ``P`` (pi dg R),
     ``a``, ``a_inner`` (a_ref), and with a test protocol ``phase`` (0 approach, 1 dwell, 2
     retraction; :attr:`sweep.Result.trajectory`). KeyError if the file keeps none or not
-    this scene's; FileNotFoundError if there is no file."""
+    this scene's; FileNotFoundError if there is no file; TypeError if ``scene_id`` is not a
+    string (the ``scene_id`` column of :func:`load`)."""
+    if not isinstance(scene_id, str):
+        raise TypeError(f"scene_id must be a string, the scene_id column of sweep.load "
+                        f"(got {scene_id!r})")
     path = Path(path)
     part = parts_dir(path) / "traj" / f"{scene_id}.h5"
     if part.exists():

@@ -123,6 +123,11 @@ NEARLY_ELASTIC = 0.05
 #: scene, the term added to its error estimate (the Gent-Schultz law alone stiffens as pz_v0
 #: grows: at pz_v0 = 1e25 a_ref/tau0 the integrator stalled until the time budget ended it)
 NEGLIGIBLE_PROCESS_ZONE = 1e-9
+#: the smallest Gent-Schultz exponent the crack-front model follows: below it the term
+#: (v/pz_v0)^pz_xi is nearly 1 at every speed (a step of Gamma at v = 0+) and the law's
+#: inverse, V(g) = pz_v0 (g - 1)^(1/pz_xi), overflows (pz_xi 3e-4 and below had failed with
+#: "integrator: OverflowError: math range error"; 1e-3 runs)
+PZ_XI_MIN = 1e-3
 #: how far below Gamma(0) (in step tolerances of the contact radius, carried to g by dg/da) an
 #: accepted state of :func:`unload` may lie before the run is failed: the exact solution stays
 #: at or above Gamma(0) once the edge moves. Measured with the odd continuation of V: at most
@@ -855,6 +860,18 @@ def simulate_crack(scene, numerics=None):
         res.reason = (f"no stable contact of radius a0 = {scene.a0:g}: below "
                       f"{FIXED_GRIP_A_MIN:g} a_ref a JKR contact is not stable under fixed grip "
                       f"(the crack-front model, the mu -> infinity limit, starts at or above it)")
+        return res
+    delta_min = float(jkr_indentation(FIXED_GRIP_A_MIN))       # -0.75
+    if scene.delta0 is not None and scene.delta0 < delta_min:
+        res.reason = (f"no stable contact at delta0 = {scene.delta0:g}: below {delta_min:g}, "
+                      f"the indentation of the JKR contact of radius {FIXED_GRIP_A_MIN:g} a_ref, "
+                      f"the smallest stable under fixed grip (the crack-front model, the mu -> "
+                      f"infinity limit)")
+        return res
+    if scene.pz_law != "none" and scene.pz_xi < PZ_XI_MIN:
+        res.reason = (f"pz_xi = {scene.pz_xi:g} is below {PZ_XI_MIN:g}, the smallest exponent "
+                      f"the crack-front model follows: the process zone's term (v/pz_v0)^pz_xi "
+                      f"is then a step of Gamma at v = 0+, whose inverse V(g) overflows")
         return res
     nearly_elastic = 1.0 / scene.k - 1.0 <= NEARLY_ELASTIC * (1.0 + 1e-12)
     if nearly_elastic:

@@ -44,7 +44,7 @@ import numpy as np
 from ..kernels.history import history_vector, step_coefficients, update_modes
 from ..kernels.interface import (ZONE_RATE, ZONE_SMOOTH, ZONE_XI, crossing_radius,
                                  lennard_jones, lj_traction, smoothing_rate, traction)
-from ..kernels.jacobian import set_deadline, use_drift_scaled
+from ..kernels.jacobian import CACHE_DEADLINE, set_deadline, use_drift_scaled
 from ..kernels.protocol import (CLOCK_A, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, CLOCK_DT_PREV2,
                                 CLOCK_GUESS, CLOCK_MADE, CLOCK_RING, CLOCK_SIZE, CLOCK_T,
                                 CLOCK_P, CLOCK_PHASE, CLOCK_TIP_SCORE, APPROACH_PASSED,
@@ -303,7 +303,8 @@ class _March:
         pb, tol = self.pb, self.pb.numerics.tol * self.pb.h0
         invalidate(self.cache)
         h = self.h.copy()
-        if relax(h, g, pb.A, ceff, H, self.law, tol, RELAX_ITER, self.stats):
+        if relax(h, g, pb.A, ceff, H, self.law, tol, RELAX_ITER, self.stats,
+                 self.cache[CACHE_DEADLINE][0]):        # the scene's budget (it had run on)
             return h, True
         return h, newton(h, g, pb.A, ceff, H, self.law, tol, MAX_ITER, self.cache, self.stats)
 
@@ -674,7 +675,8 @@ def first_contact(pb, stats):
         # pseudo-transient relaxation from it first, as across a fold (_March._jump)
         h = guess
         invalidate(cache)
-        ok = (relax(h, g, pb.A, k, np.zeros(N), law, tol, RELAX_ITER, stats)
+        ok = (relax(h, g, pb.A, k, np.zeros(N), law, tol, RELAX_ITER, stats,
+                    cache[CACHE_DEADLINE][0])
               or newton(h, g, pb.A, k, np.zeros(N), law, tol, MAX_ITER, cache, stats))
     if not ok:
         budget.check("the protocol's first contact")

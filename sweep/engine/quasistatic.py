@@ -52,10 +52,11 @@ from ..kernels.interface import TIP_GAP, lj_traction_and_stiffness, tail_load
 from .. import units
 from ..errors import check_range
 from ..scene import Numerics, Result
+from . import budget
 from ..theory import jkr_contact_radius, jkr_indentation, maugis_dugdale_pull_off, maugis_lambda
 from .initial import jkr_gap_guess
 from .postprocess import cycle_work
-from .resolution import hysteresis_error
+from .resolution import hysteresis_error, unresolved
 from .problem import derive
 
 #: the branch mesh's defaults: uniform elements of l0 / ZONE_RESOLUTION at the tip, growing to
@@ -319,7 +320,7 @@ def elastic_pull_off(mu, span=(0.35, 2.5), scan=14, xtol=1e-5, a_start=None,
         end of the scanned span.
     """
     t0 = time.perf_counter()
-    mu = check_range("mu", mu, lo=0.01, hi=100.0)
+    mu = check_range("mu", mu, lo=ELASTIC_MU_RANGE[0], hi=ELASTIC_MU_RANGE[1])
     a_g = pull_off_radius_guess(mu)
     a_lo, a_hi = span[0] * a_g, span[1] * a_g
     br = ElasticBranch(mu, a_g, a_lo, **mesh)
@@ -429,13 +430,55 @@ def simulate_elastic(scene, numerics=None):
     (:func:`_protocol_start`): an elastic bulk has no memory, so the approach follows the
     branch from first contact up to the preload, the dwell (held at force or at depth) changes
     nothing, and the retraction is the branch's unloading from the preload's radius.
+
+    The branch's resolution follows the numerics: the tip zone's spacing l0 /
+    (``ZONE_RESOLUTION`` s) and the coarse spacing ``COARSE`` / s, s = ``band_resolution`` /
+    ``ZONE_RESOLUTION`` and at least 1 (1 at the fast and balanced presets); where the estimate exceeds
+    ``pull_off_rtol`` and ``numerics.refinements`` allows, it solves again with s times f =
+    1.2 sqrt(estimate / tolerance), f in [sqrt 2, 2] (``refinements``,
+    ``band_resolution_used`` record it), within the scene's time budget.
     """
+    if numerics is None:
+        numerics = Numerics.preset("balanced")
+    t0 = time.perf_counter()
+    # never coarser than the default (at fast's 9 spacings per l0 the error grew 14-fold, to
+    # 8e-4 at mu 3.24, and the estimate to 1.9e-2: the branch costs a fraction of a second)
+    scale = max(numerics.band_resolution / ZONE_RESOLUTION, 1.0)
+    res = _simulate_elastic(scene, numerics, scale)
+    done = 0
+    while (done < numerics.refinements and unresolved(res) and budget.remaining() > 0
+           and math.isfinite(res.error_estimate)):
+        f = min(max(1.2 * math.sqrt(res.error_estimate / numerics.pull_off_rtol),
+                    math.sqrt(2.0)), 2.0)
+        if res.nodes_used * f > numerics.max_nodes:       # its dense solves: N^3
+            res.reason += (f"; not refined further: the branch would need about "
+                           f"{int(res.nodes_used * f)} nodes, above max_nodes = "
+                           f"{numerics.max_nodes}")
+            break
+        scale *= f
+        done += 1
+        res = _simulate_elastic(scene, numerics, scale)
+    res.refinements = done
+    res.band_resolution_used = ZONE_RESOLUTION * scale
+    res.wall_s = time.perf_counter() - t0
+    return res
+
+
+def _simulate_elastic(scene, numerics, scale: float):
+    """:func:`simulate_elastic` at the resolution ``scale`` times the branch's default."""
+    mesh = {"zone_resolution": ZONE_RESOLUTION * scale, "coarse": COARSE / scale}
     if numerics is None:
         numerics = Numerics.preset("balanced")
     t0 = time.perf_counter()
     res = Result(scene=scene, numerics=numerics)
     if scene.k != 1.0:
         res.reason = f"the quasi-static elastic solver needs k = 1 (got k = {scene.k})"
+        return res
+    lo, hi = ELASTIC_MU_RANGE
+    if not lo <= scene.mu <= hi:
+        res.reason = (f"mu = {scene.mu:g} is beyond the elastic branch's range [{lo:g}, "
+                      f"{hi:g}]: the crack-front model (model crack or auto), the mu -> "
+                      f"infinity limit, answers it")
         return res
     if scene.stop != "pulloff":
         res.reason = ("the quasi-static elastic branch ends at its displacement-controlled "
@@ -445,7 +488,7 @@ def simulate_elastic(scene, numerics=None):
     protocol = scene.protocol()
     if protocol is not None:
         try:
-            a_start, approach = _protocol_start(scene, protocol)
+            a_start, approach = _protocol_start(scene, protocol, mesh)
         except RuntimeError as err:
             res.reason = f"protocol: {err}"
             res.wall_s = time.perf_counter() - t0
@@ -455,7 +498,7 @@ def simulate_elastic(scene, numerics=None):
         return res
     else:
         a_start, approach = scene.a0, None
-    po = elastic_pull_off(scene.mu, a_start=a_start)
+    po = elastic_pull_off(scene.mu, a_start=a_start, **mesh)
     res.nodes_used, res.steps = po.nodes, po.solves
     res.newton_iterations = res.factorizations = po.newton_iterations
     if approach is not None:
@@ -468,6 +511,15 @@ def simulate_elastic(scene, numerics=None):
         state = state_at(ElasticBranch(scene.mu, a_start, 0.5 * a_start), a_start)
         res.reason = (fold_refusal(scene.mu, a_start) if state is not None and state[2]
                       else po.reason)
+        ratio = a_start / pull_off_radius_guess(scene.mu)
+        if res.reason == po.reason and ratio > LARGE_START:
+            # the pattern scales with the radius: its tip zone at a_start is coarser by the
+            # ratio (Newton failed at a0 >= 20 at mu >= 50, about 20 pull-off radii)
+            res.reason += (f" (the branch's mesh scales with the contact radius: from a0 = "
+                           f"{a_start:g}, {ratio:.0f} times the pull-off radius, its tip zone "
+                           f"is under-resolved; the elastic pull-off does not depend on a0 "
+                           f"beyond the pull-off radius: a smaller a0 gives it, model auto "
+                           f"answers with the crack-front model)")
         res.wall_s = time.perf_counter() - t0
         return res
     res.wall_s = time.perf_counter() - t0
@@ -503,7 +555,7 @@ def simulate_elastic(scene, numerics=None):
                       "a_inner": np.full(a_tr.size, np.nan)}
     if approach is not None:
         _join_protocol(res, approach)
-    _estimate_error(res, a_start)
+    _estimate_error(res, a_start, mesh)
     res.wall_s = time.perf_counter() - t0
     return res
 
@@ -518,7 +570,7 @@ APPROACH_RECORDS = 24
 TAIL_RECORDS = 64
 
 
-def _protocol_start(scene, protocol):
+def _protocol_start(scene, protocol, mesh: dict):
     """(the preload's radius, the approach's records) of an elastic scene with a test protocol,
     on the branch's mesh of :func:`elastic_pull_off` (so that the retraction starts from the same
     state). The approach starts where the BEM's does (:func:`sweep.engine.protocol.first_contact`:
@@ -529,7 +581,7 @@ def _protocol_start(scene, protocol):
     fails or the branch is not stable (the indentation not growing with the radius)."""
     mu = scene.mu
     a_g = pull_off_radius_guess(mu)
-    br = _branch(mu)
+    br = _branch(mu, **mesh)
     a_first = _first_contact(br, mu)
     a_pre = float(jkr_contact_radius(load=protocol.preload))
     a_end = _branch_root(br, lambda a, h, d: br.load(a, h), protocol.preload, a_pre, a_g)
@@ -663,7 +715,7 @@ def _join_protocol(res, approach) -> None:
     res.hysteresis_energy = cycle_work(joined)
 
 
-def _estimate_error(res, a_start: float) -> None:
+def _estimate_error(res, a_start: float, mesh: dict) -> None:
     """The error estimate of an ok elastic result, in place: the pull-off change on the
     branch's mesh at 1/f of the resolution (f times the tip-zone and the coarse spacing)
     over f - 1, as the BEM's (:func:`sweep.engine.resolution.estimate_error`), with
@@ -674,8 +726,8 @@ def _estimate_error(res, a_start: float) -> None:
     if tol <= 0:
         return
     check = elastic_pull_off(res.scene.mu, a_start=a_start,
-                             zone_resolution=ZONE_RESOLUTION / ELASTIC_CHECK_FACTOR,
-                             coarse=COARSE * ELASTIC_CHECK_FACTOR)
+                             zone_resolution=mesh["zone_resolution"] / ELASTIC_CHECK_FACTOR,
+                             coarse=mesh["coarse"] * ELASTIC_CHECK_FACTOR)
     if not check.converged:
         res.reason = (f"{res.reason}; " if res.reason else "") + (
             f"no error estimate: the branch at half the resolution failed ({check.reason})")
@@ -683,8 +735,9 @@ def _estimate_error(res, a_start: float) -> None:
     change = abs(res.pull_off - check.pull_off) / res.pull_off
     res.error_estimate = change / (ELASTIC_CHECK_FACTOR - 1.0)
     if res.scene.protocol() is not None:
-        coarse = _branch(res.scene.mu, zone_resolution=ZONE_RESOLUTION / ELASTIC_CHECK_FACTOR,
-                         coarse=COARSE * ELASTIC_CHECK_FACTOR)
+        coarse = _branch(res.scene.mu,
+                         zone_resolution=mesh["zone_resolution"] / ELASTIC_CHECK_FACTOR,
+                         coarse=mesh["coarse"] * ELASTIC_CHECK_FACTOR)
         res.hysteresis_error = hysteresis_error(res, _cycle_work(coarse, res.scene.mu, check),
                                                 ELASTIC_CHECK_FACTOR - 1.0)
     if res.error_estimate > tol:
@@ -694,5 +747,9 @@ def _estimate_error(res, a_start: float) -> None:
                       f"{res.error_estimate:.2g} > pull_off_rtol = {tol:g}")
 
 
+#: a start this many pull-off radii out, where the branch fails, is named as the cause
+LARGE_START = 10.0
+#: the Tabor parameters of the branch (:func:`elastic_pull_off`)
+ELASTIC_MU_RANGE = (0.01, 100.0)
 #: resolution ratio of the elastic branch's error check (:func:`_estimate_error`)
 ELASTIC_CHECK_FACTOR = math.sqrt(2.0)

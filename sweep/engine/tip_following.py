@@ -413,7 +413,9 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
         ok, h = solve(d, np.maximum(CubicSpline(r_b, h_b)(el.r), 0.3 * el.h0))
         if not ok:
             raise RuntimeError(f"no equilibrium on the window mesh at the branch state of "
-                               f"a0 = {a0:g}")
+                               f"a0 = {a0:g} (Newton stalls on this window at large mu; "
+                               f"another band_resolution may start it, e.g. 8 at mu 100, "
+                               f"a0 1.2; model auto answers with the crack-front model)")
         spacing = float(np.min(np.diff(el.r)))
         best = [abs(el.radius(h) - a0), h, d]
 

@@ -200,7 +200,9 @@ def _protocols_section(thr, paper) -> list[str]:
                   + f" against the paper's {pt['prefactor']}. The paper states a_ref = "
                   "(pi R^2 dg0/E0*)^(1/3) (its eq. main) and our a0 uses it; that its Fig. "
                   "Threshold (b) was drawn in the unit without pi is inferred from this "
-                  "factor only.", ""]
+                  "factor only. Against it: the paper's own PDMS estimate converts a0t = 30.9 "
+                  "to 5.8 mm, which is 30.9 a_ref with pi (0.188 mm; without pi it would be "
+                  "4.0 mm), so the paper's PDMS text uses the unit with pi.", ""]
     return lines + [""]
 
 
@@ -269,9 +271,16 @@ def _vr_protocol_lines(vr, theory=None) -> list[str]:
             lines.append(f"| [{r['rate_range'][0]:g}, {r['rate_range'][1]:g}] | "
                          f"{_g(r['prefactor'])} | {_ci(r['prefactor_ci'])} | "
                          f"{_g(r['exponent'])} | {_ci(r['exponent_ci'])} | {r['n_points']} |")
-        lines += ["", "The project's headline fit takes every rate of its campaign (0.1 to "
-                  "1e6); the two slowest rates (0.1, 0.316), which the paper's grid does not "
-                  "have, lift the prefactor."]
+        rates = sorted({r["rate"] for r in vr.get("local_slope") or ()})
+        below = [r for r in rates if r < pr["rate_range"][0] * (1 - 1e-9)]
+        if below:
+            def rate(r):
+                return f"{r:.3g}".replace("e+0", "e").replace("e+", "e")
+
+            lines += ["", f"The project's headline fit takes every rate of its campaign "
+                      f"({rate(rates[0])} to {rate(rates[-1])}); the slowest "
+                      f"({', '.join(rate(r) for r in below)}), which the paper's grid does "
+                      "not have, lift the prefactor."]
     ls = vr.get("local_slope")
     if ls:
         lines += ["", "The data are not one power law. Local slope d ln vhat / d ln rhat_PB "
@@ -343,6 +352,18 @@ def _vr_section(vr, theory=None) -> list[str]:
     return lines
 
 
+def _config_path(source) -> str | None:
+    """A results file's ``config_source``, relative to the repository where it lies in it."""
+    if not source or str(source).startswith("<"):
+        return None
+    path = Path(source)
+    root = Path(__file__).resolve().parents[2]
+    try:
+        return str(path.resolve().relative_to(root)) if path.is_absolute() else str(path)
+    except ValueError:
+        return str(path)
+
+
 def _campaign_table(root: Path) -> list[str]:
     lines = ["## Campaigns: scenes, failures, times", "",
              "| make target | config | scenes run (of the grid) | ok | failed | sweep elapsed (first start to "
@@ -356,6 +377,7 @@ def _campaign_table(root: Path) -> list[str]:
             lines.append(f"| `{target}` | `{cfg}` | not run | | | | | | | |")
             continue
         c, p = data["cost"], data["provenance"]
+        cfg = _config_path(p.get("config_source")) or cfg   # the one that ran (QUICK=1: thinned)
         grid = p.get("n_scenes")
         done = f"{c['scenes']} of {grid}" if grid else str(c["scenes"])
         if grid and c["scenes"] < grid:
@@ -400,9 +422,12 @@ def _pdms_section(root: Path) -> list[str]:
         f"| threshold radius for 1.5/k, our collapse fit [a_ref / mm] | {_g(res['a0t_hat'])} / "
         f"{_g(res['a0t_mm'], 3)} | 30.9 / 5.8 ({_g(pp.get('a0t_hat', math.nan))} / "
         f"{_g(pp.get('a0t_mm', math.nan), 3)}) |",
-        f"| unloading speed for the full amplification, our v-r fit [m/s] | "
-        f"{_g(res['speed_full_amplification_m_s'], 3)} | 31.4 "
-        f"({_g(pp.get('speed_full_amplification_m_s', math.nan), 3)}) |",
+        f"| unloading speed for the full amplification, our v-r fit read as the paper's "
+        f"text does, rhat = r tau0/l0 [m/s] | {_g(res['speed_full_amplification_m_s'], 3)}"
+        + (f" ({_g(res['speed_full_amplification_dref_m_s'], 3)} with this project's "
+           f"rhat = r tau0/d_ref, docs/design.md section 2)"
+           if res.get("speed_full_amplification_dref_m_s") is not None else "")
+        + f" | 31.4 ({_g(pp.get('speed_full_amplification_m_s', math.nan), 3)}) |",
         f"| same at the PDMS's own k (PB Gamma = 0.9/k at vhat = "
         f"{res['vhat_full_amplification_pdms_k']:.2g}) [m/s] | "
         f"{res['speed_full_amplification_pdms_k_m_s']:.2g} | -- |"]

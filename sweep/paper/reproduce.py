@@ -52,7 +52,7 @@ def _provenance(path) -> dict:
     from ..campaign.store import read_attrs
 
     a = read_attrs(path)
-    keep = ("config_name", "config_hash", "git_commit", "n_scenes", "n_finished", "complete",
+    keep = ("config_name", "config_source", "config_hash", "git_commit", "n_scenes", "n_finished", "complete",
             "started_at", "updated_at", "finished_at", "package_version", "numba_version")
     return {"results": str(path), **{k: a.get(k) for k in keep}}
 

@@ -247,9 +247,10 @@ def test_pb_regimes_linear_slope_is_the_small_speed_limit():
 
 
 # ------------------------------------------------------------------ CLI
-def write_results(path, df):
-    st = ResultStore(path, config_hash="synthetic", config_name="t", config_text="name: t\n",
-                     n_scenes=len(df))
+def write_results(path, df, **attrs):
+    """``df`` as a complete results file; ``attrs``: the store's own (config_source, ...)."""
+    st = ResultStore(path, **{"config_hash": "synthetic", "config_name": "t",
+                              "config_text": "name: t\n", **attrs}, n_scenes=len(df))
     st.prepare(resume=False)
     st.begin(fresh=True)
     for i, row in enumerate(df.to_dict("records")):

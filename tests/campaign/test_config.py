@@ -542,3 +542,17 @@ def test_a_name_yaml_reads_as_no_string_says_to_quote_it(text, got):
     value = text.split(": ")[1]
     assert str(info.value) == (f"<string>: name: must be a string, quoted in YAML where it "
                                f'reads as something else (name: "{value}") (got {got})')
+
+
+def test_a_grid_point_s_own_problems_come_with_the_others():
+    """A protocol missing two of its keys had been reported only once the numerics' problems
+    were fixed, though docs/configs.md says every problem is reported at once."""
+    from sweep.campaign.config import config_from_dict
+
+    with pytest.raises(InputError) as err:
+        config_from_dict({"name": "x", "grid": {"n": 0.8, "a0": 2, "rate": 1,
+                                                "approach_rate": 1},
+                          "numerics": {"max_nodes": 10, "refinements": 9}})
+    text = str(err.value)
+    assert "3 problems" in text and "numerics.max_nodes" in text
+    assert "a protocol needs approach_rate, preload and dwell together" in text

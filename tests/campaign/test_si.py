@@ -598,3 +598,13 @@ def test_a_file_of_table_scenes_written_before_the_hash_digits_resumes(tmp_path,
     capsys.readouterr()
     assert main(["info", str(tmp_path / "g.h5")]) == 0
     assert "scenes: 2 finished of 2" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("numerics", ["fast", {"preset": "fast"}])
+def test_run_si_names_a_numerics_that_is_not_one(numerics):
+    """A preset's name or a dict had ended in an AttributeError deep in the engine (bem,
+    auto) or been ignored (crack): refused at once, naming ``numerics``."""
+    si = pdms()
+    for model in ("bem", "crack", "auto"):
+        with pytest.raises(TypeError, match="numerics must be a sweep.Numerics"):
+            run_si(si, model, numerics)

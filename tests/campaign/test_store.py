@@ -297,3 +297,9 @@ def test_kill_during_consolidation_leaves_old_file(tmp_path):
     assert not tmp.exists()
     st.finish()
     assert list(load(path).scene_id) == ["id0001"]
+
+
+def test_load_trajectory_names_a_scene_id_that_is_not_a_string(tmp_path):
+    """``load_trajectory(path, 3)`` had raised h5py's "A name should be string or bytes"."""
+    with pytest.raises(TypeError, match="scene_id must be a string"):
+        load_trajectory(tmp_path / "x.h5", 3)

@@ -260,3 +260,16 @@ def test_the_row_records_the_law_and_its_parameters():
 def Result_id(scene):
     from sweep import scene_id
     return scene_id(scene, Numerics.preset("balanced"))
+
+
+def test_an_exponent_below_the_smallest_followed_is_refused_with_the_reason():
+    """pz_xi 3e-4 and below (allowed by the scene's range (0, 10]) had failed with
+    "integrator: OverflowError: math range error": refused with the reason; 1e-3 runs."""
+    from sweep import Scene
+    from sweep.engine.crack_front import PZ_XI_MIN, simulate_crack
+
+    kw = dict(n=0.8, k=0.1, mu=3.24, a0=3.0, rate=10.0, pz_law="gent-schultz", pz_v0=1.0)
+    res = simulate_crack(Scene(pz_xi=1e-4, **kw))
+    assert res.status == "failed" and res.reason.startswith("pz_xi = 0.0001 is below 0.001")
+    assert "Error" not in res.reason
+    assert simulate_crack(Scene(pz_xi=PZ_XI_MIN, **kw)).ok

@@ -297,3 +297,58 @@ def test_a_cheaper_models_row_below_its_measured_range_says_its_error_is_unknown
                                 Numerics.preset("balanced"))
     assert res.ok and math.isnan(res.error_estimate)
     assert "error is not measured below mu = 2 (error_estimate NaN)" in res.reason
+
+
+def test_auto_answers_a_negligible_zone_on_an_elastic_bulk_as_the_plain_scene():
+    """pz_v0 = 1e20 on k = 1 had sent "auto" to the hereditary BEM, unresolved at balanced
+    (estimate 0.0103) where the plain scene is ok on the elastic branch: the branch answers,
+    its estimate carries the zone's term, the row keeps the zone's scene (its id); a zone
+    that counts still runs the zone's models."""
+    from sweep.engine.crack_front import NEGLIGIBLE_PROCESS_ZONE
+
+    kw = dict(n=0.5, k=1.0, mu=3.24, a0=3.0, rate=10.0, model="auto")
+    plain = models.simulate(Scene(**kw))
+    zone = Scene(**kw, pz_law="gent-schultz", pz_v0=1e20, pz_xi=0.5)
+    res = models.simulate(zone)
+    assert plain.ok and res.ok and res.model_used == "elastic"
+    assert res.pull_off == plain.pull_off and res.scene_id == models.simulate(zone).scene_id
+    assert res.scene == zone and res.scene_id != plain.scene_id
+    term = res.error_estimate - plain.error_estimate
+    assert 0 < term <= NEGLIGIBLE_PROCESS_ZONE and "negligible" in res.reason
+    strong = models.simulate(Scene(**kw, pz_law="gent-schultz", pz_v0=1e3, pz_xi=0.5))
+    assert strong.model_used != "elastic" and strong.pull_off > 1.01 * plain.pull_off
+
+
+def test_auto_keeps_the_bem_row_of_a_compliant_machine_and_counts_every_model_s_wall():
+    """A compliant machine's BEM failure had been replaced by the crack-front model's refusal
+    (which told the user to use auto) with wall_s 0; a fallback's row counted only the
+    crack-front model's time (0.09 s of a 1.31 s scene; 0.01 s of 0.18 s here): the BEM row
+    stays with its advice,
+    and an auto row's wall_s is the whole scene's."""
+    import time
+
+    machine = Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10.0, machine_stiffness=1e-6,
+                    model="auto")
+    res = models.simulate(machine, Numerics.preset("fast", max_steps=200))
+    assert res.model_used == "bem" and res.reason.startswith("step limit"), res.reason
+    scene = Scene(n=0.8, k=0.1, mu=3.24, a0=50.0, rate=1e-4, model="auto")
+    t0 = time.perf_counter()
+    res = models.simulate(scene, Numerics.preset("fast", max_steps=500))
+    wall = time.perf_counter() - t0
+    assert res.model_used == "crack" and "the BEM failed (too many steps" in res.model_reason
+    assert 0.95 * wall <= res.wall_s <= wall
+
+
+def test_out_of_range_refusals_name_the_limit_not_an_exception():
+    """A crack-front scene below its fixed-grip indentation and an elastic-branch scene beyond
+    its Tabor range had failed with the text of an InputError ("delta0 must be >= -0.75",
+    "mu must be in [0.01, 100]"): the first is a physical refusal, the second names the
+    model that answers it."""
+    from sweep.errors import is_physical_refusal
+
+    crack = models.simulate(Scene(n=0.8, k=0.1, mu=2.9e5, delta0=-5.0, rate=1.0, model="auto"))
+    assert crack.status == "failed" and is_physical_refusal(crack.reason), crack.reason
+    elastic = models.simulate(Scene(n=0.8, k=1.0, mu=21120.0, a0=3.0, rate=1.0,
+                                    model="elastic"))
+    assert elastic.reason.startswith("mu = 21120 is beyond the elastic branch's range")
+    assert "model crack or auto" in elastic.reason

@@ -155,7 +155,7 @@ def test_an_elastic_protocol_the_branch_cannot_run_goes_to_the_march(monkeypatch
     reason says why; model "elastic" reports the branch's failure."""
     from sweep.engine import quasistatic
 
-    def fails(scene, protocol):
+    def fails(scene, protocol, mesh):
         raise RuntimeError("no radius on the elastic branch reaches it")
 
     monkeypatch.setattr(quasistatic, "_protocol_start", fails)

@@ -283,7 +283,7 @@ def test_relax_reaches_the_equilibrium_newton_finds():
                      ks.new_jacobian_cache(N), stats)
     hr = h_start.copy()
     assert ks.relax(hr, g, A, ceff, H, lennard_jones(h0, c, N), 1e-10 * h0, ks.RELAX_MAX_ITER,
-                    stats)
+                    stats, np.inf)
     sig, d = np.empty(N), np.empty(N)
     lj_traction_and_stiffness(hr, h0, c, sig, d)
     assert np.max(np.abs(hr - g - A @ (ceff * sig - H))) < 1e-10 * h0

@@ -114,3 +114,19 @@ def test_fig3_refuses_a_file_without_its_scenes(tmp_path, capsys):
                       "rate": [10.0, 10**2.5, 10**2.5, 1.0]})
     assert fig3_panels(d) == [2, 1, 1]
     assert fig3_panels(d.assign(a0=2.5, n=0.4, rate=1.0)) == [0, 0, 0]
+
+
+def test_the_report_names_the_config_that_ran(tmp_path, capsys):
+    """A QUICK=1 report had named the full campaigns' configs (configs/threshold.yaml, "28 of
+    28") though the thinned ones ran: the campaign table names each results file's own
+    ``config_source``."""
+    thr = tmp_path / "thr.h5"
+    write_results(thr, synthetic_threshold_runs().assign(wall_s=1.0, reason=""),
+                  config_name="threshold-quick", config_source="configs/quick/threshold.yaml")
+    root = tmp_path / "results"
+    assert main(["threshold", str(thr), str(root / "threshold")]) == 0
+    assert main(["report", "--results", str(root)]) == 0
+    capsys.readouterr()
+    report = (root / "REPORT.md").read_text()
+    assert "| `make threshold` | `configs/quick/threshold.yaml` |" in report
+    assert "`configs/threshold.yaml`" not in report
