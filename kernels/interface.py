@@ -46,9 +46,10 @@ def tail_load(h_end, h0, c):
 
         P_tail = 2 pi int_{h_end}^inf sigma_LJ(h) dh = -2 pi c h0 (q^2/2 - q^8/8),  q = h0/h_end
 
-    (pi dg R units; negative: tensile). The one place this formula is written: the BEM's
-    load (:func:`kernels.solve.load`) and the quasi-static elastic branch's
-    (``sweep.engine.quasistatic.ElasticBranch.load``) both add it. Beyond the mesh the
+    (pi dg R units; negative: tensile). The BEM's load (:func:`kernels.solve.load`) adds
+    it; the quasi-static elastic branch (``sweep.engine.quasistatic.ElasticBranch.load``),
+    which had the same formula first, keeps its own order of operations (its results bitwise
+    as before). Beyond the mesh the
     interface is the Lennard-Jones law: a process zone acts at the crack tip, far inside,
     and its factor m is taken as 1 there. ``h_end`` = inf gives 0 (no tail). Without it the
     BEM's pull-off was low by about (1/tail_gap)^2 relative (about 2.8e-4 at the default

@@ -638,6 +638,13 @@ class Numerics:
         (the gap continued rigidly: :func:`sweep.kernels.interface.tail_load`).
     tail_gap : float
         Gap at the mesh edge, in units of h0, used by the automatic domain (>= 10).
+    lj_tail : bool
+        Add the Lennard-Jones attraction beyond the BEM's mesh edge to every load the BEM
+        forms (default True; :func:`sweep.kernels.interface.tail_load`). False drops it: the
+        truncated model of the results computed before it (session 49), for comparisons
+        with references that drop it too (its pull-off is low by about (h0/h_edge)^2, 2.8e-4
+        at the relaxed limit at ``tail_gap`` 60). The elastic branch (``model="auto"`` at
+        k = 1, :mod:`sweep.engine.quasistatic`) always has the tail.
     step : float
         Largest indentation step, in units of h0, where the crack tip moves or the load
         evolves fast (the adaptive step exceeds it, up to 8 times, only where the
@@ -706,6 +713,7 @@ class Numerics:
     time_budget_s: float = 300.0
     da_max_pulloff: float | None = None
     refinements: int = 0
+    lj_tail: bool = True
 
     def __post_init__(self):
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731
@@ -731,6 +739,9 @@ class Numerics:
         if not isinstance(self.exact, (bool, np.bool_)):
             raise InputError(f"exact must be true or false (got {self.exact!r})")
         set_("exact", bool(self.exact))
+        if not isinstance(self.lj_tail, (bool, np.bool_)):
+            raise InputError(f"lj_tail must be true or false (got {self.lj_tail!r})")
+        set_("lj_tail", bool(self.lj_tail))
         set_("zone_nodes", check_range("zone_nodes", self.zone_nodes, 0.0, 100.0))
         set_("refinements", check_int("refinements", self.refinements, 0, MAX_REFINEMENTS))
 

@@ -13,10 +13,12 @@ import json
 import shutil
 
 import h5py
+import pytest
 
 from tests import reference
 from sweep import Numerics, Scene, scene_id
 from sweep.cli import main
+from sweep.errors import InputError
 from sweep.campaign.config import parse_config
 from sweep.scene import SCENE_ID_VERSION, axis
 from sweep.campaign.scheduler import run_sweep
@@ -54,6 +56,20 @@ def test_a_defaulted_new_field_renames_no_scene():
         # the new field enters the id as soon as it leaves its default
         moved = dataclasses.replace(scene, adhesion_hysteresis=0.5)
         assert scene_id(moved, numerics) != case["id"]
+
+
+def test_the_lennard_jones_tail_switch_keeps_every_id_at_its_default():
+    # Numerics.lj_tail (added with the tail, session 49) is not in an id at its default True;
+    # False, the truncated model, is another scene; it is a bool
+    for case in _recorded():
+        numerics = Numerics(**case["numerics"])
+        assert numerics.lj_tail is True
+        assert scene_id(Scene(**case["scene"]), numerics) == case["id"]
+        truncated = dataclasses.replace(numerics, lj_tail=False)
+        assert scene_id(Scene(**case["scene"]), truncated) != case["id"]
+    for bad in ("no", 0, None):
+        with pytest.raises(InputError, match="lj_tail must be true or false"):
+            Numerics(lj_tail=bad)
 
 
 def _pinned_config(path):

@@ -231,8 +231,9 @@ class Problem:
     @property
     def tail(self) -> float:
         """The mesh's :attr:`sweep.engine.mesh.Mesh.tail_rise`: the load's Lennard-Jones tail
-        beyond the mesh starts at the gap h_last + tail (:func:`sweep.kernels.solve.load`)."""
-        return self.mesh.tail_rise
+        beyond the mesh starts at the gap h_last + tail (:func:`sweep.kernels.solve.load`);
+        inf (no tail) where ``numerics.lj_tail`` is False."""
+        return self.mesh.tail_rise if self.numerics.lj_tail else math.inf
 
     def mesh_arrays(self):
         """The unloading kernels' :data:`sweep.kernels.solve.MeshArrays` of this problem."""
