@@ -360,9 +360,10 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, m
 def shares_text(split: dict) -> str:
     """``sweep scene --shares``'s line (:func:`sweep.analysis.shares.process_zone_shares`)."""
     rows = ", ".join(f"{name} P={split[name]['pull_off']:.6g} ({split[name]['model']}, "
-                     f"{split[name]['status']})" for name in ("bulk", "relaxed"))
+                     f"{split[name]['status']})" for name in ("bulk", "relaxed")
+                     if name in split)
     if not math.isfinite(split["bulk_share"]):
-        return f"shares     none: {split['note']} [{rows}]"
+        return f"shares     none: {split['note']}" + (f" [{rows}]" if rows else "")
     head = (f"shares     bulk {split['bulk_share']:.4g}, process zone "
             f"{split['process_zone_share']:.4g} of ln(P/P_relaxed), amplification "
             f"{split['amplification']:.6g}, share error {split['share_error']:.2g}")

@@ -684,8 +684,9 @@ class Numerics:
         P(t), spurious minima, failed Newton solves), so such a scene is refused with a
         ``failed`` status that says how many nodes it needs.
     refinements : int
-        How many times the BEM may solve a scene again at a finer resolution where its error
-        estimate exceeds ``pull_off_rtol`` (0: never; the row is then "unresolved"). Each
+        How many times the BEM (or the elastic branch) may solve a scene again at a finer
+        resolution where its error estimate exceeds ``pull_off_rtol`` (0: never; the row is
+        then "unresolved"). Each
         refinement divides the spacing and the indentation step by the factor the estimate
         asks for (its second-order convergence, between sqrt 2 and 2) and the Prony
         tolerance by 10 where the Prony error takes half the tolerance
@@ -928,12 +929,15 @@ class Result:
         Why that model ran, in a few words (the scene asked for it; or what "auto" weighed:
         e.g. "auto: crack-front model, measured error 0.4 % <= pull_off_rtol 1 % at mu = 40").
     refinements : int
-        How many times the BEM solved the scene again at a finer resolution because its
-        error estimate exceeded ``pull_off_rtol`` (``Numerics.refinements`` allows it).
+        How many times the BEM (or the elastic branch) solved the scene again at a finer
+        resolution because its error estimate exceeded ``pull_off_rtol``
+        (``Numerics.refinements`` allows it).
     band_resolution_used, step_used : float
         The BEM's resolution behind the row: spacings per process zone (the graded mesh's
         band resolution; NaN on a mesh given by its node count, whose ``nodes_used`` says it)
-        and the largest indentation step (h0). NaN for the other models.
+        and the largest indentation step (h0); the elastic branch's spacings per process zone
+        at its tip (at least its default 16, at fast too; NaN before session 49) and no step
+        (NaN). NaN for the other models.
     hysteresis_energy : float
         A scene with a test protocol: the work the machine did on the sphere over the whole
         path, int P d delta (pi dg R d_ref; :func:`sweep.engine.postprocess.cycle_work`), to

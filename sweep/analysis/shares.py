@@ -59,9 +59,12 @@ def process_zone_shares(scene: Scene, numerics: Numerics | None = None, both=Non
         zone's, (e_bulk + e_relaxed) / ln(amplification) for the bulk's (the larger of the two);
         ``determined`` (False where ln(amplification) is below :data:`DETERMINED_BELOW`
         times its error e_both + e_relaxed: the shares are given but not determined by the
-        rows) and ``note`` saying why; where a row failed, no shares (NaN) and the note.
+        rows) and ``note`` saying why; where a row failed, or there is no amplification at
+        all, no shares (NaN) and the note (a failed ``both`` row: the other two are not run).
         The ``bulk`` and ``relaxed`` rows run on the model the scene ran on (``both``'s
-        ``model``), so that one model's numbers are divided.
+        ``model``), so that one model's numbers are divided; the BEM answers an elastic,
+        quasi-static row with its quasi-static branch (``sweep.engine.models``), so at k = 1
+        the hereditary BEM's ``both`` is divided by the branch's rows.
 
     Raises
     ------
@@ -78,8 +81,11 @@ def process_zone_shares(scene: Scene, numerics: Numerics | None = None, both=Non
     # the crack-front model's relaxed contact is JKR's 1.5, the BEM's 1.546 at mu 3.24)
     model = both.model_used if both.model_used in ("bem", "crack") else scene.model
     plain = dataclasses.replace(scene, pz_law="none", pz_v0=None, pz_xi=None, model=model)
-    rows = {"both": both, "bulk": simulate(plain, numerics),
-            "relaxed": simulate(dataclasses.replace(plain, material="mpl", k=1.0), numerics)}
+    rows = {"both": both}
+    if both.ok:                 # a failed scene has nothing to split: no other rows
+        rows.update(bulk=simulate(plain, numerics),
+                    relaxed=simulate(dataclasses.replace(plain, material="mpl", k=1.0),
+                                     numerics))
     out = {name: {"pull_off": float(r.pull_off), "status": r.status, "model": r.model_used,
                   "error_estimate": float(r.error_estimate), "reason": r.reason}
            for name, r in rows.items()}
@@ -92,6 +98,10 @@ def process_zone_shares(scene: Scene, numerics: Numerics | None = None, both=Non
                        f"({'; '.join(rows[n].reason for n in failed)})")
         return out
     total = math.log(rows["both"].pull_off / rows["relaxed"].pull_off)
+    out["amplification"] = math.exp(total)
+    if total == 0.0:     # a negligible zone on an elastic bulk: all three rows the same
+        out["note"] = "no shares: no amplification to split (the three pull-offs are equal)"
+        return out
     bulk = math.log(rows["bulk"].pull_off / rows["relaxed"].pull_off)
     noise = err["both"] + err["relaxed"]
     out.update(amplification=math.exp(total), bulk_share=bulk / total,

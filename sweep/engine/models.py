@@ -541,6 +541,12 @@ def simulate_model(scene, model: str = "bem", numerics=None):
     return res
 
 
+#: the slowest crack speed at pull-off, in indentation speeds (rate h0), :func:`_negligible_zone`
+#: screens a zone with before running the elastic branch (the branch costs 0.2-5 s; the
+#: crack at the pull-off runs faster than the indentation)
+NEGLIGIBLE_CRACK_SPEED = 1e-3
+
+
 def _negligible_zone(scene, numerics) -> Result | None:
     """The row of an "auto" scene whose process zone is too weak to count on an elastic,
     quasi-static bulk: the elastic branch's row of the scene without the zone, the zone's
@@ -549,17 +555,21 @@ def _negligible_zone(scene, numerics) -> Result | None:
     model's own rule); else None. (Such a zone, pz_v0 = 1e20, had sent the scene to the
     hereditary BEM, whose row was unresolved at the balanced preset where the plain scene's
     was ok.)"""
-    plain = dataclasses.replace(scene, pz_law="none", pz_v0=None, pz_xi=None)
-    if scene.pz_law == "none" or not wants_quasistatic(plain, numerics):
+    if scene.pz_law == "none":
         return None
+    plain = dataclasses.replace(scene, pz_law="none", pz_v0=None, pz_xi=None)
+    indentation_speed = scene.rate * units.h0_hat(scene.mu)
+    if not wants_quasistatic(plain, numerics) or not (
+            10.0 * NEGLIGIBLE_CRACK_SPEED * indentation_speed / scene.pz_v0) ** scene.pz_xi \
+            <= NEGLIGIBLE_PROCESS_ZONE:
+        return None      # (a zone that counts even at a crack this slow: no branch to run)
     res = _run("elastic", plain, numerics)
-    v = res.crack_speed if math.isfinite(res.crack_speed) else \
-        scene.rate * units.h0_hat(scene.mu)
-    term = (10.0 * v / scene.pz_v0) ** scene.pz_xi
+    v = res.crack_speed if math.isfinite(res.crack_speed) else indentation_speed
+    term = float((10.0 * v / scene.pz_v0) ** scene.pz_xi)
     if not res.ok or not term <= NEGLIGIBLE_PROCESS_ZONE:
         return None
     res.scene = scene
-    res.error_estimate += term
+    res.error_estimate = float(res.error_estimate) + term
     note = (f"the process zone's term (v/pz_v0)^pz_xi at ten times the crack speed, {term:.2g}, "
             f"is negligible: the scene without it, the term added to error_estimate")
     res.reason = f"{res.reason}; {note}" if res.reason else note

@@ -447,22 +447,41 @@ def simulate_elastic(scene, numerics=None):
     # never coarser than the default (at fast's 9 spacings per l0 the error grew 14-fold, to
     # 8e-4 at mu 3.24, and the estimate to 1.9e-2: the branch costs a fraction of a second)
     scale = max(numerics.band_resolution / ZONE_RESOLUTION, 1.0)
+    t_solve = time.perf_counter()
     res = _simulate_elastic(scene, numerics, scale)
+    res.band_resolution_used = ZONE_RESOLUTION * scale
     done = 0
-    while (done < numerics.refinements and unresolved(res) and budget.remaining() > 0
-           and math.isfinite(res.error_estimate)):
+    while done < numerics.refinements and unresolved(res) and math.isfinite(res.error_estimate):
         f = min(max(1.2 * math.sqrt(res.error_estimate / numerics.pull_off_rtol),
                     math.sqrt(2.0)), 2.0)
-        if res.nodes_used * f > numerics.max_nodes:       # its dense solves: N^3
+        # its dense solves grow as the cube of the nodes: the next one costs about f^3 times
+        # the last, which must fit the nodes and the scene's budget (the branch's solves do
+        # not read the deadline: a refinement begun before it ran 28.7 s on a 9 s budget)
+        cost = (time.perf_counter() - t_solve) * f ** 3
+        if res.nodes_used * f > numerics.max_nodes:
             res.reason += (f"; not refined further: the branch would need about "
                            f"{int(res.nodes_used * f)} nodes, above max_nodes = "
                            f"{numerics.max_nodes}")
             break
-        scale *= f
+        if cost > budget.remaining():
+            res.reason += (f"; not refined further: the time budget is spent (the next "
+                           f"solve, about {cost:.2g} s, does not fit what is left of it)")
+            break
+        t_solve = time.perf_counter()
+        finer = _simulate_elastic(scene, numerics, scale * f)
         done += 1
-        res = _simulate_elastic(scene, numerics, scale)
+        if not (finer.ok or unresolved(finer)):      # the unresolved row stands
+            res.reason += (f"; refined to {ZONE_RESOLUTION * scale * f:.3g} spacings per "
+                           f"l0: {finer.reason}")
+            break
+        scale *= f
+        res = finer
+        res.band_resolution_used = ZONE_RESOLUTION * scale
+    if done and res.ok:
+        note = (f"refined {done} time{'s' * (done > 1)} to {ZONE_RESOLUTION * scale:.3g} "
+                f"spacings per l0")
+        res.reason = f"{res.reason}; {note}" if res.reason else note
     res.refinements = done
-    res.band_resolution_used = ZONE_RESOLUTION * scale
     res.wall_s = time.perf_counter() - t0
     return res
 
@@ -521,8 +540,8 @@ def _simulate_elastic(scene, numerics, scale: float):
             res.reason += (f" (the branch's mesh scales with the contact radius: from a0 = "
                            f"{a_start:g}, {ratio:.0f} times the pull-off radius, its tip zone "
                            f"is under-resolved; the elastic pull-off does not depend on a0 "
-                           f"beyond the pull-off radius: a smaller a0 gives it, model auto "
-                           f"answers with the crack-front model)")
+                           f"beyond the pull-off radius: a smaller a0 gives it; model auto "
+                           f"answers with the crack-front model, within its measured error)")
         res.wall_s = time.perf_counter() - t0
         return res
     res.wall_s = time.perf_counter() - t0

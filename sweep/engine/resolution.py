@@ -310,6 +310,9 @@ def estimate_error(res: Result, length: float, solve: Callable[[Numerics], Resul
                    f"resolution ({coarse.pull_off:.5g} vs {res.pull_off:.5g})")
             if factor == 2.0 and change < CROSSING_GATE * (res.spacing / length) ** 2:
                 change, how = _crossing_check(res, coarse, change, how, solve)
+                if not res.ok:      # its third solve stopped at the budget (_over_budget)
+                    res.error_estimate = math.nan
+                    return
             res.error_estimate = change / (factor ** ESTIMATE_ORDER - 1.0) + prony + zone
             res.hysteresis_error = hysteresis_error(res, coarse.hysteresis_energy,
                                                     factor ** ESTIMATE_ORDER - 1.0)
@@ -322,8 +325,6 @@ def estimate_error(res: Result, length: float, solve: Callable[[Numerics], Resul
                 f"check on a coarser mesh failed ({shortened(coarse.reason, 120)})")
         res.reason = f"{res.reason}; {note}" if res.reason else note
         how = f"the a-priori estimate {res.error_estimate:.2g}"
-    if not res.ok:          # the crossing check stopped at the budget (_over_budget)
-        return
     if res.error_estimate > tol:
         res.status = "failed"
         advice = (ZONE_SMOOTHING_ADVICE if zone > tol else refine_advice(res.numerics))

@@ -60,7 +60,7 @@ def test_a_failed_row_gives_no_shares_and_a_scene_without_a_zone_is_refused(caps
     s = process_zone_shares(Scene(n=0.5, k=0.1, mu=5.0, a0=1.5, rate=10.0, model="bem",
                                   **ZONE), Numerics.preset("fast", max_steps=20))
     assert s["both"]["status"] == "failed" and s["note"].startswith("no shares: the both")
-    assert math.isnan(s["bulk_share"]) and not s["determined"]
+    assert math.isnan(s["bulk_share"]) and not s["determined"] and "bulk" not in s
     argv = ["scene", "--n", "0.5", "--k", "0.1", "--mu", "5", "--a0", "1.5", "--rate", "10"]
     assert main(argv + ["--shares"]) == 2
     err = capsys.readouterr().err.strip()
@@ -69,3 +69,19 @@ def test_a_failed_row_gives_no_shares_and_a_scene_without_a_zone_is_refused(caps
                         "--model", "crack", "--shares"]) == 0
     line = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("shares")]
     assert len(line) == 1 and "process zone 0.27" in line[0] and "not determined" in line[0]
+
+
+def test_no_amplification_is_no_split(capsys):
+    """A negligible zone on an elastic bulk: the three rows are one pull-off, and the split
+    had raised ZeroDivisionError (the CLI a traceback)."""
+    kw = dict(n=0.5, k=1.0, mu=5.0, a0=1.5, rate=10.0, pz_law="gent-schultz", pz_v0=1e20,
+              pz_xi=0.5)
+    for model in ("auto", "crack"):
+        s = process_zone_shares(Scene(model=model, **kw))
+        assert s["amplification"] == 1.0 and math.isnan(s["process_zone_share"])
+        assert s["note"].startswith("no shares: no amplification")
+    argv = ["scene", "--n", "0.5", "--k", "1", "--mu", "5", "--a0", "1.5", "--rate", "10",
+            "--pz-law", "gent-schultz", "--pz-v0", "1e20", "--pz-xi", "0.5", "--model", "auto",
+            "--shares"]
+    assert main(argv) == 0
+    assert "shares     none: no shares: no amplification" in capsys.readouterr().out

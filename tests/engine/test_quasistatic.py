@@ -251,3 +251,20 @@ def test_a_start_far_beyond_the_pull_off_radius_names_the_cause():
     assert res.status == "failed" and res.reason.startswith("Newton did not converge")
     assert "under-resolved" in res.reason and "model auto" in res.reason
     assert simulate(Scene(n=0.8, k=1.0, mu=100.0, a0=15.0, rate=1.0, model="elastic")).ok
+
+
+def test_the_branch_s_refinements_keep_to_the_scene_s_budget():
+    """A refinement begun before the deadline ran to its end: a request of 7e-6 with a 9 s
+    budget took 28.7 s (2216 nodes) and came back ok (session 49's review). The next solve's
+    cost (f^3 times the last's) must fit what is left of the budget, else the row says so."""
+    import time
+
+    from sweep import simulate
+    from sweep.engine import budget
+
+    t0 = time.perf_counter()
+    res = simulate(Scene(n=1.0, k=1.0, mu=3.24, a0=2.0, rate=1.0),
+                   Numerics.for_tolerance(7e-6, time_budget_s=9.0))
+    wall = time.perf_counter() - t0
+    assert wall <= 9.0 + budget.CHECK_SLACK_S, wall
+    assert res.ok or "not refined further" in res.reason, res.reason
