@@ -454,9 +454,9 @@ def scene_text(res, preset: str) -> list[str]:
     initial = _finite(a0=res.a0_result, a0_inner=res.a0_inner, delta0=res.delta0_result)
     if initial:
         lines.append(f"initial    {initial}")
-    unresolved = (not res.ok and res.reason.startswith("unresolved")
-                  and math.isfinite(res.pull_off))
-    if unresolved:      # the finest value reached, marked (it had been in the reason only)
+    from .engine.resolution import unresolved   # (the engine is loaded: res was run)
+
+    if unresolved(res) and math.isfinite(res.pull_off):   # the finest value, marked
         lines.append(f"pull-off   P={res.pull_off:.6g} (pi dg R), unresolved: "
                      f"error_estimate={res.error_estimate:.3g} > pull_off_rtol")
     if res.ok:

@@ -104,7 +104,7 @@ def process_zone_shares(scene: Scene, numerics: Numerics | None = None, both=Non
         return out
     bulk = math.log(rows["bulk"].pull_off / rows["relaxed"].pull_off)
     noise = err["both"] + err["relaxed"]
-    out.update(amplification=math.exp(total), bulk_share=bulk / total,
+    out.update(bulk_share=bulk / total,
                process_zone_share=1.0 - bulk / total,
                share_error=max(err["both"] + err["bulk"], err["bulk"] + err["relaxed"])
                / abs(total),

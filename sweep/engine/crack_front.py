@@ -138,6 +138,17 @@ THRESHOLD_CROSSING = 10.0
 #: smallest initial contact radius (a_ref) of the crack-front model: below it a JKR contact
 #: is not stable under fixed grip (the model's physical limit, not a numerical one)
 FIXED_GRIP_A_MIN = 0.5
+#: the indentation of that contact (d_ref), -0.75: the smallest the model starts from
+FIXED_GRIP_DELTA_MIN = float(jkr_indentation(FIXED_GRIP_A_MIN))
+
+
+def negligible_zone_term(scene, crack_speed: float) -> float:
+    """The Gent-Schultz term (v/pz_v0)^pz_xi of ``scene``'s process zone at ten times
+    ``crack_speed`` (a_ref/tau0; where NaN, the indentation speed rate h0): a zone whose term
+    is at most :data:`NEGLIGIBLE_PROCESS_ZONE` is none, the term added to the row's estimate
+    (here on a nearly elastic bulk, and by ``auto`` on an elastic one)."""
+    v = crack_speed if math.isfinite(crack_speed) else scene.rate * units.h0_hat(scene.mu)
+    return float((10.0 * v / scene.pz_v0) ** scene.pz_xi)
 
 
 # ============================================================================ elastic field
@@ -560,7 +571,7 @@ def initial_state(a0=None, delta0=None):
     if a0 is not None:
         a0 = check_range("a0", a0, lo=FIXED_GRIP_A_MIN)
         return a0, float(jkr_indentation(a0))
-    delta0 = check_range("delta0", delta0, lo=-0.75)
+    delta0 = check_range("delta0", delta0, lo=FIXED_GRIP_DELTA_MIN)
     return float(jkr_contact_radius(indentation=delta0)), delta0
 
 
@@ -861,9 +872,9 @@ def simulate_crack(scene, numerics=None):
                       f"{FIXED_GRIP_A_MIN:g} a_ref a JKR contact is not stable under fixed grip "
                       f"(the crack-front model, the mu -> infinity limit, starts at or above it)")
         return res
-    delta_min = float(jkr_indentation(FIXED_GRIP_A_MIN))       # -0.75
-    if scene.delta0 is not None and scene.delta0 < delta_min:
-        res.reason = (f"no stable contact at delta0 = {scene.delta0:g}: below {delta_min:g}, "
+    if scene.delta0 is not None and scene.delta0 < FIXED_GRIP_DELTA_MIN:
+        res.reason = (f"no stable contact at delta0 = {scene.delta0:g}: below "
+                      f"{FIXED_GRIP_DELTA_MIN:g}, "
                       f"the indentation of the JKR contact of radius {FIXED_GRIP_A_MIN:g} a_ref, "
                       f"the smallest stable under fixed grip (the crack-front model, the mu -> "
                       f"infinity limit)")
@@ -878,11 +889,8 @@ def simulate_crack(scene, numerics=None):
         closed = _elastic_crack(scene, Result(scene=scene, numerics=numerics), t_start)
         if scene.pz_law == "none":
             return closed
-        # a process zone too weak to count: its Gent-Schultz term at ten times the crack
-        # speed of the constant-Gamma contact (the indentation speed where that has none)
-        v = closed.crack_speed if math.isfinite(closed.crack_speed) else \
-            scene.rate * units.h0_hat(scene.mu)
-        term = (10.0 * v / scene.pz_v0) ** scene.pz_xi
+        # a process zone too weak to count, at the constant-Gamma contact's crack speed
+        term = negligible_zone_term(scene, closed.crack_speed)
         if term <= NEGLIGIBLE_PROCESS_ZONE:
             closed.error_estimate += term
             return closed

@@ -52,7 +52,8 @@ from ..errors import (NUMERICAL_ERRORS, check_choice, check_positive, is_interna
 from ..scene import MATERIALS, Numerics, Result, Scene, SceneTable
 from ..theory import paper_v_vs_r_fit, pb_gamma_eff, pb_gamma_eff_spectrum
 from . import bem, budget
-from .crack_front import FIXED_GRIP_A_MIN, NEGLIGIBLE_PROCESS_ZONE, simulate_crack
+from .crack_front import (FIXED_GRIP_A_MIN, NEGLIGIBLE_PROCESS_ZONE, negligible_zone_term,
+                          simulate_crack)
 from .mesh import band_nodes, scene_mesh, window_nodes
 from .postprocess import FOLD_REASON
 from .problem import BEM_MU_RANGE, derive, protocol_band
@@ -564,8 +565,7 @@ def _negligible_zone(scene, numerics) -> Result | None:
             <= NEGLIGIBLE_PROCESS_ZONE:
         return None      # (a zone that counts even at a crack this slow: no branch to run)
     res = _run("elastic", plain, numerics)
-    v = res.crack_speed if math.isfinite(res.crack_speed) else indentation_speed
-    term = float((10.0 * v / scene.pz_v0) ** scene.pz_xi)
+    term = negligible_zone_term(scene, res.crack_speed)
     if not res.ok or not term <= NEGLIGIBLE_PROCESS_ZONE:
         return None
     res.scene = scene

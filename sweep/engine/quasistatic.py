@@ -52,8 +52,8 @@ from ..kernels.interface import TIP_GAP, lj_traction_and_stiffness
 from .. import units
 from ..errors import check_range
 from ..scene import Numerics, Result
-from . import budget
 from ..theory import jkr_contact_radius, jkr_indentation, maugis_dugdale_pull_off, maugis_lambda
+from . import budget
 from .initial import jkr_gap_guess
 from .postprocess import cycle_work
 from .resolution import hysteresis_error, unresolved
@@ -436,10 +436,10 @@ def simulate_elastic(scene, numerics=None):
 
     The branch's resolution follows the numerics: the tip zone's spacing l0 /
     (``ZONE_RESOLUTION`` s) and the coarse spacing ``COARSE`` / s, s = ``band_resolution`` /
-    ``ZONE_RESOLUTION`` and at least 1 (1 at the fast and balanced presets); where the estimate exceeds
-    ``pull_off_rtol`` and ``numerics.refinements`` allows, it solves again with s times f =
-    1.2 sqrt(estimate / tolerance), f in [sqrt 2, 2] (``refinements``,
-    ``band_resolution_used`` record it), within the scene's time budget.
+    ``ZONE_RESOLUTION`` and at least 1 (1 at the fast and balanced presets); where the
+    estimate exceeds ``pull_off_rtol`` and ``numerics.refinements`` allows, it solves again
+    with s times f = 1.2 sqrt(estimate / tolerance), f in [sqrt 2, 2] (``refinements``,
+    ``band_resolution_used`` record it), within ``max_nodes`` and the scene's time budget.
     """
     if numerics is None:
         numerics = Numerics.preset("balanced")
@@ -489,8 +489,6 @@ def simulate_elastic(scene, numerics=None):
 def _simulate_elastic(scene, numerics, scale: float):
     """:func:`simulate_elastic` at the resolution ``scale`` times the branch's default."""
     mesh = {"zone_resolution": ZONE_RESOLUTION * scale, "coarse": COARSE / scale}
-    if numerics is None:
-        numerics = Numerics.preset("balanced")
     t0 = time.perf_counter()
     res = Result(scene=scene, numerics=numerics)
     if scene.k != 1.0:
