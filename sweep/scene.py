@@ -811,6 +811,19 @@ class Numerics:
 #: every id) must raise this number and teach :mod:`sweep.campaign.store` to migrate older files.
 SCENE_ID_VERSION = 1
 
+#: Revision of the engine's numbers for an unchanged scene id, recorded in every results row
+#: (column ``engine_revision``; rows written before it have none: revision 1). Revision 1:
+#: the hereditary BEM's load left out the Lennard-Jones attraction beyond its mesh
+#: (visco-sweep 0.2.0 and earlier); revision 2: that tail is in every load
+#: (``Numerics.lj_tail``), pull-offs up to about 3e-4 higher (docs/design.md, "Meshes").
+#: Raise it, and say what changed in :data:`REVISION_CHANGES`, where the numbers of unchanged
+#: ids move by design; resuming a file with rows of an earlier revision says so.
+ENGINE_REVISION = 2
+
+#: What each earlier engine revision computed otherwise than :data:`ENGINE_REVISION`
+REVISION_CHANGES = {1: "loads without the Lennard-Jones tail beyond the mesh: pull-offs up to "
+                       "about 3e-4 lower"}
+
 #: The fields of Scene and Numerics when ids were introduced (version 1). They are always
 #: part of the id, so that the ids of files written then stay what they were.
 ID_V1_FIELDS = {

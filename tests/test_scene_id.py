@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 import shutil
 
@@ -20,8 +21,8 @@ from sweep import Numerics, Scene, scene_id
 from sweep.cli import main
 from sweep.errors import InputError
 from sweep.campaign.config import parse_config
-from sweep.scene import SCENE_ID_VERSION, axis
-from sweep.campaign.scheduler import run_sweep
+from sweep.scene import ENGINE_REVISION, SCENE_ID_VERSION, axis
+from sweep.campaign.scheduler import older_revision_rows, run_sweep
 from sweep.campaign.store import load, load_trajectory, read_attrs, recorded_numerics
 
 V1_FILE = reference.DATA / "results_v1.h5"
@@ -118,6 +119,27 @@ def test_version_1_file_resumes_with_nothing_recomputed(tmp_path):
     report = run_sweep(cfg, jobs=1, out=path, simulate=_must_not_run, progress="none")
     assert (report.total, report.skipped, report.ran) == (3, 3, 0)
     assert sorted(load(path).scene_id) == sorted(load(V1_FILE).scene_id)
+
+
+def test_rows_of_an_earlier_engine_revision_are_kept_and_named_on_resume(tmp_path):
+    # the v1 file's rows were computed without the Lennard-Jones tail (revision 1, no
+    # engine_revision column): resuming keeps them and says so in one line; rows run now
+    # record this engine's revision
+    path = tmp_path / "v1.h5"
+    shutil.copyfile(V1_FILE, path)
+    text = read_attrs(path)["config_text"].replace("n: [0.4, 1.6]", "n: [0.4, 1.0, 1.6]")
+    pinned = text.replace("numerics: {preset: fast, nodes: 80}",
+                          "numerics: " + json.dumps(recorded_numerics(path).to_dict()))
+    stream = io.StringIO()
+    run_sweep(parse_config(pinned), jobs=1, out=path, simulate=_fake, progress="log",
+              stream=stream)
+    said = [ln for ln in stream.getvalue().splitlines() if "earlier engine" in ln]
+    assert len(said) == 1 and "3 of revision 1 (loads without the Lennard-Jones tail" in said[0]
+    assert f"this engine is revision {ENGINE_REVISION}" in said[0]
+    df = load(path)
+    assert df.engine_revision.isna().sum() == 3
+    assert list(df.engine_revision.dropna()) == [ENGINE_REVISION]
+    assert older_revision_rows(df.to_dict("records"), set(df.scene_id)) == {1: 3}
 
 
 def test_a_redefined_preset_is_refused_in_one_line(tmp_path, capsys):

@@ -49,8 +49,9 @@ File contents (plain arrays and text only; no pickles):
   scene: ``scene_id``, the scene parameters, the numerics (``num_*``), every scalar result
   (:data:`sweep.scene.RESULT_SCALARS`, incl. ``status``, ``reason``, ``wall_s``) and the
   scheduler's ``task_wall_s`` and ``task_cpu_s`` (wall and CPU seconds of the task in its
-  worker; CPU well below wall means a loaded machine), ``worker`` (host:pid) and
-  ``finished_at`` (unix time).
+  worker; CPU well below wall means a loaded machine), ``worker`` (host:pid),
+  ``finished_at`` (unix time) and ``engine_revision`` (:data:`sweep.scene.ENGINE_REVISION`;
+  absent, NaN, in rows written before it was recorded, which are revision 1).
 * ``/trajectories/<scene_id>/{t, delta, P, a, a_inner}`` when the config asks for them.
 * File attributes: ``format``, ``format_version``, ``config_name``, ``config_hash``,
   ``config_text``, ``config_source``, ``package_version``, ``git_commit``, ``numba_version``,
