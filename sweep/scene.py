@@ -821,8 +821,8 @@ SCENE_ID_VERSION = 1
 ENGINE_REVISION = 2
 
 #: What each earlier engine revision computed otherwise than :data:`ENGINE_REVISION`
-REVISION_CHANGES = {1: "loads without the Lennard-Jones tail beyond the mesh: pull-offs up to "
-                       "about 3e-4 lower"}
+REVISION_CHANGES = {1: "loads without the Lennard-Jones tail beyond the mesh: pull-offs lower, "
+                       "by up to about 3e-4 on the default domain"}
 
 #: The fields of Scene and Numerics when ids were introduced (version 1). They are always
 #: part of the id, so that the ids of files written then stay what they were.

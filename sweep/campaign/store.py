@@ -85,7 +85,8 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError
-from ..scene import SCENE_AXES, SCENE_ID_VERSION, TABLE_MATERIAL, Numerics
+from ..scene import (ENGINE_REVISION, REVISION_CHANGES, SCENE_AXES, SCENE_ID_VERSION,
+                     TABLE_MATERIAL, Numerics)
 from .config import parse_config
 from .si import si_row
 
@@ -1039,6 +1040,15 @@ def summary(path, slowest: int = 5) -> str:
     if len(df) and "status" in df:
         counts = df["status"].value_counts()
         lines.append("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    if len(df):
+        revision = (np.nan_to_num(df["engine_revision"].to_numpy(float), nan=1.0)
+                    if "engine_revision" in df else np.ones(len(df))).astype(int)
+        if (revision != ENGINE_REVISION).any():
+            older = np.unique(revision[revision != ENGINE_REVISION], return_counts=True)
+            kept = ", ".join(f"{v} of revision {k} ({REVISION_CHANGES.get(int(k), 'other numbers')})"
+                             for k, v in zip(*older))
+            lines.append(f"  engine: rows of an earlier engine than this one (revision "
+                         f"{ENGINE_REVISION}): {kept}")
     varying, fixed = [], []
     # n is unused where every material is a Prony table (its value is bookkeeping)
     tables = (len(df) and "material" in df
