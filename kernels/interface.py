@@ -39,6 +39,28 @@ def lj_traction_and_stiffness(h, h0, c, sig, dsig):
 
 
 @njit(cache=True)
+def tail_load(h_end, h0, c):
+    """The load of the Lennard-Jones attraction beyond a mesh whose traction ends where the
+    gap is ``h_end`` (the end of the last node's hat), the gap continued there as the rigid
+    sphere's, dh = r dr:
+
+        P_tail = 2 pi int_{h_end}^inf sigma_LJ(h) dh = -2 pi c h0 (q^2/2 - q^8/8),  q = h0/h_end
+
+    (pi dg R units; negative: tensile). The BEM's load (:func:`kernels.solve.load`) adds
+    it; the quasi-static elastic branch (``sweep.engine.quasistatic.ElasticBranch.load``),
+    which had the same formula first, keeps its own order of operations (its results bitwise
+    as before). Beyond the mesh the
+    interface is the Lennard-Jones law: a process zone acts at the crack tip, far inside,
+    and its factor m is taken as 1 there. ``h_end`` = inf gives 0 (no tail). Without it the
+    BEM's pull-off was low by about (1/tail_gap)^2 relative (about 2.8e-4 at the default
+    tail_gap = 60)."""
+    q = h0 / h_end
+    q2 = q * q
+    q8 = q2 * q2 * q2 * q2
+    return -2.0 * np.pi * c * h0 * (0.5 * q2 - 0.125 * q8)
+
+
+@njit(cache=True)
 def crossing_radius(h, r, level):
     """Outermost radius where the gap equals ``level`` (linear interpolation between nodes).
 

@@ -9,7 +9,7 @@ delta at which the equilibrium of the step carries the preload. Solved as one sy
 nodal gaps h and the indentation change s from a guess delta (docs/design.md section 4):
 
     F(h, s) = h - g + s - A [ C_eff sigma(h) - H ] = 0,     g = -delta + h0 + r^2/2,
-    G(h)    = 2 pi wP . sigma(h) - P* = 0,
+    G(h)    = P(h) - P* = 0,     P(h) = 2 pi wP . sigma(h) + P_tail(h_N),
 
 (dF/ds = 1 at every node). With J the Jacobian of F in h (:mod:`kernels.jacobian`, its kept
 factorization), x = -J^-1 F and y = J^-1 1, the Newton update is dh = x - y ds with
@@ -17,7 +17,10 @@ factorization), x = -J^-1 F and y = J^-1 1, the Newton update is dh = x - y ds w
     ds = (2 pi wP . (sigma' x) + P - P*) / (2 pi wP . (sigma' y))
 
 (the bordered system eliminated: two solves with one factorization). One solve of the step
-instead of a secant of two or three solves on delta.
+instead of a secant of two or three solves on delta. P_tail is the Lennard-Jones attraction
+beyond the mesh (:func:`kernels.solve.load`); its derivative, in the last node's gap alone
+and about 2 pi c / tail_gap^3, is left out of ds's denominator and numerator (Newton's
+G converges with it left out: G itself includes the tail).
 
 The march's starts (an extrapolation of the last states) are furthest off at the crack tip,
 where the gap equation is most nonlinear: the node behind an advancing tip lands on the
@@ -121,15 +124,17 @@ def _bordered_update(h, F, A, ceff, law, P, force, wP, cache, stats, y, out):
 
 
 @njit(cache=True)
-def newton_at_load(h, g, A, wP, ceff, H, law, force, tols, max_iter, cache, stats):
+def newton_at_load(h, g, mesh, ceff, H, law, force, tols, max_iter, cache, stats):
     """Solve F(h, s) = 0 and G(h) = 0 (module docstring) in place of ``h`` from ``h`` and
-    s = 0, the gap g of the guessed indentation; ``tols`` = (``max |F|`` in units of d_ref,
-    ``|G|`` in units of pi dg R). Returns (converged, s): the step's indentation is the
-    guess plus s. The cache's factorization is kept and made again where its iteration
-    contracts the residual by less than HELD_SLOW_CONTRACTION (not with the drift-scaled chord,
-    ``state[STATE_SCALED]``: :func:`kernels.solve.newton`); a residual growing by
-    HELD_DIVERGENCE ends the solve unconverged."""
-    N = h.size
+    s = 0, the gap g of the guessed indentation, on the mesh ``mesh``
+    (:data:`kernels.solve.MeshArrays`: the load :func:`kernels.solve.load` of its weights and
+    tail, the Lennard-Jones attraction beyond the mesh included); ``tols`` = (``max |F|`` in
+    units of d_ref, ``|G|`` in units of pi dg R). Returns (converged, s): the step's
+    indentation is the guess plus s. The cache's factorization is kept and made again where
+    its iteration contracts the residual by less than HELD_SLOW_CONTRACTION (not with the
+    drift-scaled chord, ``state[STATE_SCALED]``: :func:`kernels.solve.newton`); a residual
+    growing by HELD_DIVERGENCE ends the solve unconverged."""
+    N, A = h.size, mesh.A
     sig, w, F, dh, y = np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.full(N, np.nan)
     gs = g.copy()
     s = 0.0
@@ -138,11 +143,11 @@ def newton_at_load(h, g, A, wP, ceff, H, law, force, tols, max_iter, cache, stat
     norm = residual(h, gs, A, ceff, H, law, sig, w, F)
     stats[STAT_RESIDUALS] += 1
     for _ in range(max_iter):
-        P = 2.0 * np.pi * np.dot(wP, sig)
+        P = load(sig, mesh.wP, h, mesh.tail, law.h0, law.c)
         if norm <= tols[0] and abs(P - force) <= tols[1]:
             return True, s
         stats[STAT_ITER] += 1
-        ds, ok = _bordered_update(h, F, A, ceff, law, P, force, wP, cache, stats, y, dh)
+        ds, ok = _bordered_update(h, F, A, ceff, law, P, force, mesh.wP, cache, stats, y, dh)
         if not ok:
             return False, s
         lam = positive_step(h, dh)
@@ -341,8 +346,8 @@ def dwell_steps(mesh, physics, law, control, state, out, cache, stats):
         ceff = _step_start(mesh, physics, law, control, state, out.starts, dt, delta,
                            (e, b, H, g, hs), control.origin)
         if control.hold_force:
-            ok, shift = newton_at_load(hs, g, mesh.A, mesh.wP, ceff, H, law, control.force,
-                                       control.tols, control.max_iter, cache, stats)
+            ok, shift = newton_at_load(hs, g, mesh, ceff, H, law, control.force, control.tols,
+                                       control.max_iter, cache, stats)
             delta = delta + shift
         else:
             ok = newton(hs, g, mesh.A, ceff, H, law, control.tols[0], control.max_iter,
@@ -428,7 +433,7 @@ def _accept(mesh, law, state, out, n, e, b, hs, sig, a, dt, delta):
     clock[CLOCK_DT_PREV2], clock[CLOCK_DT_PREV] = clock[CLOCK_DT_PREV], dt
     clock[CLOCK_DELTA], clock[CLOCK_T] = delta, clock[CLOCK_T] + dt
     rec = out.records
-    clock[CLOCK_P] = load(state.sigma, mesh.wP)
+    clock[CLOCK_P] = load(state.sigma, mesh.wP, h, mesh.tail, law.h0, law.c)
     rec[0, n], rec[1, n], rec[2, n] = clock[CLOCK_T], delta, clock[CLOCK_P]
     rec[3, n], rec[4, n] = a, crossing_radius(h, mesh.r, law.h0)
     ring = int(clock[CLOCK_RING])
@@ -506,7 +511,7 @@ def approach_steps(mesh, physics, law, control, state, out, cache, stats):
         if moved > control.da_max and not smallest:
             clock[CLOCK_DT] = max(0.5 * dd, control.dd_min)
             continue
-        if load(sig, mesh.wP) > control.preload:
+        if load(sig, mesh.wP, hs, mesh.tail, law.h0, law.c) > control.preload:
             for i in range(N):
                 out.h[i], out.sigma[i] = hs[i], sig[i]
             return APPROACH_PASSED, n

@@ -19,11 +19,12 @@ without evaluating it (PREDICTED_RESIDUAL).
 
 A compliant machine (a spring of stiffness K in series with the sphere, Physics.compliance
 = 1/K, 0 for a rigid one) drives its own displacement D; the sphere's indentation is
-delta = D - P(h)/K with P(h) = 2 pi wP . sigma(h), so that
+delta = D - P(h)/K with P(h) = 2 pi wP . sigma(h) + P_tail (:func:`load`), so that
 
     F(h) = h - g(D) - P(h)/K - A [ C_eff sigma(h) - H ] = 0
 
-and the Jacobian gains the rank-one term -(1/K) 1 (dP/dh)^T, dP/dh = 2 pi wP o sigma'(h):
+and the Jacobian gains the rank-one term -(1/K) 1 (dP/dh)^T, dP/dh = 2 pi wP o sigma'(h)
+(the tail's derivative, in the last node's gap alone, left out: :func:`load`):
 Newton's direction is the kept factorization's with the Sherman-Morrison correction
 (:func:`machine_direction`, one more solve, of J^-1 1, per direction). The loop's
 indentation (RUN_DELTA) is then D; the records' delta is the sphere's, D - P/K. With
@@ -63,7 +64,7 @@ from numba import njit
 from .blas import lu_factor, lu_solve
 from .history import history_vector, step_coefficients, update_modes
 from .interface import (TIP_GAP, ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_XI, Interface,
-                        crossing_radius, lj_traction, smoothing_rate, traction,
+                        crossing_radius, lj_traction, smoothing_rate, tail_load, traction,
                         traction_and_stiffness)
 # invalidate and new_jacobian_cache are re-exported: the callers of newton/unload make the cache
 from .clock import past
@@ -99,8 +100,15 @@ N_STATS = 13
 # ------------------------------------------------------------------ the kernel's inputs
 
 #: the mesh: A (N, N) influence matrix (scaled by the spacing), r (N,) node positions
-#: (a_ref units, r[0] = 0), wP (N,) load weights (P = 2 pi wP . sigma)
-MeshArrays = namedtuple("MeshArrays", ["A", "r", "wP"])
+#: (a_ref units, r[0] = 0), wP (N,) load weights (P = 2 pi wP . sigma + the tail, :func:`load`),
+#: tail = (r_end^2 - r_last^2)/2 the rigid gap's rise from the last node to the end of its hat,
+#: r_end = 2 r_last - r_(last-1) (``sweep.engine.mesh.Mesh.tail_rise``; inf: no tail)
+MeshArrays = namedtuple("MeshArrays", ["A", "r", "wP", "tail"])
+
+#: the machine a solve loads the sphere through: its compliance (1/K, 0 a rigid machine) and
+#: what the load the spring carries needs, the mesh's weights wP and tail (:data:`MeshArrays`,
+#: :func:`load`); one argument of :func:`newton_machine`, :func:`relax_machine`
+Machine = namedtuple("Machine", ["compliance", "wP", "tail"])
 
 #: the scene's laws and loading (dimensionless, docs/design.md section 2): h0 and c of the
 #: Lennard-Jones law, the Prony modes (weights, times) of Chat (times may be inf: a lumped
@@ -386,14 +394,16 @@ def residual(h, g, A, ceff, H, law, sig, w, F):
 
 
 @njit(cache=True, inline='always')
-def machine_residual(h, g, A, ceff, H, law, compliance, wP, sig, w, F):
-    """:func:`residual` with a compliant machine: F - compliance P(h), P = 2 pi wP . sigma
-    (the indentation is D - compliance P, ``g`` that of D); exactly :func:`residual` for
-    ``compliance`` 0. Returns max |F|."""
+def machine_residual(h, g, A, ceff, H, law, machine, sig, w, F):
+    """:func:`residual` with a compliant machine (:data:`Machine`): F - compliance P(h),
+    P = 2 pi wP . sigma + the Lennard-Jones tail beyond the mesh (:func:`load`) (the
+    indentation is D - compliance P, ``g`` that of D); exactly :func:`residual` for
+    compliance 0. Returns max |F|."""
     norm = residual(h, g, A, ceff, H, law, sig, w, F)
+    compliance = machine.compliance
     if compliance == 0.0:
         return norm
-    cP = compliance * load(sig, wP)
+    cP = compliance * load(sig, machine.wP, h, machine.tail, law.h0, law.c)
     norm = 0.0
     for i in range(h.size):
         F[i] -= cP
@@ -407,7 +417,11 @@ def machine_direction(dh, d, A, compliance, wP, cache):
     """Newton's direction ``dh`` = -J^-1 F of the kept factorization corrected in place for a
     compliant machine, whose Jacobian is J - compliance 1 v^T with v = dP/dh = 2 pi wP o
     sigma'(h) (``d``): by Sherman-Morrison, dh + compliance y (v . dh) / (1 - compliance
-    v . y) with y = J^-1 1. False where the denominator vanishes (the spring's fold)."""
+    v . y) with y = J^-1 1. False where the denominator vanishes (the spring's fold).
+    The tail of the load beyond the mesh (:func:`load`) is left out of v: its derivative,
+    in the last node's gap alone, is 2 pi c (q^3 - q^9), q = h0/h_end, about 2 pi c / 60^3
+    at the default tail_gap, against v's entries of order 2 pi wP_j c at the crack tip;
+    Newton converges with it left out (its residual includes the tail)."""
     y = apply_inverse(np.ones(dh.size), A, cache)
     vy, vdh = 0.0, 0.0
     for i in range(dh.size):
@@ -454,7 +468,7 @@ def _refactorize(h, A, ceff, law, cache, stats, reason):
 
 
 @njit(cache=True, inline='always')
-def _direction(h, F, A, ceff, law, compliance, wP, sig, d, dr, cache, stats):
+def _direction(h, F, A, ceff, law, machine, sig, d, dr, cache, stats):
     """Newton's direction at ``h`` (residual ``F``) with the cached factorization, made again
     once when it no longer fits (the crack tip left the zone), corrected for a compliant
     machine (:func:`machine_direction`). Returns (dh, ok, refactorized); ok is False when
@@ -466,8 +480,8 @@ def _direction(h, F, A, ceff, law, compliance, wP, sig, d, dr, cache, stats):
         _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_ZONE)
         dh, ok = newton_direction(F, d, dr, A, ceff, cache, stats, STAT_ZONE)
         refactorized = True
-    if ok and compliance != 0.0:
-        ok = machine_direction(dh, d, A, compliance, wP, cache)
+    if ok and machine.compliance != 0.0:
+        ok = machine_direction(dh, d, A, machine.compliance, machine.wP, cache)
     return dh, ok, refactorized
 
 
@@ -486,15 +500,16 @@ def newton(h, g, A, ceff, H, law, tol, max_iter, cache, stats):
     """Solve F(h) = 0 in place, starting from ``h``, with the interface law ``law``
     (:data:`kernels.interface.Interface`) and a rigid machine: :func:`newton_machine` with
     compliance 0. Returns True on convergence."""
-    return newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, 0.0,
-                          np.zeros(h.size))
+    return newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats,
+                          Machine(0.0, np.zeros(h.size), np.inf))
 
 
 @njit(cache=True)
-def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, compliance, wP):
+def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, machine):
     """Solve F(h) = 0 in place from ``h`` with the interface law ``law``
-    (:data:`kernels.interface.Interface`) and a machine of compliance ``compliance`` (1/K;
-    0 rigid), load weights ``wP`` (:func:`machine_residual`, :func:`machine_direction`).
+    (:data:`kernels.interface.Interface`) and the :data:`Machine` ``machine``: its compliance
+    (1/K; 0 rigid), the load's weights and the mesh's tail (:func:`load`)
+    (:func:`machine_residual`, :func:`machine_direction`).
     True on convergence; False past the cache's deadline (read before every iteration,
     :func:`kernels.jacobian.set_deadline`). The cache's factorization is reused, its crack-tip
     zone kept exact (:func:`kernels.jacobian.newton_direction`); it is rebuilt when the crack
@@ -512,7 +527,7 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
     N = h.size
     sig, d, dr, w = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
     F, Ft, ht = np.empty(N), np.empty(N), np.empty(N)
-    norm = machine_residual(h, g, A, ceff, H, law, compliance, wP, sig, w, F)
+    norm = machine_residual(h, g, A, ceff, H, law, machine, sig, w, F)
     stats[STAT_RESIDUALS] += 1
     if norm <= tol:
         return True
@@ -527,8 +542,8 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
         if state[STATE_EXACT] == 1 and not fresh:
             _refactorize(h, A, ceff, law, cache, stats, STAT_REFACTOR_RETRY)
             fresh = True
-        dh, ok, refactorized = _direction(h, F, A, ceff, law, compliance, wP, sig, d, dr,
-                                          cache, stats)
+        dh, ok, refactorized = _direction(h, F, A, ceff, law, machine, sig, d, dr, cache,
+                                          stats)
         fresh = fresh or refactorized
         if not ok:       # singular even on a fresh factorization: give up
             return False
@@ -545,7 +560,7 @@ def newton_machine(h, g, A, ceff, H, law, tol, max_iter, cache, stats, complianc
         for _ls in range(LINE_SEARCH_STEPS):
             for i in range(N):
                 ht[i] = h[i] + lam * dh[i]
-            nt = machine_residual(ht, g, A, ceff, H, law, compliance, wP, sig, w, Ft)
+            nt = machine_residual(ht, g, A, ceff, H, law, machine, sig, w, Ft)
             stats[STAT_RESIDUALS] += 1
             nt2 = _norm2(Ft)
             if nt2 < (1.0 - ARMIJO * lam) * n2:
@@ -576,12 +591,12 @@ def relax(h, g, A, ceff, H, law, tol, max_iter, stats, deadline):
     """:func:`relax_machine` with a rigid machine (compliance 0), in place; True on success.
     ``deadline``: the kernels' clock time past which it gives up (a Jacobian cache's
     ``cache[CACHE_DEADLINE][0]``; inf: none)."""
-    return relax_machine(h, g, A, ceff, H, law, 0.0, np.zeros(h.size), tol, max_iter, stats,
-                         deadline)
+    return relax_machine(h, g, A, ceff, H, law, Machine(0.0, np.zeros(h.size), np.inf), tol,
+                         max_iter, stats, deadline)
 
 
 @njit(cache=True, inline='always')
-def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats, deadline):
+def relax_machine(h, g, A, ceff, H, law, machine, tol, max_iter, stats, deadline):
     """Pseudo-transient continuation to a *stable* equilibrium, in place; True on success.
 
     Integrates the relaxation dh/dtau = -F(h) with linearly implicit Euler steps,
@@ -591,9 +606,11 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats, d
     stable equilibria. Used where the discrete equilibrium path folds (the crack tip
     snapping from one node to the next), as the physical system would. One dense
     factorization per iteration: a fallback, not the main path. A compliant machine
-    (``compliance`` = 1/K, load weights ``wP``) adds -compliance 2 pi wP_j sigma'_j to every
-    row of J (:func:`machine_residual`). False once ``deadline`` (the kernels' clock,
-    :mod:`kernels.clock`; inf: none) has passed, read before every iteration.
+    (:data:`Machine` ``machine``: compliance = 1/K, the load's weights wP and the mesh's
+    tail) adds -compliance 2 pi wP_j sigma'_j to every row of J (:func:`machine_residual`;
+    the tail's derivative left out, as in :func:`machine_direction`). False once
+    ``deadline`` (the kernels' clock, :mod:`kernels.clock`; inf: none) has passed, read before
+    every iteration.
     """
     N = h.size
     sig = np.empty(N)
@@ -602,7 +619,7 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats, d
     F = np.empty(N)
     Ft = np.empty(N)
     ht = np.empty(N)
-    norm = machine_residual(h, g, A, ceff, H, law, compliance, wP, sig, w, F)
+    norm = machine_residual(h, g, A, ceff, H, law, machine, sig, w, F)
     n2 = _norm2(F)
     dtau = RELAX_DTAU_START
     J = np.empty((N, N))
@@ -621,9 +638,9 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats, d
             for j in range(N):
                 J[i, j] = -ceff * A[i, j] * d[j]
             J[i, i] += 1.0 + 1.0 / dtau
-        if compliance != 0.0:
+        if machine.compliance != 0.0:
             for j in range(N):
-                spring = compliance * 2.0 * np.pi * wP[j] * d[j]
+                spring = machine.compliance * 2.0 * np.pi * machine.wP[j] * d[j]
                 for i in range(N):
                     J[i, j] -= spring
         # LAPACK's LU through kernels.blas (np.linalg.solve: 5 s of a cold compile)
@@ -635,7 +652,7 @@ def relax_machine(h, g, A, ceff, H, law, compliance, wP, tol, max_iter, stats, d
         lam = positive_step(h, dh)
         for i in range(N):
             ht[i] = h[i] + lam * dh[i]
-        nt = machine_residual(ht, g, A, ceff, H, law, compliance, wP, sig, w, Ft)
+        nt = machine_residual(ht, g, A, ceff, H, law, machine, sig, w, Ft)
         nt2 = _norm2(Ft)
         if not np.isfinite(nt2) or nt2 > RELAX_DIVERGENCE * n2:
             dtau *= RELAX_DTAU_CUT
@@ -675,16 +692,24 @@ def snap(mesh, physics, work, ceff, tol, max_iter, hm, cache, stats):
                 hp[i] = h[N - 1] + (h[N - 1] - h[N - 2]) * (i + shift - N + 1)
         if newton_machine(hp, work.g, mesh.A, ceff, work.H,
                           Interface(physics.h0, physics.c, work.ref, work.zone), tol, max_iter,
-                          cache, stats, physics.compliance, mesh.wP):
+                          cache, stats, Machine(physics.compliance, mesh.wP, mesh.tail)):
             if crossing_radius(hp, r, hm) < a_old:
                 return True
     return False
 
 
 @njit(cache=True, inline='always')
-def load(sigma, wP):
-    """P = 2 pi sum_j w_j sigma_j (positive = compressive)."""
-    return 2.0 * np.pi * np.dot(wP, sigma)
+def load(sigma, wP, h, tail, h0, c):
+    """P = 2 pi sum_j w_j sigma_j + P_tail (positive = compressive): the tractions ``sigma``
+    of the gaps ``h`` on the mesh, and the Lennard-Jones attraction beyond its end
+    (:func:`kernels.interface.tail_load`), the gap continued there as the rigid sphere's
+    from the last node's: h_end = h[-1] + ``tail`` (:data:`MeshArrays`; inf: no tail). A
+    process zone's factor is 1 beyond the mesh (it acts at the crack tip, far inside). The
+    tail's derivative (in h[-1] alone, 2 pi c (q^3 - q^9), q = h0/h_end: about 3e-5 c at the
+    default tail_gap 60) is left out of the Newton Jacobians that involve the load (the
+    machine's, :func:`machine_direction`; the held step's, ``kernels.protocol``): Newton
+    converges without it, the residuals include the tail."""
+    return 2.0 * np.pi * np.dot(wP, sigma) + tail_load(h[h.size - 1] + tail, h0, c)
 
 
 @njit(cache=True, inline='always')
@@ -883,7 +908,7 @@ def start_run(mesh, physics, start, records, work, run, hm):
     if start.n == 0:
         records.t[0] = 0.0
         records.delta[0] = start.delta0
-        records.P[0] = load(work.sigma, mesh.wP)
+        records.P[0] = load(work.sigma, mesh.wP, work.h, mesh.tail, h0, physics.c)
         records.a[0] = run[RUN_A]
         records.a_inner[0] = crossing_radius(work.h, r, h0)
         n = 1
@@ -1043,7 +1068,7 @@ def settle_tip(h, g, A, ceff, H, law, lo, hi, iters, wall=0.0):
 
 
 @njit(cache=True)
-def zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, compliance, wP):
+def zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, machine):
     """A process zone's first step by continuation in the zone's strength (ZONE_RAMP_START,
     ZONE_RAMP_FACTOR, ZONE_RAMP_SOLVES): Newton at the opening rate's scale
     ``work.zone[ZONE_RATE]`` times s, s rising from ZONE_RAMP_START to 1, each solve from the
@@ -1059,7 +1084,7 @@ def zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, compliance, w
         _copy(good, hp)
         cache[CACHE_STATE][STATE_VALID] = 0
         if newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
-                          compliance, wP):
+                          machine):
             if s == 1.0:
                 ok = True
                 break
@@ -1093,11 +1118,11 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     max_iter = control.max_iter
     if not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0:
         max_iter *= FIRST_ZONE_ITER
-    compliance, wP = physics.compliance, mesh.wP
+    machine = Machine(physics.compliance, mesh.wP, mesh.tail)
     if run[RUN_ZONE_RAMP] == 1.0 and not run[RUN_DT_PREV] > 0.0:
         run[RUN_ZONE_RAMP] = 2.0
         stats[STAT_FAILED_SOLVES] += 1
-        if zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, compliance, wP):
+        if zone_ramp(hp, work, A, ceff, law, tol, max_iter, cache, stats, machine):
             cache[CACHE_STATE][STATE_EXACT] = 0
             return SOLVED
         return FAILED
@@ -1106,14 +1131,14 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
         settle_tip(hp, work.g, A, ceff, work.H, law, max(tip - ZONE_SETTLE_NODES, 0),
                    min(tip + ZONE_SETTLE_NODES, hp.size), ZONE_SETTLE_ITER)
     ok = newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
-                        compliance, wP)
+                        machine)
     if not ok and cubic:
         # where the path is not smooth (the tip jumping nodes on a coarse mesh) the
         # cubic start can overshoot: again from the quadratic one before the step halves
         stats[STAT_FAILED_SOLVES] += 1
         _copy(work.h_pred, hp)
         ok = newton_machine(hp, work.g, A, ceff, work.H, law, tol, max_iter, cache, stats,
-                            compliance, wP)
+                            machine)
     if ok:
         return SOLVED
     stats[STAT_FAILED_SOLVES] += 1
@@ -1131,7 +1156,7 @@ def solve_step(mesh, physics, control, work, run, cubic, hm, cache, stats):
     if snap(mesh, physics, work, ceff, tol, control.max_iter, hm, cache, stats):
         return SNAPPED
     _copy(work.h, hp)
-    if relax_machine(hp, work.g, A, ceff, work.H, law, compliance, wP, tol, RELAX_MAX_ITER,
+    if relax_machine(hp, work.g, A, ceff, work.H, law, machine, tol, RELAX_MAX_ITER,
                      stats, cache[CACHE_DEADLINE][0]):
         return SNAPPED
     if (not np.isinf(physics.hdot_c) and not run[RUN_DT_PREV] > 0.0
@@ -1203,13 +1228,14 @@ def step_load(mesh, physics, work, quadratic):
     """The load of the solved state ``work.hp`` (its tractions into ``work.sig_new``) and the
     step-error estimate: the relative load error of the quadratic extrapolation, inf
     without one. Returns (P, err)."""
-    h0, c, wP = physics.h0, physics.c, mesh.wP
+    h0, c, wP, tail = physics.h0, physics.c, mesh.wP, mesh.tail
     traction(work.hp, work.ref, work.zone, h0, c, work.sig_new)
-    P = load(work.sig_new, wP)
+    P = load(work.sig_new, wP, work.hp, tail, h0, c)
     if not quadratic:
         return P, np.inf
     traction(work.h_pred, work.ref, work.zone, h0, c, work.sigma_pred)
-    return P, abs(load(work.sigma_pred, wP) - P) / max(abs(P), LOAD_ERROR_FLOOR)
+    return P, abs(load(work.sigma_pred, wP, work.h_pred, tail, h0, c) - P) / max(
+        abs(P), LOAD_ERROR_FLOOR)
 
 
 @njit(cache=True, inline='always')
@@ -1285,7 +1311,7 @@ def unload(mesh, physics, control, start, records, cache, stats):
     Parameters (dimensionless, docs/design.md section 2; steps and tolerances in units of
     h0, converted to d_ref where used)
     ----------
-    mesh : MeshArrays (A, r, wP).
+    mesh : MeshArrays (A, r, wP, tail).
     physics : Physics (h0, c, weights, times, rate, hdot_c, xi, compliance).
     control : StepControl (step_max, step_min, da_max, step_tol, tol, max_iter, max_steps,
         stop_mode, min_travel, tip_lo, tip_hi, da_max_pulloff, pulloff_zone).

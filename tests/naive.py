@@ -31,6 +31,14 @@ Load P = 2 pi sum_j w_j p_j with w_j = int phi_j(r) r dr EXACT for the piecewise
 w_0 = dr^2/6, w_j = j dr^2 (interior), w_{N-1} = dr^2 ((N-2)/2 + 1/3) for the half hat
 (w_{N-1} = (N-1) dr^2 for tail="full").
 
+``lj_tail=True`` adds the Lennard-Jones attraction beyond the traction's end r_end (r_{N-1} for
+tail="half", r_N for tail="full") to P, the gap continued there as the rigid sphere's,
+h(r) = h_{N-1} + (r^2 - r_{N-1}^2)/2, so dh = r dr and
+P_tail = 2 pi int_{h_end}^inf sigma_LJ(h) dh, h_end = h(r_end), by quad in x = h0/h on [0, h0/h_end].
+It changes P only (not the equations: displacement control). Default off (the independent
+references of tests/data/independent_solutions.yaml drop it); the engine has it by default
+(``Numerics.lj_tail``).
+
 Solvers
 -------
 Dense Newton on the gap (numpy.linalg.solve), residual
@@ -98,6 +106,7 @@ __all__ = [
     "naive_elastic",
     "naive_elastic_pulloff",
     "naive_unload",
+    "lj_tail_load",
 ]
 
 NEWTON_TOL = 1e-10
@@ -490,13 +499,32 @@ def _mesh(N, dr):
     return np.arange(N, dtype=float) * dr
 
 
-def _state(r, h, mu, w, sigma=None):
+def _r_end(r, tail):
+    """End of the traction: the last node (half hat) or one spacing beyond (full triangle)."""
+    return float(r[-1]) if tail == "half" else float(2.0 * r[-1] - r[-2])
+
+
+def lj_tail_load(h_last, r_last, r_end, mu):
+    """2 pi int_{h_end}^inf sigma_LJ dh beyond r_end, the gap continued rigidly from the last
+    node (h_end = h_last + (r_end^2 - r_last^2)/2), by quad in x = h0/h (dh = -h0 dx / x^2)."""
+    h0 = lj_h0(mu)
+    h_end = h_last + 0.5 * (r_end**2 - r_last**2)
+    val, err = integrate.quad(lambda x: float(lj_traction(h0 / x, mu)) * h0 / x**2,
+                              0.0, h0 / h_end, epsabs=0.0, epsrel=1e-13, limit=200)
+    return 2.0 * math.pi * val
+
+
+def _state(r, h, mu, w, sigma=None, r_end=None):
+    """The state's record; ``r_end`` (not None): P with the Lennard-Jones tail beyond it."""
     if sigma is None:
         sigma = lj_traction(h, mu)
+    P = float(2.0 * math.pi * np.dot(w, sigma))
+    if r_end is not None:
+        P += lj_tail_load(float(h[-1]), float(r[-1]), r_end, mu)
     return dict(
         gap=h,
         sigma=sigma,
-        P=float(2.0 * math.pi * np.dot(w, sigma)),
+        P=P,
         a=radius_at_gap(r, h, lj_hm(mu)),
         a_inner=radius_at_gap(r, h, lj_h0(mu)),
     )
@@ -514,11 +542,12 @@ def _elastic_start(A, r, mu, delta):
     return h
 
 
-def naive_elastic(mu, delta, N, dr, h_init=None, tail="half"):
+def naive_elastic(mu, delta, N, dr, h_init=None, tail="half", lj_tail=False):
     """Relaxed elastic LJ equilibrium at indentation ``delta``.
 
     Returns dict(gap, sigma, P, a, a_inner, r). Starts from ``h_init`` if given, else from the
     JKR gap (see module docstring); :func:`solve_gap` (Newton, relaxation on failure).
+    ``lj_tail``: P with the Lennard-Jones attraction beyond the mesh (module docstring).
     """
     mu = check_positive("mu", mu)
     delta = check_range("delta", delta)
@@ -529,7 +558,7 @@ def naive_elastic(mu, delta, N, dr, h_init=None, tail="half"):
         h = _elastic_start(A, r, mu, delta)
     else:
         h, _, _ = _elastic_solve(A, r, mu, delta, h_init)
-    out = _state(r, h, mu, w)
+    out = _state(r, h, mu, w, r_end=_r_end(r, tail) if lj_tail else None)
     out["r"] = r
     return out
 
@@ -553,7 +582,8 @@ def _parabola_min(x, y):
     return float(xv), float(np.polyval([c2, c1, c0], xv))
 
 
-def naive_elastic_pulloff(mu, N, dr, step, a_start=2.0, tail="half", recover=0.05):
+def naive_elastic_pulloff(mu, N, dr, step, a_start=2.0, tail="half", recover=0.05,
+                          lj_tail=False):
     """Quasi-static elastic (Chat = 1) unloading under displacement control.
 
     Starts from the LJ solution at delta = jkr_delta(a_start) and decreases delta by
@@ -563,7 +593,7 @@ def naive_elastic_pulloff(mu, N, dr, step, a_start=2.0, tail="half", recover=0.0
     steps), or a -> 0.
     Pull-off = |min P|, refined by the parabola through the three samples around the minimum
     (as a function of delta). Returns dict(pull_off, delta_pulloff, a_pulloff, delta, P, a,
-    a_inner, stop).
+    a_inner, stop). ``lj_tail``: P with the Lennard-Jones attraction beyond the mesh.
     """
     mu = check_positive("mu", mu)
     step = check_positive("step", step)
@@ -576,8 +606,9 @@ def naive_elastic_pulloff(mu, N, dr, step, a_start=2.0, tail="half", recover=0.0
     D, P, Ar, Ai = [], [], [], []
     stop = "max_steps"
     snaps = []
+    r_end = _r_end(r, tail) if lj_tail else None
     for _ in range(100000):
-        s = _state(r, h, mu, w)
+        s = _state(r, h, mu, w, r_end=r_end)
         D.append(delta); P.append(s["P"]); Ar.append(s["a"]); Ai.append(s["a_inner"])
         if _recovered(P, recover):
             stop = "recovered"
@@ -626,7 +657,7 @@ def _crack_speed(t, a, t_star, a_star, dr, width=3.0, min_points=5):
 
 
 def naive_unload(n, k, mu, delta0, rate, N, dr, step, material="mpl", tail="half",
-                 recover=0.05, max_steps=200000, min_dt_fraction=1.0 / 64):
+                 recover=0.05, max_steps=200000, min_dt_fraction=1.0 / 64, lj_tail=False):
     """Viscoelastic unloading from a fully relaxed contact at delta0 (exact hereditary integral).
 
     Parameters
@@ -639,6 +670,7 @@ def naive_unload(n, k, mu, delta0, rate, N, dr, step, material="mpl", tail="half
     Each step: :func:`solve_gap` (Newton from the previous gap; relaxation at a fold, step index
     recorded in ``snaps``). If that fails too, the step is retried with halved dt (down to
     ``min_dt_fraction`` of the nominal step); then the run stops with stop="newton".
+    ``lj_tail``: P with the Lennard-Jones attraction beyond the mesh (module docstring).
 
     Returns dict(pull_off, t_pulloff, delta_pulloff, a_pulloff, a_inner_pulloff, crack_speed,
     a0, a0_inner, P0, t, delta, P, a, a_inner, stop, steps, newton_iterations).
@@ -659,8 +691,9 @@ def naive_unload(n, k, mu, delta0, rate, N, dr, step, material="mpl", tail="half
     h0 = lj_h0(mu)
     base = h0 + r**2 / 2.0
 
+    r_end = _r_end(r, tail) if lj_tail else None
     h = _elastic_start(A, r, mu, delta0)
-    s0 = _state(r, h, mu, w)
+    s0 = _state(r, h, mu, w, r_end=r_end)
     T, D, P, Ar, Ai = [0.0], [delta0], [s0["P"]], [s0["a"]], [s0["a_inner"]]
     sig = [s0["sigma"]]
     dt_nom = step / rate
@@ -688,7 +721,7 @@ def naive_unload(n, k, mu, delta0, rate, N, dr, step, material="mpl", tail="half
         if snapped:
             snaps.append(len(T))
         h = h_new
-        s = _state(r, h, mu, w)
+        s = _state(r, h, mu, w, r_end=r_end)
         T.append(t_new); D.append(d_new); P.append(s["P"]); Ar.append(s["a"]); Ai.append(s["a_inner"])
         sig.append(s["sigma"])
         if _recovered(P, recover):

@@ -9,17 +9,20 @@
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 import shutil
 
 import h5py
+import pytest
 
 from tests import reference
 from sweep import Numerics, Scene, scene_id
 from sweep.cli import main
+from sweep.errors import InputError
 from sweep.campaign.config import parse_config
-from sweep.scene import SCENE_ID_VERSION, axis
-from sweep.campaign.scheduler import run_sweep
+from sweep.scene import ENGINE_REVISION, SCENE_ID_VERSION, axis
+from sweep.campaign.scheduler import older_revision_rows, run_sweep
 from sweep.campaign.store import load, load_trajectory, read_attrs, recorded_numerics
 
 V1_FILE = reference.DATA / "results_v1.h5"
@@ -56,6 +59,20 @@ def test_a_defaulted_new_field_renames_no_scene():
         assert scene_id(moved, numerics) != case["id"]
 
 
+def test_the_lennard_jones_tail_switch_keeps_every_id_at_its_default():
+    # Numerics.lj_tail (added with the tail, session 49) is not in an id at its default True;
+    # False, the truncated model, is another scene; it is a bool
+    for case in _recorded():
+        numerics = Numerics(**case["numerics"])
+        assert numerics.lj_tail is True
+        assert scene_id(Scene(**case["scene"]), numerics) == case["id"]
+        truncated = dataclasses.replace(numerics, lj_tail=False)
+        assert scene_id(Scene(**case["scene"]), truncated) != case["id"]
+    for bad in ("no", 0, None):
+        with pytest.raises(InputError, match="lj_tail must be true or false"):
+            Numerics(lj_tail=bad)
+
+
 def _pinned_config(path):
     """The file's config with its preset replaced by the numerics its rows were run with
     (the presets were redefined when the graded mesh came; explicit numerics keep ids)."""
@@ -89,6 +106,9 @@ def test_version_1_file_loads_and_shows_in_info(capsys):
     assert main(["info", str(V1_FILE)]) == 0
     out = capsys.readouterr().out
     assert "scenes: 3 finished of 3" in out and "material: mpl, sls" in out
+    # its rows were computed without the Lennard-Jones tail, and info says so
+    assert ("engine: rows of an earlier engine than this one (revision 2): 3 of revision 1 "
+            "(loads without the Lennard-Jones tail beyond the mesh") in out
 
 
 def _must_not_run(scene, numerics):
@@ -102,6 +122,27 @@ def test_version_1_file_resumes_with_nothing_recomputed(tmp_path):
     report = run_sweep(cfg, jobs=1, out=path, simulate=_must_not_run, progress="none")
     assert (report.total, report.skipped, report.ran) == (3, 3, 0)
     assert sorted(load(path).scene_id) == sorted(load(V1_FILE).scene_id)
+
+
+def test_rows_of_an_earlier_engine_revision_are_kept_and_named_on_resume(tmp_path):
+    # the v1 file's rows were computed without the Lennard-Jones tail (revision 1, no
+    # engine_revision column): resuming keeps them and says so in one line; rows run now
+    # record this engine's revision
+    path = tmp_path / "v1.h5"
+    shutil.copyfile(V1_FILE, path)
+    text = read_attrs(path)["config_text"].replace("n: [0.4, 1.6]", "n: [0.4, 1.0, 1.6]")
+    pinned = text.replace("numerics: {preset: fast, nodes: 80}",
+                          "numerics: " + json.dumps(recorded_numerics(path).to_dict()))
+    stream = io.StringIO()
+    run_sweep(parse_config(pinned), jobs=1, out=path, simulate=_fake, progress="log",
+              stream=stream)
+    said = [ln for ln in stream.getvalue().splitlines() if "earlier engine" in ln]
+    assert len(said) == 1 and "3 of revision 1 (loads without the Lennard-Jones tail" in said[0]
+    assert f"this engine is revision {ENGINE_REVISION}" in said[0]
+    df = load(path)
+    assert df.engine_revision.isna().sum() == 3
+    assert list(df.engine_revision.dropna()) == [ENGINE_REVISION]
+    assert older_revision_rows(df.to_dict("records"), set(df.scene_id)) == {1: 3}
 
 
 def test_a_redefined_preset_is_refused_in_one_line(tmp_path, capsys):

@@ -5,7 +5,8 @@ chord-Newton solve per step (linear predictor from the last two states, one LU f
 reused while the residual falls at least by half per iteration, refactorized otherwise), the
 exact hereditary integral (closed-form integrated compliance, traction piecewise linear in
 time, O(steps^2 N) in all; with equal steps the lags are multiples of the step and Psi is
-tabulated once per lag) and a fixed indentation step.
+tabulated once per lag), a fixed indentation step, and the load's Lennard-Jones tail beyond
+the mesh in closed form, as the engine's (``Numerics.lj_tail``).
 
 It shares the engine's discretization of space (the overlapping-triangle influence matrix of
 ``kernels.influence`` on the same domain, the same load weights), so on a fine mesh both
@@ -70,6 +71,14 @@ class PlainResult:
 @lru_cache(maxsize=8)
 def _unit_matrix(N: int) -> np.ndarray:
     return assemble_unit(int(N))
+
+
+def _tail(h_last, rise, h0, c):
+    """The Lennard-Jones load beyond the mesh: 2 pi int sigma r dr from the end of the last
+    node's hat (r_end = N dr) to infinity, the gap continued rigidly (h = h_last + (r^2 -
+    r_last^2)/2, so r dr = dh): 2 pi int_{h_end}^inf sigma dh with h_end = h_last + rise."""
+    q = h0 / (h_last + rise)
+    return -2.0 * math.pi * c * h0 * (q**2 / 2.0 - q**8 / 8.0)
 
 
 def _lj(h, h0, c):
@@ -168,6 +177,10 @@ def plain_unload(scene: Scene, nodes: int, domain: float, step: float,
     h0, c = units.h0_hat(scene.mu), units.lj_prefactor(scene.mu)
     hm = 3.0 ** (1.0 / 6.0) * h0
     r = np.arange(N) * dr
+    rise = 0.5 * ((N * dr) ** 2 - r[-1] ** 2)     # from the last node to its hat's end
+
+    def load(sigma, h):
+        return float(wP @ sigma) + _tail(float(h[-1]), rise, h0, c)
     eye = np.eye(N)
     psi = _integrated_compliance(scene)
     counts = {"factorizations": 0, "newton_iterations": 0}
@@ -194,7 +207,7 @@ def plain_unload(scene: Scene, nodes: int, domain: float, step: float,
         return done("failed", "initial state: no convergence")
     sigma = _lj(h, h0, c)[0]
     sigma0 = sigma.copy()
-    P, a = [float(wP @ sigma)], [_crossing(h, dr, hm)]
+    P, a = [load(sigma, h)], [_crossing(h, dr, hm)]
     dsig, dts = [], []
     dd_nominal = step * h0
     h_prev, dd_prev = None, dd_nominal        # linear predictor from the last two states
@@ -231,7 +244,7 @@ def plain_unload(scene: Scene, nodes: int, domain: float, step: float,
         uniform = uniform and dd == dd_nominal
         h, sigma, delta = h_new, sig_new, delta - dd
         T.append(t_new)
-        P.append(float(wP @ sigma))
+        P.append(load(sigma, h))
         a.append(_crossing(h, dr, hm))
         if a[-1] >= (N - 1) * dr:
             return done("failed", "contact reached the mesh edge")

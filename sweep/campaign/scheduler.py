@@ -56,7 +56,7 @@ from tqdm import tqdm
 
 from .config import SweepConfig, as_config
 from ..errors import InputError, check_int, check_range
-from ..scene import Result
+from ..scene import ENGINE_REVISION, REVISION_CHANGES, Result
 from . import spool
 from .store import ResultStore, StoreBusyError, plain_row
 from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
@@ -147,6 +147,24 @@ def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
     _WORKER_READY = True
 
 
+def older_revision_rows(rows, ids) -> dict[int, int]:
+    """Rows among ``ids`` computed by an earlier engine revision than this one
+    (:data:`sweep.scene.ENGINE_REVISION`), counted by revision; a row without the column was
+    written by revision 1."""
+    older: dict[int, int] = {}
+    for row in rows:
+        if row.get("scene_id") not in ids:
+            continue
+        rev = row.get("engine_revision")
+        try:
+            rev = int(rev) if rev is not None and math.isfinite(float(rev)) else 1
+        except (TypeError, ValueError):
+            rev = 1
+        if rev != ENGINE_REVISION:
+            older[rev] = older.get(rev, 0) + 1
+    return older
+
+
 def _one_line(text: str, limit: int = 300) -> str:
     text = " ".join(str(text).split())
     return text if len(text) <= limit else text[: limit - 3] + "..."
@@ -189,6 +207,7 @@ def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | 
     row["task_cpu_s"] = task_cpu
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     row["finished_at"] = time.time()
+    row["engine_revision"] = ENGINE_REVISION
     traj = None
     if trajectories and res.trajectory:
         traj = {str(k): np.asarray(v, dtype=np.float64) for k, v in res.trajectory.items()}
@@ -222,7 +241,8 @@ def template_row(config: SweepConfig) -> dict:
     """A row with every column of the runs table (used for an empty table's schema)."""
     _, scene = config.tasks()[0]
     row = Result(scene=scene, numerics=config.numerics).to_row()
-    row.update(task_wall_s=0.0, task_cpu_s=0.0, worker="", finished_at=0.0)
+    row.update(task_wall_s=0.0, task_cpu_s=0.0, worker="", finished_at=0.0,
+               engine_revision=ENGINE_REVISION)
     return row
 
 
@@ -596,6 +616,13 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
         prog.message(f"sweep {cfg.name}: all {len(tasks)} scenes already done -> {path}")
     if store.backup is not None:
         prog.message(f"previous results moved to {store.backup}")
+    older = older_revision_rows(store.rows, {sid for sid, _ in tasks} - {s for s, _ in todo})
+    if older:
+        kept = ", ".join(f"{count} of revision {rev} ({REVISION_CHANGES.get(rev, 'other numbers')})"
+                         for rev, count in sorted(older.items()))
+        prog.message(f"{path} keeps finished rows of an earlier engine: {kept}; this engine is "
+                     f"revision {ENGINE_REVISION} (column engine_revision); use --fresh to "
+                     f"compute every row again")
     if store.grown_from and todo:
         prog.message(f"growing {path}: same numerics as the config that wrote it, so its "
                      f"finished scenes are kept and only new ones run ({len(done)} in the "

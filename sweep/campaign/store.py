@@ -49,8 +49,9 @@ File contents (plain arrays and text only; no pickles):
   scene: ``scene_id``, the scene parameters, the numerics (``num_*``), every scalar result
   (:data:`sweep.scene.RESULT_SCALARS`, incl. ``status``, ``reason``, ``wall_s``) and the
   scheduler's ``task_wall_s`` and ``task_cpu_s`` (wall and CPU seconds of the task in its
-  worker; CPU well below wall means a loaded machine), ``worker`` (host:pid) and
-  ``finished_at`` (unix time).
+  worker; CPU well below wall means a loaded machine), ``worker`` (host:pid),
+  ``finished_at`` (unix time) and ``engine_revision`` (:data:`sweep.scene.ENGINE_REVISION`;
+  absent, NaN, in rows written before it was recorded, which are revision 1).
 * ``/trajectories/<scene_id>/{t, delta, P, a, a_inner}`` when the config asks for them.
 * File attributes: ``format``, ``format_version``, ``config_name``, ``config_hash``,
   ``config_text``, ``config_source``, ``package_version``, ``git_commit``, ``numba_version``,
@@ -84,7 +85,8 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError
-from ..scene import SCENE_AXES, SCENE_ID_VERSION, TABLE_MATERIAL, Numerics
+from ..scene import (ENGINE_REVISION, REVISION_CHANGES, SCENE_AXES, SCENE_ID_VERSION,
+                     TABLE_MATERIAL, Numerics)
 from .config import parse_config
 from .si import si_row
 
@@ -1038,6 +1040,15 @@ def summary(path, slowest: int = 5) -> str:
     if len(df) and "status" in df:
         counts = df["status"].value_counts()
         lines.append("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    if len(df):
+        revision = (np.nan_to_num(df["engine_revision"].to_numpy(float), nan=1.0)
+                    if "engine_revision" in df else np.ones(len(df))).astype(int)
+        if (revision != ENGINE_REVISION).any():
+            older = np.unique(revision[revision != ENGINE_REVISION], return_counts=True)
+            kept = ", ".join(f"{v} of revision {k} ({REVISION_CHANGES.get(int(k), 'other numbers')})"
+                             for k, v in zip(*older))
+            lines.append(f"  engine: rows of an earlier engine than this one (revision "
+                         f"{ENGINE_REVISION}): {kept}")
     varying, fixed = [], []
     # n is unused where every material is a Prony table (its value is bookkeeping)
     tables = (len(df) and "material" in df

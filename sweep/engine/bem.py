@@ -29,8 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from ..kernels.solve import (N_STATS, STAT_FACTOR, STAT_ITER, STATUS_LEFT_BAND,
-                             STATUS_STEP_LIMIT, MeshArrays, Physics, Records, RunState,
-                             StepControl, invalidate, set_deadline, unload)
+                             STATUS_STEP_LIMIT, Physics, Records, RunState, StepControl,
+                             invalidate, set_deadline, unload)
 from ..errors import NUMERICAL_ERRORS, is_internal_error
 from ..kernels.interface import lj_traction
 from ..kernels.jacobian import use_drift_scaled
@@ -198,7 +198,7 @@ def unload_chunk(pb: Problem, run: UnloadingState, tip_range, steps: int,
                           da_max_pulloff * pb.mesh.spacing,
                           PULLOFF_ZONE_SPACINGS * pb.mesh.spacing)
     set_deadline(run.cache, deadline - time.perf_counter())
-    status, run.n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
+    status, run.n = unload(pb.mesh_arrays(),
                            Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, pb.scene.rate,
                                    pb.hdot_c, pb.pz_xi, pb.machine_compliance),
                            control, RunState(run.h, run.delta0, run.q, run.n, run.step,

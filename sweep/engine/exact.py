@@ -31,7 +31,8 @@ def unload_exact(pb, h_init, delta0, material, min_travel, out, stats):
     min_travel : crack-tip recession after the load minimum required to stop (a_ref).
     out : the five record arrays (t, delta, P, a, a_inner); ``stats`` the solver counters.
     """
-    A, r, wP, scene, numerics = pb.A, pb.mesh.r, pb.wP, pb.scene, pb.numerics
+    A, r, wP, tail = pb.A, pb.mesh.r, pb.wP, pb.tail
+    scene, numerics = pb.scene, pb.numerics
     h0, c, hm, stop_mode = pb.h0, pb.c, pb.hm, pb.stop_mode
     t_out, d_out, P_out, a_out, ai_out = out
     N = h_init.size
@@ -47,7 +48,7 @@ def unload_exact(pb, h_init, delta0, material, min_travel, out, stats):
     cache = new_jacobian_cache(N)
     t, delta = 0.0, delta0
     t_out[0], d_out[0] = 0.0, delta
-    P_out[0] = load(sigma, wP)
+    P_out[0] = load(sigma, wP, h, tail, h0, c)
     a_out[0] = crossing_radius(h, r, hm)
     ai_out[0] = crossing_radius(h, r, h0)
     P_min, i_min, n = P_out[0], 0, 1
@@ -81,7 +82,7 @@ def unload_exact(pb, h_init, delta0, material, min_travel, out, stats):
         dts.append(dt)
         times.append(t_new)
         h, sigma, t, delta = hp, sig_new, t_new, delta - dd
-        P = load(sigma, wP)
+        P = load(sigma, wP, h, tail, h0, c)
         a_new = crossing_radius(h, r, hm)
         t_out[n], d_out[n], P_out[n], a_out[n] = t, delta, P, a_new
         ai_out[n] = crossing_radius(h, r, h0)

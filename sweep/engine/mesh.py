@@ -87,6 +87,16 @@ class Mesh:
         """The influence matrix (read-only, cached per process)."""
         return influence(self)
 
+    @property
+    def tail_rise(self) -> float:
+        """(r_end^2 - r_last^2)/2: the rise of the rigid gap from the last node to the end of
+        its hat, r_end = 2 r_last - r_(last-1) (the last node's hat is a full triangle,
+        :func:`sweep.kernels.influence.load_weights_nodes`). Beyond r_end the load adds the
+        Lennard-Jones attraction of the gap continued rigidly, from h_end = h_last +
+        tail_rise (:func:`sweep.kernels.solve.load`, :func:`sweep.kernels.interface.tail_load`)."""
+        r_last, r_end = float(self.r[-1]), 2.0 * float(self.r[-1]) - float(self.r[-2])
+        return 0.5 * (r_end * r_end - r_last * r_last)
+
 
 def uniform_mesh(nodes: int, domain: float) -> Mesh:
     """``nodes`` nodes from 0 to ``domain`` (a_ref units)."""

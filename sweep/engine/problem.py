@@ -229,6 +229,24 @@ class Problem:
         return self.scales.tip_gap
 
     @property
+    def tail(self) -> float:
+        """The mesh's :attr:`sweep.engine.mesh.Mesh.tail_rise`: the load's Lennard-Jones tail
+        beyond the mesh starts at the gap h_last + tail (:func:`sweep.kernels.solve.load`);
+        inf (no tail) where ``numerics.lj_tail`` is False."""
+        return self.mesh.tail_rise if self.numerics.lj_tail else math.inf
+
+    def mesh_arrays(self):
+        """The unloading kernels' :data:`sweep.kernels.solve.MeshArrays` of this problem."""
+        from ..kernels.solve import MeshArrays
+        return MeshArrays(self.A, self.mesh.r, self.wP, self.tail)
+
+    def load(self, sigma, h) -> float:
+        """P = 2 pi wP . sigma + the Lennard-Jones tail beyond the mesh, of the gaps ``h``
+        whose tractions are ``sigma`` (:func:`sweep.kernels.solve.load`)."""
+        from ..kernels.solve import load
+        return float(load(sigma, self.wP, h, self.tail, self.h0, self.c))
+
+    @property
     def tip_zone(self) -> float:
         """The mesh's resolution unit (a_ref), :attr:`Scales.tip_zone`."""
         return self.scales.tip_zone

@@ -54,8 +54,8 @@ from ..kernels.protocol import (CLOCK_A, CLOCK_DELTA, CLOCK_DT, CLOCK_DT_PREV, C
                                 approach_steps, dwell_steps, factorize_ahead, held_guess,
                                 newton_at_load, predictor_steps)
 from ..kernels.solve import (LATTICE_HISTORY, LATTICE_SCORE_USE, LATTICE_SCORE_WEIGHT,
-                             MeshArrays, Physics, invalidate, load, new_jacobian_cache, newton,
-                             predict, predict_lattice, relax, score_starts, settle_tip)
+                             Physics, invalidate, new_jacobian_cache, newton, predict,
+                             predict_lattice, relax, score_starts, settle_tip)
 from ..theory import jkr_contact_radius
 from .postprocess import cycle_work
 from ..scene import Protocol
@@ -178,7 +178,7 @@ class _March:
     def _record(self, phase):
         pb, r = self.pb, self.pb.mesh.r
         for key, value in (("t", self.t), ("delta", self.delta),
-                           ("P", load(self.sigma, pb.wP)),
+                           ("P", pb.load(self.sigma, self.h)),
                            ("a", crossing_radius(self.h, r, pb.hm)),
                            ("a_inner", crossing_radius(self.h, r, pb.h0)), ("phase", phase)):
             self.records[key].append(value)
@@ -233,7 +233,7 @@ class _March:
         self._settle(h, g, ceff, H)
         self._ahead(h, ceff)
         tols = np.array([pb.numerics.tol * pb.h0, HOLD_RTOL * force])
-        ok, shift = newton_at_load(h, g, pb.A, pb.wP, ceff, H, self.law, force, tols,
+        ok, shift = newton_at_load(h, g, pb.mesh_arrays(), ceff, H, self.law, force, tols,
                                    MAX_ITER, self.cache, self.stats)
         if not ok:
             invalidate(self.cache)
@@ -281,7 +281,7 @@ class _March:
     def _state(self, ok, h, e, b, starts):
         law, sig = self.law, np.empty(h.size)
         traction(h, law.h_old, law.zone, law.h0, law.c, sig)
-        return ok, h, sig, load(sig, self.pb.wP), e, b, starts
+        return ok, h, sig, self.pb.load(sig, h), e, b, starts
 
     def _start(self, dt):
         """Newton's start for the step ``dt`` and the two starts, quadratic and tip
@@ -408,7 +408,7 @@ class _March:
                            self.past_ta, clock, self.recent())
         out = DwellOut(np.empty((5, DWELL_CHUNK_STEPS)), np.empty((2, N)), np.empty(N),
                        np.empty(N))
-        outcome, n = kernel(MeshArrays(pb.A, pb.mesh.r, pb.wP),
+        outcome, n = kernel(pb.mesh_arrays(),
                             Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times,
                                     pb.scene.rate, pb.hdot_c, pb.pz_xi),
                             self.law, control, state, out, self.cache, self.stats)

@@ -238,6 +238,8 @@ class ElasticBranch:
         lj_traction_and_stiffness(h, self.h0, self.c, sig, np.empty(h.size))
         x_end = 2.0 * self.x[-1] - self.x[-2]
         h_end = h[-1] + 0.5 * a * a * (x_end**2 - self.x[-1] ** 2)
+        # kernels.interface.tail_load's formula, written in this order since before the BEM had
+        # it (its results stay bitwise those computed then)
         q = self.h0 / h_end
         tail = -self.c * self.h0 * (0.5 * q**2 - 0.125 * q**8) if self.tail else 0.0
         return 2.0 * math.pi * (a * a * float(self.w @ sig) + tail)

@@ -10,6 +10,7 @@ map is exact as the term goes to zero, so at small terms they agree to the map's
 Gamma is the product of the Gent-Schultz and Persson-Brener factors, on two materials;
 (d) a run resumed in chunks (the traction carried between kernel calls) equals one run.
 """
+import dataclasses
 import math
 
 import pytest
@@ -198,12 +199,22 @@ FOLDS_PAST = Scene(n=1.349, k=0.04705, mu=5.184, rate=307000.0, approach_rate=11
 def test_a_path_that_folds_past_the_minimum_gives_a_converging_pull_off():
     """The balanced row is ok, its pull-off the load minimum; a solve at band resolution 12,
     a third resolution beside the row's pair (16 and 8), lies within the row's estimate
-    (measured 212.466, estimate 5.3e-4, against 212.428)."""
-    row = simulate(FOLDS_PAST, Numerics.preset("balanced"))
+    (measured 212.466, estimate 5.3e-4, against 212.428).
+
+    Without the Lennard-Jones tail beyond the mesh (``lj_tail`` False: the path on which the
+    scene was found, bitwise). Whether this scene's march crosses the folds before its
+    minimum is chaotic in its start: at band resolution 16, 7 of 17 preloads within +-2e-4
+    of this one end "no equilibrium found at the minimum step before pull-off" without the
+    tail and 9 of 17 with it; the tail moves the dwell's depth by 1.6e-4 (2.88257 against
+    2.88241), and this preload's march then fails at a = 1.318, before the minimum (1.288). At band resolution 24 all 10 tried fail, either way
+    (session 49, /work/helpers/s49_tail2.md): a limit of the march across folds, not of the
+    tail, which this test does not exercise."""
+    num = Numerics.preset("balanced", lj_tail=False)
+    row = simulate(FOLDS_PAST, num)
     assert row.ok, row.reason
     assert row.pull_off > 100.0          # 100 times the elastic pull-off: a strong zone
-    third = simulate(FOLDS_PAST, Numerics.preset("balanced", band_resolution=12.0,
-                                                 pull_off_rtol=0.0))
+    third = simulate(FOLDS_PAST, dataclasses.replace(num, band_resolution=12.0,
+                                                     pull_off_rtol=0.0))
     assert third.ok, third.reason
     assert abs(third.pull_off / row.pull_off - 1.0) <= row.error_estimate
 

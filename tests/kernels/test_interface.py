@@ -15,7 +15,7 @@ from sweep import units
 from sweep.engine.process_zone import work_of_separation
 from sweep.kernels.interface import (ZONE_RATE, ZONE_SIZE, ZONE_SMOOTH, ZONE_SMOOTH_TERM,
                                      ZONE_XI, lj_traction, lj_traction_and_stiffness,
-                                     traction, traction_and_stiffness, zone_factor)
+                                     tail_load, traction, traction_and_stiffness, zone_factor)
 
 MU = 5.0
 H0, C = units.h0_hat(MU), units.lj_prefactor(MU)
@@ -110,3 +110,23 @@ def test_the_stiffness_is_the_laws_derivative(xi):
     lj_traction_and_stiffness(h, H0, C, lj, dlj)
     assert np.allclose(d - rate, np.where(h > H0, m, 1.0) * dlj, rtol=1e-10, atol=0)
     assert np.any(rate != 0) and not rate[h - h_old <= 0].any()
+
+
+@pytest.mark.parametrize("gaps", [1.2, 3.0, 60.0, 600.0])
+def test_the_tail_load_is_the_lennard_jones_law_integrated_beyond_the_mesh(gaps):
+    # P_tail = 2 pi int_{h_end}^inf sigma_LJ(h) dh (the rigid gap beyond the mesh, dh = r dr),
+    # the law itself integrated numerically
+    h_end = gaps * H0
+    sig = np.empty(1)
+
+    def sigma(h):
+        lj_traction(np.array([h]), H0, C, sig)
+        return sig[0]
+
+    value, err = quad(sigma, h_end, np.inf, epsabs=0.0, epsrel=1e-12, limit=200)
+    assert tail_load(h_end, H0, C) == pytest.approx(2.0 * math.pi * value, rel=1e-10)
+    assert tail_load(h_end, H0, C) < 0.0         # tensile beyond 4^(-1/6) h0
+
+
+def test_no_tail_at_an_infinite_gap():
+    assert tail_load(np.inf, H0, C) == 0.0

@@ -312,7 +312,7 @@ def test_newton_with_a_compliant_machine_is_the_rigid_solve_at_d_minus_p_over_k(
     hs = h_start.copy()
     assert ks.newton_machine(hs, -D + h0 + 0.5 * r**2, A, ceff, H,
                              lennard_jones(h0, c, N), 1e-11 * h0, 40, cache, stats,
-                             1.0 / stiffness, wP)
+                             ks.Machine(1.0 / stiffness, wP, np.inf))   # inf: no LJ tail, as P
     lj_traction_and_stiffness(hs, h0, c, sig, d)
     P = 2.0 * np.pi * wP @ sig
     delta = D - P / stiffness
@@ -320,6 +320,37 @@ def test_newton_with_a_compliant_machine_is_the_rigid_solve_at_d_minus_p_over_k(
     g = -delta + h0 + 0.5 * r**2
     assert np.max(np.abs(hs - g - A @ (ceff * sig - H))) < 1e-10 * h0
     # measured 9 and 16 iterations at K = 3 and 0.3 (8 for a rigid machine, K = 1e6)
+    assert stats[ks.STAT_ITER] <= 20
+
+
+def test_a_compliant_machine_carries_the_load_with_its_lennard_jones_tail():
+    # the same solve with the mesh's tail (the LJ attraction beyond the edge, kernels.solve.load):
+    # the spring's load is 2 pi wP . sigma + tail_load(h_end), h_end the last gap continued
+    # rigidly; the tail's derivative is not in the Jacobian and Newton still converges
+    from sweep.engine.initial import ElasticSolver, relaxed_state
+    from sweep.kernels.interface import tail_load
+    N, stiffness = 120, 0.3
+    A, _, h0, c, _ = _problem(N=N, seed=3)
+    mesh = uniform_mesh(N, 3.0)
+    r, wP, tail = np.asarray(mesh.r), np.asarray(mesh.load_weights, float), mesh.tail_rise
+    assert tail == pytest.approx(0.5 * ((3.0 + r[1]) ** 2 - 9.0))
+    h_start, _ = relaxed_state(ElasticSolver(A, r, h0, c, 1e-10), delta0=1.0)
+    sig, d = np.empty(N), np.empty(N)
+    ceff, H = 0.95, -0.01 * np.exp(-r)
+    D = 1.0 - 0.05 * h0
+    stats = np.zeros(ks.N_STATS, np.int64)
+    hs = h_start.copy()
+    assert ks.newton_machine(hs, -D + h0 + 0.5 * r**2, A, ceff, H, lennard_jones(h0, c, N),
+                             1e-11 * h0, 40, ks.new_jacobian_cache(N), stats,
+                             ks.Machine(1.0 / stiffness, wP, tail))
+    lj_traction_and_stiffness(hs, h0, c, sig, d)
+    P_tail = tail_load(hs[-1] + tail, h0, c)
+    assert P_tail < 0.0
+    P = 2.0 * np.pi * wP @ sig + P_tail
+    g = -(D - P / stiffness) + h0 + 0.5 * r**2
+    assert np.max(np.abs(hs - g - A @ (ceff * sig - H))) < 1e-10 * h0
+    # without the tail the spring would sit elsewhere by P_tail / K, far beyond the tolerance
+    assert abs(P_tail / stiffness) > 1e3 * 1e-10 * h0
     assert stats[ks.STAT_ITER] <= 20
 
 

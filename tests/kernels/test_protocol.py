@@ -52,7 +52,8 @@ def test_the_held_step_carries_the_load_at_the_indentation_it_found(extra):
     h = h_start.copy()
     cache, stats = ks.new_jacobian_cache(N), np.zeros(ks.N_STATS, np.int64)
     law = lennard_jones(h0, c, N)
-    ok, shift = newton_at_load(h, g, A, wP, ceff, H, law, force,
+    mesh = ks.MeshArrays(A, r, wP, np.inf)            # inf: no LJ tail, as _load
+    ok, shift = newton_at_load(h, g, mesh, ceff, H, law, force,
                                np.array([TOL * h0, 1e-9 * abs(force)]), 40, cache, stats)
     assert ok
     assert np.sign(shift) == np.sign(extra)           # more load, more indentation
@@ -66,6 +67,30 @@ def test_the_held_step_carries_the_load_at_the_indentation_it_found(extra):
                      ks.new_jacobian_cache(N), np.zeros(ks.N_STATS, np.int64))
     assert np.max(np.abs(h_plain - h)) <= 1e-6 * h0
 
+
+
+def test_the_held_step_carries_the_load_with_its_lennard_jones_tail():
+    # with the mesh's tail (kernels.solve.load) the load held is 2 pi wP . sigma plus the
+    # LJ attraction beyond the edge, the last gap continued rigidly; the tail's derivative is
+    # not in the bordered update and Newton still converges
+    from sweep.kernels.interface import tail_load
+    A, r, h0, c, h_start, wP = _step()
+    tail = uniform_mesh(N, 3.0).tail_rise
+    ceff, H = 0.8, -0.05 * np.exp(-r)
+    g = -1.0 + h0 + 0.5 * r ** 2
+    force = _load(h_start, h0, c, wP)[0] + 0.3
+    h = h_start.copy()
+    cache, stats = ks.new_jacobian_cache(N), np.zeros(ks.N_STATS, np.int64)
+    ok, shift = newton_at_load(h, g, ks.MeshArrays(A, r, wP, tail), ceff, H,
+                               lennard_jones(h0, c, N), force,
+                               np.array([TOL * h0, 1e-9 * abs(force)]), 40, cache, stats)
+    assert ok
+    P, sig = _load(h, h0, c, wP)
+    P_tail = tail_load(h[-1] + tail, h0, c)
+    assert abs(P + P_tail - force) <= 1e-9 * abs(force)
+    assert abs(P_tail) > 1e3 * 1e-9 * abs(force)        # the tail did count
+    g_found = g - shift
+    assert np.max(np.abs(h - g_found - A @ (ceff * sig - H))) <= TOL * h0
 
 
 def test_settling_the_tip_lowers_its_residual_and_moves_no_other_node():

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from sweep.kernels.solve import (N_STATS, STAT_ITER, STATUS_DONE, STATUS_STEP_LIMIT,
-                                 STATUS_TIME_BUDGET, MeshArrays, Physics, Records, RunState,
+                                 STATUS_TIME_BUDGET, Physics, Records, RunState,
                                  StepControl, new_jacobian_cache, set_deadline, unload)
 from sweep.engine.initial import ElasticSolver, relaxed_state
 from sweep.engine.problem import prepare
@@ -38,7 +38,7 @@ def _run(chunk, deadline_s=np.inf):
                               STEP_TOL, NUMERICS.tol, MAX_NEWTON_ITER, limit, pb.stop_mode,
                               STOP_TRAVEL_SPACINGS * pb.mesh.spacing, *pb.tip_range,
                               NUMERICS.da_max * pb.mesh.spacing, 0.0)
-        status, n = unload(MeshArrays(pb.A, pb.mesh.r, pb.wP),
+        status, n = unload(pb.mesh_arrays(),
                            Physics(pb.h0, pb.c, pb.prony_weights, pb.prony_times, SCENE.rate,
                                    pb.hdot_c, pb.pz_xi),
                            control, RunState(h, delta0, q, n, step, sigma, np.zeros(N)), Records(*out, h_out),
