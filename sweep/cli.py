@@ -17,7 +17,9 @@ import inspect
 import json
 import math
 import shlex
+import signal
 import sys
+import threading
 from importlib import import_module
 from pathlib import Path
 
@@ -567,6 +569,16 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
     """Run (or resume) the sweep described by the YAML file CONFIG."""
     from .campaign.scheduler import SweepInterrupted, SweepRuntimeError, run_sweep
 
+    # SIGTERM (what `timeout`, a batch system's time limit or `kill` send) ends the sweep as
+    # Ctrl-C does: the finished scenes stored, one line saying how to resume
+    terminated = []
+
+    def on_sigterm(signum, frame):
+        terminated.append(signum)
+        raise KeyboardInterrupt
+
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, on_sigterm) if main_thread else None
     try:
         report = run_sweep(config, jobs=jobs, backend=backend, scheduler=scheduler, out=out,
                            resume=resume, progress=progress, connect_timeout=connect_timeout,
@@ -579,9 +591,13 @@ def run_cmd(config, jobs, backend, scheduler, out, resume, progress, connect_tim
             again += ["--out", out]
         if backend != "local":
             again += ["--backend", backend] + (["--scheduler", scheduler] if scheduler else [])
-        click.echo(f"\ninterrupted: {exc.kept} of {exc.total} scenes are kept in "
-                   f"{exc.output}; to resume, run: {shlex.join(again)}", err=True)
-        raise SystemExit(130) from None
+        click.echo(f"\n{'terminated' if terminated else 'interrupted'}: {exc.kept} of "
+                   f"{exc.total} scenes are kept in {exc.output}; to resume, run: "
+                   f"{shlex.join(again)}", err=True)
+        raise SystemExit(128 + signal.SIGTERM if terminated else 130) from None
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)
     click.echo(report.line())
     if report.errors:   # a bug is not a result: the sweep finished, but says so and fails
         click.echo(f"error: {report.error_line()}", err=True)

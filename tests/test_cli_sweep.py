@@ -605,6 +605,28 @@ def test_sigint_to_the_process_group_keeps_scenes(tmp_path):
     assert "Traceback" not in text
 
 
+def test_sigterm_keeps_scenes_and_says_how_to_resume(tmp_path):
+    """SIGTERM to the parent (what `timeout` or a batch system's time limit sends) ends the
+    sweep as Ctrl-C does: the finished scenes stored, one line with the command that
+    resumes, exit 143."""
+    cfg = write(tmp_path / "big.yaml", KILL_CFG.replace("{preset: fast, nodes: 60}",
+                                                        "{preset: balanced}")
+                .replace("a0: [2.0, 2.5]", "a0: [3.0, 4.0, 5.0]"))
+    run = Sweep(tmp_path, ["run", str(cfg), "-j", "1", "--progress", "log"])
+    run.wait_lines(2)
+    assert run.p.poll() is None, "sweep finished before the signal"
+    run.p.send_signal(signal.SIGTERM)
+    code = run.p.wait(timeout=60)
+    assert code == 143, (code, "".join(run.raw)[-2000:])
+    run.pump.join(timeout=30)
+    text = "".join(run.raw)
+    m = re.search(r"^terminated: (\d+) of 36 scenes are kept in (\S+); to resume, run: "
+                  r"sweep run \S+big.yaml$", text, re.M)
+    assert m, text
+    assert int(m.group(1)) == len(load(tmp_path / "kill.h5")) >= 2
+    assert "Traceback" not in text
+
+
 def test_run_exits_nonzero_after_an_internal_error(tmp_path, monkeypatch, capsys):
     """`sweep run` finishes the sweep, stores every scene, prints the count of internal errors
     with the log's path and exits 3 (a bug is not a result)."""

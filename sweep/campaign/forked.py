@@ -41,8 +41,10 @@ def usable() -> bool:
             and threading.active_count() == 1)
 
 
-def _ignore_sigint() -> None:
+def _worker_signals() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # the parent's `sweep run` turns SIGTERM into an interrupt; a worker ends on it
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _call(index: int):
@@ -65,7 +67,7 @@ class ForkedWorkers:
         try:
             self._executor = ProcessPoolExecutor(
                 workers, mp_context=multiprocessing.get_context("fork"),
-                initializer=_ignore_sigint)
+                initializer=_worker_signals)
             # the first submit forks every worker (the fork start method starts them all at
             # once, before the executor's own threads): they inherit _CALLS as it is now
             futures = [self._executor.submit(_call, i) for i in range(len(_CALLS[1]))]

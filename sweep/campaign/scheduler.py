@@ -58,7 +58,7 @@ from .config import SweepConfig, as_config
 from ..errors import InputError, check_int, check_range
 from ..scene import ENGINE_REVISION, REVISION_CHANGES, Result
 from . import spool
-from .store import ResultStore, StoreBusyError, plain_row
+from .store import ResultStore, StoreBusyError, error_log_path, plain_row, real_path
 from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
 from .forked import ForkedWorkers, usable as forked_workers_usable
 
@@ -219,11 +219,6 @@ def run_scene(scene, numerics, trajectories: bool = False, simulate: Callable | 
 
 #: key of the traceback an internal error adds to a worker's row (never stored in the table)
 TRACEBACK_KEY = "_traceback"
-
-
-def error_log_path(path: Path) -> Path:
-    """The log of internal errors beside the results file ``path``: ``<path>.errors.log``."""
-    return Path(path).with_name(Path(path).name + ".errors.log")
 
 
 def log_internal_error(log: Path, row: dict, tb: str) -> None:
@@ -568,7 +563,7 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
                          f"(got {progress!r})")
     consolidate_every = check_range("consolidate_every", consolidate_every, 0.0, 1e6)
     connect_timeout = check_range("connect_timeout", connect_timeout, 0.0, 3600.0, lo_open=True)
-    path = cfg.output_path(out)
+    path = real_path(cfg.output_path(out))
     check_output_writable(path)
     tasks = cfg.tasks()
 
@@ -594,7 +589,7 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
     spool_dir = store.parts / SPOOL
     # rows a killed sweep's workers had finished and it had not stored (sweep.campaign.spool)
     task_ids = {sid for sid, _ in tasks}
-    done |= _unspool(store, spool_dir, task_ids - done, error_log_path(path))
+    done |= _unspool(store, spool_dir, task_ids, error_log_path(path))
     # a scene that hit an internal error (a bug, not a result) runs again on resume
     retry = {row["scene_id"] for row in store.rows if row.get("status") == "error"}
     todo = [(sid, scene) for sid, scene in tasks if sid not in done or sid in retry]
@@ -700,13 +695,16 @@ SPOOL = "spool"
 
 
 def _unspool(store: ResultStore, spool_dir: Path, wanted: set, error_log: Path) -> set:
-    """Store the spooled rows of ``wanted`` scenes that ``store`` lacks (an interrupted
-    chunk's finished scenes, or those of a sweep killed with its workers), then clear the
-    spool; an internal error's traceback goes to ``error_log``. Returns their ids."""
+    """Store the spooled rows of ``wanted`` scenes that ``store`` lacks, or holds as an
+    internal error (an interrupted chunk's finished scenes, or those of a sweep killed with
+    its workers), then clear the spool; an internal error's traceback goes to ``error_log``.
+    Returns their ids."""
     kept = set()
     for row, traj in spool.read(spool_dir):
         sid = row.get("scene_id")
-        if sid in wanted and not store.holds(sid) and sid not in kept:
+        # a scene whose stored row is an internal error ran again: its new row replaces it
+        retried = store.status(sid) == "error" and row.get("status") != "error"
+        if sid in wanted and (not store.holds(sid) or retried) and sid not in kept:
             tb = row.pop(TRACEBACK_KEY, None)
             store.append(row, traj)
             if row.get("status") == "error":

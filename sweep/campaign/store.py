@@ -111,9 +111,23 @@ class StoreBusyError(RuntimeError):
 
 
 # ----------------------------------------------------------------------------- paths
-def parts_dir(path) -> Path:
+def real_path(path) -> Path:
+    """``path``, or the file it names when it is a symbolic link: a results file reached
+    through a link is the file itself, with its own journal, lock and consolidation (a link
+    replaced by a private copy, and two writers through two names, are what this prevents)."""
     path = Path(path)
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+def parts_dir(path) -> Path:
+    path = real_path(path)
     return path.with_name(path.name + ".parts")
+
+
+def error_log_path(path) -> Path:
+    """The log of internal errors beside the results file ``path``: ``<path>.errors.log``."""
+    path = real_path(path)
+    return path.with_name(path.name + ".errors.log")
 
 
 def _lock_path(path: Path) -> Path:
@@ -328,18 +342,21 @@ def load(path) -> pd.DataFrame:
         main = None
     else:
         raise FileNotFoundError(f"no results at {path}")
+    # the journal is newer than the main file: its row of a scene replaces the main file's
+    # (a scene run again on resume, an internal error's, appends its new row there), and of
+    # two journal rows of one scene the later one counts
+    newer = list({r["scene_id"]: r for r in jrows}.values())
     if main is None:
-        return _dedupe(_frame_from_rows(jrows)) if jrows else \
+        return _frame_from_rows(newer) if newer else \
             pd.DataFrame({"scene_id": pd.Series([], dtype=object)})
-    known = set(main["scene_id"])
-    extra = [r for r in jrows if r["scene_id"] not in known]
-    if not extra:
+    if not newer:
         return main
-    cols = list(main.columns) + [c for c in _column_order(extra) if c not in main.columns]
-    jf = _frame_from_rows(extra, cols)
-    if len(main) == 0:
+    cols = list(main.columns) + [c for c in _column_order(newer) if c not in main.columns]
+    jf = _frame_from_rows(newer, cols)
+    kept = main[~main["scene_id"].isin({r["scene_id"] for r in newer})]
+    if len(kept) == 0:
         return _dedupe(jf)
-    return _dedupe(pd.concat([main, jf], ignore_index=True))
+    return _dedupe(pd.concat([kept, jf], ignore_index=True))
 
 
 def load_results(path) -> pd.DataFrame:
@@ -605,7 +622,7 @@ def _write_traj_file(target: Path, traj: dict) -> None:
 def _backup_name(path: Path) -> Path:
     cand = path.with_name(path.name + ".bak")
     i = 1
-    while cand.exists() or parts_dir(cand).exists():
+    while cand.exists() or parts_dir(cand).exists() or error_log_path(cand).exists():
         cand = path.with_name(f"{path.name}.bak{i}")
         i += 1
     return cand
@@ -622,7 +639,7 @@ class ResultStore:
     def __init__(self, path, *, config_hash: str, config_name: str = "", config_text: str = "",
                  config_source: str = "", n_scenes: int = 0, trajectories: bool = False,
                  template_row: dict | None = None, interval: float = 5.0, config=None):
-        self.path = Path(path)
+        self.path = real_path(path)
         #: the SweepConfig being run (optional): lets a results file of the same numerics and
         #: trajectory flag *grow* to this config's grid (see :meth:`prepare`)
         self.config = config
@@ -631,6 +648,8 @@ class ResultStore:
         self.grown_from: list[tuple[str, str]] = []
         self._grow_ids: set[str] = set()
         self.parts = parts_dir(self.path)
+        #: the journal's meta.json did not read, and the main file named the sweep
+        self._meta_unreadable = False
         self.config_hash = config_hash
         self.meta = {
             "format": FORMAT, "format_version": FORMAT_VERSION,
@@ -712,8 +731,14 @@ class ResultStore:
                 m = json.loads(meta.read_text())
                 found.append((str(self.parts), m["config_hash"],
                               int(m.get("scene_id_version", 1)), str(m.get("config_text", ""))))
-            except (ValueError, KeyError, OSError, TypeError):
-                found.append((str(self.parts), "?", 1, ""))
+            except (ValueError, KeyError, OSError, TypeError) as exc:
+                if not found:
+                    raise InputError(
+                        f"{meta} does not read ({type(exc).__name__}), so which config wrote "
+                        f"the finished scenes in {self.parts} is unknown; use --fresh to move "
+                        f"them aside (kept as a .bak) or --out to write elsewhere") from None
+                # the main file's own config identifies the sweep: begin writes it again
+                self._meta_unreadable = True
         return found
 
     def prepare(self, resume: bool = True) -> None:
@@ -816,6 +841,9 @@ class ResultStore:
                 os.replace(self.path, self.backup)
             if self.parts.exists():
                 os.replace(self.parts, parts_dir(self.backup))
+            # the old file's internal errors go with it
+            if error_log_path(self.path).exists():
+                os.replace(error_log_path(self.path), error_log_path(self.backup))
         started = None
         history = []
         if self.path.exists():
@@ -834,9 +862,12 @@ class ResultStore:
         if started:
             self.meta["started_at"] = str(started)
         for row in _read_journal(self.path):
-            if row["scene_id"] not in self._ids:
+            # newer than the main file's row of the scene, if it has one (load's rule)
+            if row["scene_id"] in self._ids:
+                self.rows[self._ids[row["scene_id"]]] = row
+            else:
                 self._add(row)
-                self._dirty = True
+            self._dirty = True
         if self.grown_from:
             # growing: the file's grid is the union of this config's and the earlier ones'
             # (the attribute config_history keeps the earlier configs' hashes and texts)
@@ -865,7 +896,7 @@ class ResultStore:
             self.consolidate()
         # journal: create or repair (truncate a torn last line), then open for appending
         (self.parts / "traj").mkdir(parents=True, exist_ok=True)
-        if not meta.exists() or self.grown_from:
+        if not meta.exists() or self.grown_from or self._meta_unreadable:
             tmp = meta.with_name(META + ".tmp")
             tmp.write_text(json.dumps(self.meta))
             os.replace(tmp, meta)
@@ -881,6 +912,11 @@ class ResultStore:
     def holds(self, scene_id: str) -> bool:
         """Whether a row of ``scene_id`` is stored (read or appended)."""
         return scene_id in self._ids
+
+    def status(self, scene_id: str) -> str | None:
+        """The stored row's ``status`` of ``scene_id``, or None when none is stored."""
+        i = self._ids.get(scene_id)
+        return None if i is None else self.rows[i].get("status")
 
     def _add(self, row: dict) -> None:
         self._ids[row["scene_id"]] = len(self.rows)

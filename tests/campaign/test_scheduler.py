@@ -162,6 +162,19 @@ def test_typeerror_in_one_scene_sequential(tmp_path):
     assert "TypeError" in (tmp_path / "r.h5.errors.log").read_text()
 
 
+def test_fresh_moves_the_error_log_aside_with_its_file(tmp_path):
+    """--fresh moves the old file to .bak: its internal errors' log goes with it, so the new
+    file's log holds only the new file's errors."""
+    out = tmp_path / "r.h5"
+    run_sweep(cfg(), jobs=1, out=out, simulate=typeerror_simulate, progress="none")
+    assert "TypeError" in (tmp_path / "r.h5.errors.log").read_text()
+    rep = run_sweep(cfg(), jobs=1, out=out, simulate=fake_simulate, progress="none",
+                    resume=False)
+    assert rep.errors == 0 and not (tmp_path / "r.h5.errors.log").exists()
+    assert "TypeError" in (tmp_path / "r.h5.bak.errors.log").read_text()
+    assert (load(tmp_path / "r.h5.bak").status == "error").sum() == 1
+
+
 def test_no_error_log_without_errors(tmp_path):
     rep = run_sweep(cfg(), jobs=1, out=tmp_path / "r.h5", simulate=fake_simulate,
                     progress="none")

@@ -51,3 +51,28 @@ def test_clear_removes_the_spool_and_a_later_write_starts_a_new_file(tmp_path):
     assert [r["scene_id"] for r, _ in spool.read(d)] == [_row(1)[0]["scene_id"]]
     spool.clear(d)
     spool.clear(d)                                         # nothing left: a no-op
+
+
+def test_a_spooled_row_replaces_a_stored_internal_error_of_its_scene(tmp_path):
+    """A resume runs an `error` scene again; its worker spools the new row and the sweep is
+    killed before storing it: the next resume stores the spooled row in place of the error
+    (and keeps a stored ok row against a spooled one)."""
+    import math
+
+    from sweep.campaign.scheduler import _unspool
+    from sweep.campaign.store import ResultStore, load
+
+    path = tmp_path / "r.h5"
+    template = {"scene_id": "", "status": "", "pull_off": math.nan}
+    store = ResultStore(path, config_hash="h", config_name="t", config_text="name: t\n",
+                        n_scenes=2, template_row=template)
+    store.prepare()
+    store.begin()
+    store.append({"scene_id": "a", "status": "error", "pull_off": math.nan})
+    store.append({"scene_id": "b", "status": "ok", "pull_off": 2.0})
+    d = tmp_path / "spool"
+    spool.write(d, {"scene_id": "a", "status": "ok", "pull_off": 1.0}, None)
+    spool.write(d, {"scene_id": "b", "status": "ok", "pull_off": 9.0}, None)
+    assert _unspool(store, d, {"a", "b"}, tmp_path / "errors.log") == {"a"}
+    store.finish()
+    assert load(path).set_index("scene_id").pull_off.to_dict() == {"a": 1.0, "b": 2.0}

@@ -112,6 +112,33 @@ def test_journal_is_read_before_consolidation(tmp_path):
     assert len(load(path)) == 4 and not parts_dir(path).exists()
 
 
+def test_a_journal_row_replaces_the_main_files_row_of_its_scene(tmp_path):
+    # an internal error's row is consolidated; the resume runs the scene again and its new
+    # row reaches the journal, then the process dies before the next consolidation: load,
+    # a resume and sweep info see the new row, not the stale error
+    path = tmp_path / "r.h5"
+    st = make(path, n_scenes=2)
+    st.prepare()
+    st.begin()
+    st.append(row(1, status="error", reason="internal error: TypeError", pull_off=math.nan))
+    st.append(row(2))
+    st.finish()
+    st = make(path, n_scenes=2, interval=1e9)
+    st.prepare()
+    st.begin()
+    st.append(row(1, pull_off=7.5))
+    st.abort()                                 # like a kill: no consolidation
+    df = load(path)
+    assert list(df.status) == ["ok", "ok"] and set(df.pull_off) == {3.0, 7.5}
+    assert "error" not in summary(path)
+    st = make(path, n_scenes=2)
+    st.prepare()
+    assert st.begin() == {"id0001", "id0002"} and st.status("id0001") == "ok"
+    st.finish()
+    df = load(path)
+    assert len(df) == 2 and df.set_index("scene_id").pull_off["id0001"] == 7.5
+
+
 def test_torn_journal_line_ignored_then_repaired(tmp_path):
     path = tmp_path / "r.h5"
     st = make(path, interval=1e9)
@@ -303,3 +330,57 @@ def test_load_trajectory_names_a_scene_id_that_is_not_a_string(tmp_path):
     """``load_trajectory(path, 3)`` had raised h5py's "A name should be string or bytes"."""
     with pytest.raises(TypeError, match="scene_id must be a string"):
         load_trajectory(tmp_path / "x.h5", 3)
+
+
+def test_a_results_file_reached_through_a_link_is_the_file_itself(tmp_path):
+    """Writing through a symbolic link keeps the link and writes the file it names (its
+    journal, its lock): the link is not replaced by a private copy, and a second writer
+    through the other name is refused."""
+    real = tmp_path / "shared" / "r.h5"
+    real.parent.mkdir()
+    link = tmp_path / "r.h5"
+    st = make(real, n_scenes=4)
+    st.prepare()
+    st.begin()
+    st.append(row(1))
+    st.finish()
+    link.symlink_to(real)
+    st = make(link, n_scenes=4, interval=1e9)
+    st.prepare()
+    other = make(real, n_scenes=4)
+    with pytest.raises(StoreBusyError):
+        other.prepare()
+    st.begin()
+    st.append(row(2))
+    assert list(load(link).scene_id) == list(load(real).scene_id) == ["id0001", "id0002"]
+    st.finish()
+    assert link.is_symlink() and len(load(real)) == 2
+    assert not parts_dir(link).exists() and not (tmp_path / "r.h5.parts").exists()
+
+
+def test_an_unreadable_journal_meta_is_named_and_the_main_file_still_resumes(tmp_path):
+    path = tmp_path / "r.h5"
+    st = make(path, interval=1e9)
+    st.prepare()
+    st.begin()
+    st.append(row(1))
+    st.abort()                                 # killed: the journal and its meta.json stay
+    meta = parts_dir(path) / "meta.json"
+    meta.write_text('{"broken')
+    st = make(path)                            # the main file names the sweep: resume
+    st.prepare()
+    assert st.begin() == {"id0001"}
+    assert json.loads(meta.read_text())["config_hash"] == "h1"     # written again
+    st.finish()
+    assert list(load(path).scene_id) == ["id0001"]
+    # without a main file nothing tells which config wrote the journal: refused, untouched
+    st = make(path, interval=1e9)
+    st.prepare()
+    st.begin()
+    st.append(row(2))
+    st.abort()
+    os.remove(path)
+    meta.write_text('{"broken')
+    with pytest.raises(InputError, match=r"meta.json does not read .*use --fresh"):
+        make(path).prepare()
+    assert meta.read_text() == '{"broken' and (parts_dir(path) / JOURNAL).exists()
