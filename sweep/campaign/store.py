@@ -53,6 +53,8 @@ File contents (plain arrays and text only; no pickles):
   ``finished_at`` (unix time) and ``engine_revision`` (:data:`sweep.scene.ENGINE_REVISION`;
   absent, NaN, in rows written before it was recorded, which are revision 1).
 * ``/trajectories/<scene_id>/{t, delta, P, a, a_inner}`` when the config asks for them.
+* Numeric columns and trajectory arrays carry HDF5's Fletcher-32 checksum (``fletcher32``;
+  files written before session 50 have none): a damaged one is an InputError on reading.
 * File attributes: ``format``, ``format_version``, ``config_name``, ``config_hash``,
   ``config_text``, ``config_source``, ``package_version``, ``git_commit``, ``numba_version``,
   ``numpy_version``, ``h5py_version``, ``python_version``, ``started_at``, ``updated_at``,
@@ -292,11 +294,23 @@ def _read_runs_frame(f) -> pd.DataFrame:
         kind = ds.attrs.get("kind", "")
         if kind == "str" or h5py.check_string_dtype(ds.dtype) is not None:
             data[c] = np.array(ds.asstr()[()], dtype=object)
-        elif kind == "bool":
-            data[c] = ds[()].astype(bool)
         else:
-            data[c] = ds[()]
+            data[c] = _checked(ds, f"the column {c}")
+            if kind == "bool":
+                data[c] = data[c].astype(bool)
     return pd.DataFrame(data, columns=columns)
+
+
+def _checked(ds, what: str) -> np.ndarray:
+    """The values of the dataset ``ds``; a checksum that fails (a numeric column or a
+    trajectory array written since session 50 carries one, ``fletcher32``) is an
+    InputError naming the file and ``what``."""
+    try:
+        return ds[()]
+    except OSError as exc:
+        raise InputError(f"{ds.file.filename}: {what} does not read "
+                         f"({' '.join(str(exc).split())}): the file is damaged (by the disk "
+                         f"or by hand); it is left as it is") from None
 
 
 def _read_runs_rows(f) -> list[dict]:
@@ -528,7 +542,8 @@ def load_trajectory(path, scene_id: str) -> dict:
         with _open_main(path) as f:
             g = f.get("trajectories")
             if g is not None and scene_id in g:
-                return {k: g[scene_id][k][()] for k in g[scene_id].keys()}
+                return {k: _checked(g[scene_id][k], f"the trajectory {scene_id}/{k}")
+                        for k in g[scene_id].keys()}
             trajectories = bool(f.attrs.get("trajectories", 0))
     elif parts_dir(path).exists():
         trajectories = bool(read_attrs(path).get("trajectories", False))
@@ -615,7 +630,7 @@ def _write_traj_file(target: Path, traj: dict) -> None:
     tmp = target.with_name(target.name + f".tmp{os.getpid()}")
     with h5py.File(tmp, "w") as f:
         for k, v in traj.items():
-            f.create_dataset(str(k), data=np.asarray(v, dtype=np.float64))
+            f.create_dataset(str(k), data=np.asarray(v, dtype=np.float64), fletcher32=True)
     os.replace(tmp, target)
 
 
@@ -962,10 +977,10 @@ class ResultStore:
             vals = [r.get(c) for r in rows] if rows else [self.template.get(c)]
             kind = _column_kind(vals)
             arr = _column_array(vals, kind)[: len(rows)]
-            if kind == "str":
+            if kind == "str":           # HDF5 takes no filter on strings
                 ds = g.create_dataset(c, data=arr, dtype=h5py.string_dtype("utf-8"))
-            else:
-                ds = g.create_dataset(c, data=arr)
+            else:                       # a checksum: damage fails the read (_checked)
+                ds = g.create_dataset(c, data=arr, fletcher32=True)
             ds.attrs["kind"] = kind
         g.attrs["columns"] = np.array(columns, dtype=h5py.string_dtype("utf-8"))
 
@@ -1003,7 +1018,7 @@ class ResultStore:
                             sub = tg.create_group(sid)
                             with h5py.File(part, "r") as p:
                                 for k in p.keys():
-                                    sub.create_dataset(k, data=p[k][()])
+                                    sub.create_dataset(k, data=p[k][()], fletcher32=True)
                         elif old_tg is not None and sid in old_tg:
                             old.copy(old_tg[sid], tg, name=sid)
         finally:

@@ -384,3 +384,39 @@ def test_an_unreadable_journal_meta_is_named_and_the_main_file_still_resumes(tmp
     with pytest.raises(InputError, match=r"meta.json does not read .*use --fresh"):
         make(path).prepare()
     assert meta.read_text() == '{"broken' and (parts_dir(path) / JOURNAL).exists()
+
+
+def _flip_a_byte(path, dataset):
+    with h5py.File(path, "r") as f:
+        info = f[dataset].id.get_chunk_info(0)
+    data = bytearray(path.read_bytes())
+    data[info.byte_offset + 3] ^= 0xFF
+    path.write_bytes(bytes(data))
+
+
+def test_damaged_bytes_in_a_column_or_a_trajectory_fail_their_checksum(tmp_path):
+    """A byte changed on disk inside a numeric column or a trajectory array is found by its
+    Fletcher-32 checksum: load, load_trajectory and a resume say so in one line (an
+    InputError naming the file and the dataset) and leave the file as it is."""
+    path = tmp_path / "r.h5"
+    st = make(path, trajectories=True)
+    st.prepare()
+    st.begin()
+    for i in range(3):
+        st.append(row(i), traj(i))
+    st.finish()
+    _flip_a_byte(path, "trajectories/id0001/P")
+    assert list(load(path).scene_id) == ["id0000", "id0001", "id0002"]
+    with pytest.raises(InputError, match=r"r\.h5: the trajectory id0001/P does not read .*"
+                                         r"damaged"):
+        load_trajectory(path, "id0001")
+    _flip_a_byte(path, "runs/pull_off")
+    before = path.read_bytes()
+    with pytest.raises(InputError, match=r"r\.h5: the column pull_off does not read"):
+        load(path)
+    st = make(path, trajectories=True)
+    st.prepare()
+    with pytest.raises(InputError, match="the column pull_off does not read"):
+        st.begin()
+    st.abort()
+    assert path.read_bytes() == before
