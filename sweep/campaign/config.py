@@ -121,6 +121,19 @@ class SweepConfig:
         """``(scene_id, scene)`` pairs of the sweep, de-duplicated, in grid order."""
         return list(self._tasks)
 
+    def copies_by_unused_n(self) -> int:
+        """How many of the sweep's scenes differ from an earlier one only in ``n``, which
+        their material does not use ("sls", a Prony table): a grid over n crossed with such
+        a material runs each of its scenes once per n, to the same numbers."""
+        seen, copies = set(), 0
+        for _, scene in self._tasks:
+            if scene.material == "mpl":
+                continue
+            key = scene_id(dataclasses.replace(scene, n=1.0), self.numerics)
+            copies += key in seen
+            seen.add(key)
+        return copies
+
     def si_tasks(self) -> list:
         """``(scene_id, SIScene)`` pairs of a ``units: si`` sweep (empty otherwise): the SI
         point that made each scene (the first one, if several give the same scene)."""

@@ -611,6 +611,12 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
         prog.message(f"sweep {cfg.name}: all {len(tasks)} scenes already done -> {path}")
     if store.backup is not None:
         prog.message(f"previous results moved to {store.backup}")
+    copies = cfg.copies_by_unused_n()
+    if copies and todo:
+        prog.message(f"note: {copies} of the scenes differ from another only in n, which "
+                     f"their material (sls, a Prony table) does not use: they compute the "
+                     f"same numbers again (give those materials one n in a sub-grid of their "
+                     f"own: docs/configs.md)")
     older = older_revision_rows(store.rows, {sid for sid, _ in tasks} - {s for s, _ in todo})
     if older:
         kept = ", ".join(f"{count} of revision {rev} ({REVISION_CHANGES.get(rev, 'other numbers')})"

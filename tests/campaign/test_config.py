@@ -556,3 +556,16 @@ def test_a_grid_point_s_own_problems_come_with_the_others():
     text = str(err.value)
     assert "3 problems" in text and "numerics.max_nodes" in text
     assert "a protocol needs approach_rate, preload and dwell together" in text
+
+
+def test_copies_by_unused_n_counts_the_sls_and_table_scenes_a_grid_over_n_repeats():
+    """n is unused by sls and a Prony table: crossed with three n, each of their scenes runs
+    three times to the same numbers, and the config says how many copies that makes."""
+    crossed = config_from_dict({"name": "x", "grid": {"material": ["mpl", "sls"],
+                                                      "n": [0.4, 0.8, 1.6], "rate": [1, 10],
+                                                      "a0": 2.0}})
+    assert len(crossed.tasks()) == 12 and crossed.copies_by_unused_n() == 4
+    apart = config_from_dict({"name": "x", "grid": [
+        {"material": "mpl", "n": [0.4, 0.8, 1.6], "rate": [1, 10], "a0": 2.0},
+        {"material": "sls", "n": 1.0, "rate": [1, 10], "a0": 2.0}]})
+    assert len(apart.tasks()) == 8 and apart.copies_by_unused_n() == 0

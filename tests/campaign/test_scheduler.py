@@ -175,6 +175,19 @@ def test_fresh_moves_the_error_log_aside_with_its_file(tmp_path):
     assert (load(tmp_path / "r.h5.bak").status == "error").sum() == 1
 
 
+def test_a_grid_over_n_crossed_with_sls_says_its_copies(tmp_path):
+    import io
+
+    stream = io.StringIO()
+    run_sweep({"name": "x", "grid": {"material": ["mpl", "sls"], "n": [0.4, 0.8],
+                                     "rate": 1, "a0": 2.0}},
+              jobs=1, out=tmp_path / "r.h5", simulate=fake_simulate, progress="log",
+              stream=stream)
+    said = [ln for ln in stream.getvalue().splitlines() if ln.startswith("note:")]
+    assert len(said) == 1 and said[0].startswith("note: 1 of the scenes differ from another "
+                                                 "only in n")
+
+
 def test_no_error_log_without_errors(tmp_path):
     rep = run_sweep(cfg(), jobs=1, out=tmp_path / "r.h5", simulate=fake_simulate,
                     progress="none")
