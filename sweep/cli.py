@@ -30,7 +30,8 @@ from click.core import ParameterSource
 from .errors import (InputError, as_float, check_array, check_choice, check_int, check_output,
                      check_positive, check_range, writing)
 from ._version import __version__
-from .scene import AXES, PRESETS, REFINEMENTS_ON_REQUEST, Numerics, Scene
+from .scene import (AXES, PRESETS, REFINEMENTS_ON_REQUEST, Numerics, Scene,
+                    preset_for_tolerance)
 
 #: exit code of ``sweep run`` when scenes hit an internal error (the sweep itself finished)
 EXIT_INTERNAL_ERROR = 3
@@ -317,6 +318,10 @@ def scene_command(preset, pull_off_rtol, nodes, domain, step, band_resolution, m
         raise InputError(f"{', '.join(meshless)}: model {axes['model']} has no mesh and no "
                          f"time steps (the BEM's and the elastic branch's options)")
     num = _scene_numerics(preset, pull_off_rtol, overrides)
+    if (pull_off_rtol is not None and click.get_current_context().get_parameter_source(
+            "preset") is not ParameterSource.COMMANDLINE):
+        # the accuracy asked for chose the preset it starts from (Numerics.for_tolerance)
+        preset = f"{preset_for_tolerance(num.pull_off_rtol)} (from --pull-off-rtol)"
     if shares and (si or axes["pz_law"] in (None, "none")):
         raise InputError("--shares: a dimensionless scene with a process zone (--pz-law "
                          "gent-schultz, --pz-v0, --pz-xi)" + (", not --si" if si else ""))

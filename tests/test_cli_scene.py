@@ -174,6 +174,11 @@ def test_scene_asked_for_an_accuracy(capsys):
     assert main(base + ["--pull-off-rtol", "2"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["error: pull_off_rtol must be in (0, 1] (got 2)"]
+    # the text names the preset the request started from, not --preset's default
+    assert main(base + ["--pull-off-rtol", "0.05"]) in (0, 1)
+    assert "BEM: preset=fast (from --pull-off-rtol)" in capsys.readouterr().out
+    assert main(SCENE + ["--pull-off-rtol", "0.05"]) in (0, 1)
+    assert "BEM: preset=fast mesh=" in capsys.readouterr().out
 
 
 def test_scene_text_shows_a_protocols_cycle_and_its_error(capsys):
