@@ -283,7 +283,9 @@ _SI_OPTIONS = ("R", "E0", "Einf", "nu", "tau0", "dg", "h0", "a0_si", "indentatio
               help="Override the preset's largest number of steps.")
 @click.option("--time-budget", "time_budget_s", type=str, default=None,
               help="The scene's time budget [s] (0: none).")
-@click.option("--exact", is_flag=True, help="Exact hereditary integral instead of Prony (slow).")
+@click.option("--exact", is_flag=True,
+              help="Exact hereditary integral instead of Prony (slow), at fixed steps of "
+                   "--step h0 without the Prony run's da_max control (docs/scenes.md).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
 @click.option("--trajectory", is_flag=True, help="With --json, include the trajectory arrays.")
 @click.option("--shares", is_flag=True,

@@ -677,7 +677,10 @@ class Numerics:
         thrashing; the budget is checked between chunks of time steps.
     exact : bool
         Use the exact hereditary integral (integrated compliance, O(steps^2 N)) instead
-        of the Prony recursion. For validation on small problems.
+        of the Prony recursion. For validation on small problems. It marches fixed
+        indentation steps of ``step`` h0, without the Prony run's control of the contact
+        radius's change per step (``da_max``): compare the two at a step fine enough that
+        the exact row no longer moves (docs/scenes.md).
     zone_nodes : float
         Fewest node spacings across the cohesive (process) zone, l0 = 1.693/mu^2 a_ref
         (docs/design.md section 2). A coarser mesh traps the crack tip between nodes (jagged

@@ -53,7 +53,7 @@ from ..units import PhysicalScale
 
 __all__ = ["SIScene", "run_si", "SI_MODELS", "SI_AXES", "si_row", "si_point"]
 
-SI_MODELS = ("bem", "crack", "pb", "auto")
+SI_MODELS = ("bem", "crack", "pb", "elastic", "auto")
 
 
 def _si_axis(name, unit, help, lo=0.0, hi=None, lo_open=True, required=True, order=0):
@@ -378,9 +378,10 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
     Parameters
     ----------
     si : SIScene
-    model : {"bem", "crack", "pb", "auto"}
-        "bem" needs a :class:`sweep.Scene` (its ranges, e.g. mu <= 100); "crack" and "pb" run
-        at any Tabor parameter; "auto" is :func:`sweep.engine.models.choose_model` within the Scene's
+    model : {"bem", "crack", "pb", "elastic", "auto"}
+        "bem" and "elastic" need a :class:`sweep.Scene` (its ranges, e.g. mu <= 100); "crack"
+        runs as :func:`sweep.simulate` runs it within the Scene's ranges and on its law
+        beyond them, and "pb" at any Tabor parameter; "auto" is :func:`sweep.engine.models.choose_model` within the Scene's
         ranges and "crack" beyond them (``model`` in the output says which ran).
     numerics : sweep.Numerics, optional
         BEM discretization (default: the balanced preset); read by "bem" and "auto" only.
@@ -419,11 +420,13 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
             raise InputError(f"{exc}: outside the BEM's scene ranges; use model crack or pb") \
                 from None
         r = simulate_model(scene, "bem", numerics)
-        dim = {"status": r.status, "reason": r.reason, "pull_off": r.pull_off,
-               "a_pulloff": r.a_pulloff, "delta_pulloff": r.delta_pulloff,
-               "t_pulloff": r.t_pulloff, "crack_speed": r.crack_speed, "vhat": r.vhat,
-               "a0": r.a0_result, "delta0": r.delta0_result,
-               "hysteresis_energy": r.hysteresis_energy, "hysteresis_error": r.hysteresis_error}
+        dim = _dimensionless_row(r)
+    elif model == "elastic":
+        try:
+            scene = si.to_scene()
+        except InputError as exc:
+            raise InputError(f"{exc}: outside the elastic branch's scene ranges") from None
+        dim = _dimensionless_row(simulate_model(scene, "elastic", numerics))
     elif model in PROTOCOL_REFUSALS and si.has_protocol:
         dim = {"status": "failed", "reason": PROTOCOL_REFUSALS[model], "a0": None,
                "delta0": None}
@@ -437,14 +440,23 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
         dim = {"status": "failed", "reason": PROCESS_ZONE_REFUSALS["pb"].format(**d),
                "a0": d["a0"], "delta0": d["delta0"]}
     elif model == "crack":
-        law = scene_law(d["n"], d["k"], d["mu"], d["material"], d["pz_law"], d["pz_v0"],
-                        d["pz_xi"])
-        s = unload(law, rate=d["rate"], mu=d["mu"], a0=d["a0"], delta0=d["delta0"])
-        dim = {"status": s.status, "reason": s.reason, "pull_off": s.pull_off,
-               "a_pulloff": s.a_pulloff, "delta_pulloff": s.delta_pulloff,
-               "t_pulloff": s.t_pulloff, "crack_speed": s.crack_speed,
-               "vhat": float(units.vhat_from_crack_speed(s.crack_speed, d["mu"])),
-               "gamma_pulloff": s.gamma_pulloff, "a0": s.a0, "delta0": s.delta0}
+        try:
+            scene = si.to_scene()
+        except InputError:
+            scene = None
+        if scene is not None:
+            # the front door that `sweep run` takes (its nearly elastic and relaxed limits,
+            # the time budget): one answer per scene
+            dim = _dimensionless_row(simulate_model(scene, "crack", numerics))
+        else:       # beyond the Scene's ranges: the crack-front model's law itself
+            law = scene_law(d["n"], d["k"], d["mu"], d["material"], d["pz_law"], d["pz_v0"],
+                            d["pz_xi"])
+            s = unload(law, rate=d["rate"], mu=d["mu"], a0=d["a0"], delta0=d["delta0"])
+            dim = {"status": s.status, "reason": s.reason, "pull_off": s.pull_off,
+                   "a_pulloff": s.a_pulloff, "delta_pulloff": s.delta_pulloff,
+                   "t_pulloff": s.t_pulloff, "crack_speed": s.crack_speed,
+                   "vhat": float(units.vhat_from_crack_speed(s.crack_speed, d["mu"])),
+                   "gamma_pulloff": s.gamma_pulloff, "a0": s.a0, "delta0": s.delta0}
     else:
         e = pb_estimate(d["n"], d["k"], d["mu"], d["rate"], d["material"])
         dim = {"status": "ok", "reason": "", "pull_off": float(e["pull_off"]),
@@ -455,6 +467,15 @@ def run_si(si: SIScene, model: str = "crack", numerics=None) -> dict:
     res["si"] = si.to_dict()
     res.update(_si_of(si, dim))
     return res
+
+
+def _dimensionless_row(r) -> dict:
+    """The dimensionless results of a :class:`sweep.Result` that :func:`run_si` reports."""
+    return {"status": r.status, "reason": r.reason, "pull_off": r.pull_off,
+            "a_pulloff": r.a_pulloff, "delta_pulloff": r.delta_pulloff,
+            "t_pulloff": r.t_pulloff, "crack_speed": r.crack_speed, "vhat": r.vhat,
+            "a0": r.a0_result, "delta0": r.delta0_result,
+            "hysteresis_energy": r.hysteresis_energy, "hysteresis_error": r.hysteresis_error}
 
 
 def si_row(si: SIScene, row) -> dict:

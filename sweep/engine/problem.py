@@ -365,8 +365,8 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None, *,
     if not lo <= scene.mu <= hi:
         others = (", the one model that runs a test protocol or a compliant machine"
                   if scene.protocol() is not None or scene.machine_stiffness is not None else
-                  "; elastic scenes (k = 1, from a0) take the whole Tabor range with model "
-                  "elastic or auto, large contacts the crack-front model (model crack)")
+                  "; beyond it the crack-front model (model crack or auto), the large-mu limit, "
+                  "answers it")
         raise Refused(f"mu = {scene.mu:g} is outside the hereditary BEM's range [{lo:g}, {hi:g}]"
                       f"{others}")
     protocol = scene.protocol()

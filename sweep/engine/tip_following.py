@@ -414,8 +414,9 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
         if not ok:
             raise RuntimeError(f"no equilibrium on the window mesh at the branch state of "
                                f"a0 = {a0:g} (Newton stalls on this window at large mu; "
-                               f"another band_resolution may start it, e.g. 8 at mu 100, "
-                               f"a0 1.2; model auto answers with the crack-front model)")
+                               f"another band_resolution may start it: 16 (the balanced "
+                               f"preset) where the fast preset's 9 fails at mu 8-12, 8 at mu "
+                               f"100, a0 1.2; model auto answers with the crack-front model)")
         spacing = float(np.min(np.diff(el.r)))
         best = [abs(el.radius(h) - a0), h, d]
 
@@ -450,7 +451,10 @@ def initial_state(el: ElasticSolver, scene: Scene, branch=None):
             d_far, h_far, f = d_new, h_new, f_new
             step = math.copysign(min(2.0 * abs(step), 0.2 * el.h0), step)
         if lo is None:
-            raise RuntimeError(f"could not bracket the indentation of a0 = {a0:g}")
+            raise RuntimeError(f"could not bracket the indentation of a0 = {a0:g} on the window "
+                               f"mesh (another band_resolution may start it: 16, the balanced "
+                               f"preset, where the fast preset's 9 fails at mu 8-12; model "
+                               f"auto answers with the crack-front model)")
         for _ in range(60):
             if best[0] <= 1e-10 * a0 or hi[0] - lo[0] <= 1e-14 * max(1.0, abs(d)):
                 break

@@ -608,3 +608,28 @@ def test_run_si_names_a_numerics_that_is_not_one(numerics):
     for model in ("bem", "crack", "auto"):
         with pytest.raises(TypeError, match="numerics must be a sweep.Numerics"):
             run_si(si, model, numerics)
+
+
+def test_run_si_answers_a_scene_as_sweep_run_does():
+    """One answer per scene (user test J, session 50): run_si's crack model had skipped the
+    front door's nearly elastic branch, so an elastic bulk (Einf = E0) raised "k must be < 1"
+    and a nearly elastic one gave another pull-off than `sweep run` stores. It now runs
+    sweep.simulate's path: JKR's 1.5 pi dg R at k = 1, the same row as the Scene's; and the
+    elastic branch is a model of its own."""
+    import dataclasses
+
+    from sweep import simulate
+
+    elastic = dataclasses.replace(pdms(), Einf=pdms().E0)
+    for model in ("crack", "auto"):
+        out = run_si(elastic, model)
+        assert out["status"] == "ok" and out["pull_off"] == pytest.approx(1.5, rel=1e-12)
+    nearly = dataclasses.replace(pdms(), Einf=1.503e6, speed=1e-2)
+    out = run_si(nearly, "crack")
+    row = simulate(nearly.to_scene(model="crack"))
+    assert out["pull_off"] == row.pull_off and out["crack_speed"] == row.crack_speed
+    small = SIScene(R=1e-3, E0=1e6, Einf=1e6, nu=0.5, n=0.5, tau0=0.01, dg=0.05, h0=2e-7,
+                    preload=1e-5, speed=1e-5)
+    out = run_si(small, "elastic")
+    assert out["model"] == "elastic" and out["status"] == "ok"
+    assert out["pull_off"] == simulate(small.to_scene(model="elastic")).pull_off

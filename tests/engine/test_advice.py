@@ -73,6 +73,17 @@ def test_a_protocol_beyond_the_bem_range_is_not_sent_to_the_crack_front_model():
     assert "crack" not in res.reason
 
 
+def test_beyond_the_bem_range_the_advice_names_a_model_that_runs_there():
+    """Above mu = 100 the BEM's refusal had advised the elastic branch, which refuses there
+    too (user test J, session 50): it names the crack-front model, which answers it."""
+    from sweep.engine.models import simulate_model as run
+
+    scene = Scene(n=0.8, k=0.1, mu=1e6, a0=2.0, rate=10.0)
+    res = run(scene, "bem", Numerics.preset("fast"))
+    assert "model elastic" not in res.reason and "model crack or auto" in res.reason
+    assert run(scene, "crack").ok
+
+
 def test_an_unresolved_row_quotes_the_estimate_it_compared():
     """The reason quotes the pair's change and the estimate compared with pull_off_rtol (the
     change over 2^ESTIMATE_ORDER - 1): a change below the tolerance whose estimate is above
