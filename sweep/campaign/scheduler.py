@@ -56,9 +56,10 @@ from tqdm import tqdm
 
 from .config import SweepConfig, as_config
 from ..errors import InputError, check_int, check_range
-from ..scene import ENGINE_REVISION, REVISION_CHANGES, Result
+from ..scene import ENGINE_REVISION, Result
 from . import spool
-from .store import ResultStore, StoreBusyError, error_log_path, plain_row, real_path
+from .store import (ResultStore, StoreBusyError, error_log_path, older_revision_rows,
+                    plain_row, real_path, revision_counts)
 from ..threads import THREAD_VARS, exit_with_parent, limit_env, limit_loaded_pools
 from .forked import ForkedWorkers, usable as forked_workers_usable
 
@@ -145,24 +146,6 @@ def _prepare_worker(warm: bool, limit_threads: bool = True) -> None:
 
         solver.warm_up()
     _WORKER_READY = True
-
-
-def older_revision_rows(rows, ids) -> dict[int, int]:
-    """Rows among ``ids`` computed by an earlier engine revision than this one
-    (:data:`sweep.scene.ENGINE_REVISION`), counted by revision; a row without the column was
-    written by revision 1."""
-    older: dict[int, int] = {}
-    for row in rows:
-        if row.get("scene_id") not in ids:
-            continue
-        rev = row.get("engine_revision")
-        try:
-            rev = int(rev) if rev is not None and math.isfinite(float(rev)) else 1
-        except (TypeError, ValueError):
-            rev = 1
-        if rev != ENGINE_REVISION:
-            older[rev] = older.get(rev, 0) + 1
-    return older
 
 
 def _one_line(text: str, limit: int = 300) -> str:
@@ -619,9 +602,8 @@ def run_sweep(config, jobs: int | None = None, backend: str = "local",
                      f"own: docs/configs.md)")
     older = older_revision_rows(store.rows, {sid for sid, _ in tasks} - {s for s, _ in todo})
     if older:
-        kept = ", ".join(f"{count} of revision {rev} ({REVISION_CHANGES.get(rev, 'other numbers')})"
-                         for rev, count in sorted(older.items()))
-        prog.message(f"{path} keeps finished rows of an earlier engine: {kept}; this engine is "
+        prog.message(f"{path} keeps finished rows of an earlier engine: "
+                     f"{revision_counts(older)}; this engine is "
                      f"revision {ENGINE_REVISION} (column engine_revision); use --fresh to "
                      f"compute every row again")
     if store.grown_from and todo:

@@ -1061,6 +1061,31 @@ class ResultStore:
 SCENE_PARAMS = SCENE_AXES
 
 
+def older_revision_rows(rows, ids) -> dict[int, int]:
+    """Rows among ``ids`` computed by an earlier engine revision than this one
+    (:data:`sweep.scene.ENGINE_REVISION`), counted by revision; a row without the column was
+    written by revision 1."""
+    older: dict[int, int] = {}
+    for row in rows:
+        if row.get("scene_id") not in ids:
+            continue
+        rev = row.get("engine_revision")
+        try:
+            rev = int(rev) if rev is not None and math.isfinite(float(rev)) else 1
+        except (TypeError, ValueError):
+            rev = 1
+        if rev != ENGINE_REVISION:
+            older[rev] = older.get(rev, 0) + 1
+    return older
+
+
+def revision_counts(older: dict[int, int]) -> str:
+    """``3 of revision 1 (what it computed otherwise)``, for each count of
+    :func:`older_revision_rows`."""
+    return ", ".join(f"{count} of revision {rev} ({REVISION_CHANGES.get(rev, 'other numbers')})"
+                     for rev, count in sorted(older.items()))
+
+
 def _g(x) -> str:
     return f"{x:.4g}" if isinstance(x, (float, np.floating)) else str(x)
 
@@ -1091,15 +1116,10 @@ def summary(path, slowest: int = 5) -> str:
     if len(df) and "status" in df:
         counts = df["status"].value_counts()
         lines.append("  status: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
-    if len(df):
-        revision = (np.nan_to_num(df["engine_revision"].to_numpy(float), nan=1.0)
-                    if "engine_revision" in df else np.ones(len(df))).astype(int)
-        if (revision != ENGINE_REVISION).any():
-            older = np.unique(revision[revision != ENGINE_REVISION], return_counts=True)
-            kept = ", ".join(f"{v} of revision {k} ({REVISION_CHANGES.get(int(k), 'other numbers')})"
-                             for k, v in zip(*older))
-            lines.append(f"  engine: rows of an earlier engine than this one (revision "
-                         f"{ENGINE_REVISION}): {kept}")
+    older = older_revision_rows(df.to_dict("records"), set(df["scene_id"])) if len(df) else {}
+    if older:
+        lines.append(f"  engine: rows of an earlier engine than this one (revision "
+                     f"{ENGINE_REVISION}): {revision_counts(older)}")
     varying, fixed = [], []
     # n is unused where every material is a Prony table (its value is bookkeeping)
     tables = (len(df) and "material" in df
