@@ -584,43 +584,29 @@ def test_sigint_says_what_is_kept_and_how_to_resume(tmp_path, monkeypatch, capsy
     assert (report.ran, report.skipped) == (1, 3)
 
 
-def test_sigint_to_the_process_group_keeps_scenes(tmp_path):
-    """Ctrl-C in a terminal signals the parent and its workers: one line says how many
-    scenes are kept (as many as the file holds) and the command that resumes."""
+@pytest.mark.parametrize("sig, jobs, group, code, word", [
+    (signal.SIGINT, 2, True, 130, "interrupted"),
+    (signal.SIGTERM, 1, False, 143, "terminated"),
+])
+def test_a_signal_keeps_scenes_and_says_how_to_resume(tmp_path, sig, jobs, group, code, word):
+    """Ctrl-C in a terminal signals the parent and its workers; SIGTERM (what `timeout` or a
+    batch system's time limit sends) the parent alone. Either ends the sweep with the
+    finished scenes stored and one line saying how many are kept (as many as the file holds)
+    and the command that resumes; exit 130 and 143."""
     cfg = write(tmp_path / "big.yaml", KILL_CFG.replace("{preset: fast, nodes: 60}",
                                                         "{preset: balanced}")
                 .replace("a0: [2.0, 2.5]", "a0: [3.0, 4.0, 5.0]"))
-    run = Sweep(tmp_path, ["run", str(cfg), "-j", "2", "--progress", "log"])
-    run.wait_lines(2)
-    assert run.p.poll() is None, "sweep finished before the interrupt"
-    os.killpg(run.p.pid, signal.SIGINT)
-    code = run.p.wait(timeout=60)
-    assert code == 130, (code, "".join(run.raw)[-2000:])
-    run.pump.join(timeout=30)                        # stderr read to its end
-    text = "".join(run.raw)
-    m = re.search(r"^interrupted: (\d+) of 36 scenes are kept in (\S+); to resume, run: "
-                  r"sweep run \S+big.yaml$", text, re.M)
-    assert m, text
-    assert int(m.group(1)) == len(load(tmp_path / "kill.h5")) >= 2
-    assert "Traceback" not in text
-
-
-def test_sigterm_keeps_scenes_and_says_how_to_resume(tmp_path):
-    """SIGTERM to the parent (what `timeout` or a batch system's time limit sends) ends the
-    sweep as Ctrl-C does: the finished scenes stored, one line with the command that
-    resumes, exit 143."""
-    cfg = write(tmp_path / "big.yaml", KILL_CFG.replace("{preset: fast, nodes: 60}",
-                                                        "{preset: balanced}")
-                .replace("a0: [2.0, 2.5]", "a0: [3.0, 4.0, 5.0]"))
-    run = Sweep(tmp_path, ["run", str(cfg), "-j", "1", "--progress", "log"])
+    run = Sweep(tmp_path, ["run", str(cfg), "-j", str(jobs), "--progress", "log"])
     run.wait_lines(2)
     assert run.p.poll() is None, "sweep finished before the signal"
-    run.p.send_signal(signal.SIGTERM)
-    code = run.p.wait(timeout=60)
-    assert code == 143, (code, "".join(run.raw)[-2000:])
-    run.pump.join(timeout=30)
+    if group:
+        os.killpg(run.p.pid, sig)
+    else:
+        run.p.send_signal(sig)
+    assert run.p.wait(timeout=60) == code, "".join(run.raw)[-2000:]
+    run.pump.join(timeout=30)                        # stderr read to its end
     text = "".join(run.raw)
-    m = re.search(r"^terminated: (\d+) of 36 scenes are kept in (\S+); to resume, run: "
+    m = re.search(rf"^{word}: (\d+) of 36 scenes are kept in (\S+); to resume, run: "
                   r"sweep run \S+big.yaml$", text, re.M)
     assert m, text
     assert int(m.group(1)) == len(load(tmp_path / "kill.h5")) >= 2

@@ -369,7 +369,7 @@ def load(path) -> pd.DataFrame:
     jf = _frame_from_rows(newer, cols)
     kept = main[~main["scene_id"].isin({r["scene_id"] for r in newer})]
     if len(kept) == 0:
-        return _dedupe(jf)
+        return jf                   # one row per scene already (newer)
     return _dedupe(pd.concat([kept, jf], ignore_index=True))
 
 

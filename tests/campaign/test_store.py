@@ -37,6 +37,17 @@ def make(path, n_scenes=6, trajectories=False, config_hash="h1", **kw):
                        n_scenes=n_scenes, trajectories=trajectories, template_row=TEMPLATE, **kw)
 
 
+def written(path, scenes=3, trajectories=False):
+    """A finished results file of ``scenes`` rows (and their trajectories)."""
+    st = make(path, trajectories=trajectories)
+    st.prepare()
+    st.begin()
+    for i in range(scenes):
+        st.append(row(i), traj(i) if trajectories else None)
+    st.finish()
+    return path
+
+
 def test_round_trip_plain_types(tmp_path):
     path = tmp_path / "r.h5"
     st = make(path)
@@ -67,13 +78,7 @@ def test_sweep_reexports():
 
 
 def test_file_holds_plain_arrays_and_text_only(tmp_path):
-    path = tmp_path / "r.h5"
-    st = make(path, trajectories=True)
-    st.prepare()
-    st.begin()
-    for i in range(3):
-        st.append(row(i), traj(i))
-    st.finish()
+    path = written(tmp_path / "r.h5", trajectories=True)
     seen = []
 
     def visit(name, obj):
@@ -398,13 +403,7 @@ def test_damaged_bytes_in_a_column_or_a_trajectory_fail_their_checksum(tmp_path)
     """A byte changed on disk inside a numeric column or a trajectory array is found by its
     Fletcher-32 checksum: load, load_trajectory and a resume say so in one line (an
     InputError naming the file and the dataset) and leave the file as it is."""
-    path = tmp_path / "r.h5"
-    st = make(path, trajectories=True)
-    st.prepare()
-    st.begin()
-    for i in range(3):
-        st.append(row(i), traj(i))
-    st.finish()
+    path = written(tmp_path / "r.h5", trajectories=True)
     _flip_a_byte(path, "trajectories/id0001/P")
     assert list(load(path).scene_id) == ["id0000", "id0001", "id0002"]
     with pytest.raises(InputError, match=r"r\.h5: the trajectory id0001/P does not read .*"
