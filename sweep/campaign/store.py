@@ -1132,10 +1132,15 @@ def summary(path, slowest: int = 5) -> str:
             col = col.dropna()
             if not len(col):
                 continue
-            uniq = np.unique(col)
+            # values that differ only in their last bits (a table's k read from two
+            # formats) are one value
+            uniq = np.unique([float(f"{v:.12g}") for v in col] if col.dtype.kind == "f"
+                             else col)
             if len(uniq) > 1:
-                varying.append(f"{c}: {len(uniq)} values in [{_g(uniq.min())}, "
-                               f"{_g(uniq.max())}]")
+                lo, hi = _g(uniq.min()), _g(uniq.max())
+                if lo == hi:
+                    lo, hi = f"{uniq.min():.12g}", f"{uniq.max():.12g}"
+                varying.append(f"{c}: {len(uniq)} values in [{lo}, {hi}]")
             else:
                 fixed.append(f"{c}={_g(uniq[0])}")
         else:

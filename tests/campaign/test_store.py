@@ -312,6 +312,35 @@ def test_summary_text(tmp_path):
     assert "failures (2):" in text and "Newton failed" in text
 
 
+def test_summary_names_values_that_differ_in_the_last_bits_once(tmp_path):
+    """A table's k read from two formats differs in its last bits: one value, not "2 values
+    in [0.05, 0.05]"; two values that print alike at 4 digits print with more."""
+    path = tmp_path / "r.h5"
+    st = make(path, n_scenes=4)
+    st.prepare()
+    st.begin()
+    ks = (0.05, 0.05 * (1 + 2 ** -50), 0.3, 0.30001)
+    for i, k in enumerate(ks):
+        st.append({**row(i), "k": k, "rate": 1.0 if i < 2 else 10.0})
+    st.finish()
+    text = summary(path)
+    assert "k: 3 values in [0.05, 0.3]" in text
+    st2 = make(tmp_path / "s.h5", n_scenes=2)
+    st2.prepare()
+    st2.begin()
+    for i, k in enumerate(ks[:2]):
+        st2.append({**row(i), "k": k})
+    st2.finish()
+    assert "k=0.05" in summary(tmp_path / "s.h5")
+    st3 = make(tmp_path / "t.h5", n_scenes=2)
+    st3.prepare()
+    st3.begin()
+    for i, k in enumerate((0.123451, 0.123452)):
+        st3.append({**row(i), "k": k})
+    st3.finish()
+    assert "k: 2 values in [0.123451, 0.123452]" in summary(tmp_path / "t.h5")
+
+
 def test_kill_during_consolidation_leaves_old_file(tmp_path):
     """A consolidation cut short leaves only a stray .tmp: readers ignore it, writers drop it."""
     path = tmp_path / "r.h5"
