@@ -256,6 +256,22 @@ def test_the_figure_names_what_was_held_constant():
     assert "material = prony:gmm:a06e69d9b019ec0e" in constant_axes(table)
 
 
+def test_a_long_title_is_wrapped_inside_the_figure():
+    """A results file's title with many constant axes ran past the figure's edge: it is
+    wrapped, every line inside the figure."""
+    df = synthetic_frame(CONFIGS / "demo.yaml")
+    title = "results.h5: 12 ok, 0 failed; " + ", ".join(f"axis{i} = {i}.12345" for i in range(30))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = sweep_figure(df, title)
+        fig.savefig(io.BytesIO(), format="png", dpi=50)
+    text = fig._suptitle
+    assert text.get_text().count("\n") >= 1
+    assert text.get_text().replace("\n", " ") == title
+    box = text.get_window_extent(fig.canvas.get_renderer())
+    assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1
+
+
 def test_an_abscissa_says_what_it_is_and_in_what():
     """With a0 as the abscissa its label had been a bare symbol (no name, no unit)."""
     from sweep.analysis.plots import axis_label
