@@ -396,8 +396,12 @@ def prepare(scene: Scene, numerics: Numerics, band: tuple | None = None, *,
         raise Refused(f"mesh too coarse: the tip zone {zone_length:.3g} a_ref spans {zone:.2g} "
                       f"node spacings (< zone_nodes = {numerics.zone_nodes:g}); {advice}")
     if mesh.nodes > numerics.max_nodes:
-        other = ("" if window else "; or run it on the tip-following mesh "
-                 "(sweep.engine.tip_following; model bem does so)")
+        # a compliant machine runs on the graded or uniform mesh only (docs/design.md)
+        other = ("" if window else
+                 "; a compliant machine runs only on this mesh, never the tip-following one"
+                 if scene.machine_stiffness is not None else
+                 "; or run it on the tip-following mesh (sweep.engine.tip_following; model "
+                 "bem does so)")
         raise Refused(f"mesh too large: the {'window' if window else 'crack band'} needs "
                       f"{mesh.nodes} nodes at band_resolution {numerics.band_resolution:g} (> "
                       f"max_nodes = {numerics.max_nodes}); raise max_nodes or lower "
