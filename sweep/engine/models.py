@@ -364,8 +364,12 @@ def model_choice(scene, numerics=None) -> Choice:
     if scene.protocol() is not None:
         return Choice("bem", "auto: BEM, the one model with a test protocol (approach, dwell, "
                              "retract)")
+    if scene.machine_stiffness is not None and wants_quasistatic(scene, numerics):
+        return Choice("elastic", "auto: k = 1, quasi-static: the elastic branch (the "
+                                 "compliant machine holds it on the same branch up to the "
+                                 "load minimum)")
     if scene.machine_stiffness is not None:
-        return Choice("bem", "auto: BEM, the one model with a compliant machine "
+        return Choice("bem", "auto: BEM, the one viscoelastic model with a compliant machine "
                              "(machine_stiffness)")
     if scene.pz_law != "none":
         return Choice("crack", f"auto: crack-front model with the process zone (pz_law "
@@ -422,15 +426,15 @@ MODELS = {"bem": _bem, "crack": simulate_crack, "pb": simulate_pb, "elastic": si
 def wants_quasistatic(scene, numerics) -> bool:
     """Whether a "bem" or "auto" scene is elastic and quasi-static, so that the equilibrium
     branch (:mod:`sweep.engine.quasistatic`) answers it without the hereditary machinery: k = 1,
-    no process zone (a rate-dependent interface is not quasi-static), a rigid machine (the
-    branch prescribes the sphere's indentation), started from a0, stopped at the pull-off, on
+    no process zone (a rate-dependent interface is not quasi-static), started from a0,
+    stopped at the pull-off (a compliant machine holds the sphere on the same branch up to
+    its load minimum: :func:`sweep.engine.quasistatic.simulate_elastic`), on
     the engine's own mesh (an explicit ``numerics.domain`` or ``exact`` asks for the
     hereditary BEM on that domain). A test protocol too: without memory, its approach and
     dwell end in the branch's equilibrium at the preload."""
     return (scene.k == 1.0 and (scene.a0 is not None or scene.protocol() is not None)
             and scene.stop == "pulloff"
-            and numerics.domain is None and not numerics.exact and scene.pz_law == "none"
-            and scene.machine_stiffness is None)
+            and numerics.domain is None and not numerics.exact and scene.pz_law == "none")
 
 
 #: a crack row with a process zone: its difference from the BEM's local law, measured by
@@ -485,14 +489,12 @@ PROTOCOL_REFUSALS = {
 }
 
 
-#: why each model but the BEM refuses a scene with a compliant machine (``machine_stiffness``):
+#: why each model but the BEM and the elastic branch refuses a scene with a compliant machine
 #: a failed row with this reason (not a physical refusal: the BEM answers it; auto sends it
 #: there)
 MACHINE_REFUSALS = {
     "crack": "the crack-front model prescribes the sphere's indentation: a compliant machine "
              "(machine_stiffness) runs with model bem or auto",
-    "elastic": "the elastic branch prescribes the sphere's indentation: a compliant machine "
-               "(machine_stiffness) runs with model bem or auto",
     "pb": "the pb estimate's v-r fit was measured with a rigid machine: a compliant machine "
           "(machine_stiffness) runs with model bem or auto",
 }

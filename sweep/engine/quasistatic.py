@@ -429,6 +429,13 @@ def simulate_elastic(scene, numerics=None):
     ``steps`` = equilibrium solves, ``factorizations`` = Newton iterations (one dense solve
     each). A numerical failure gives ``status="failed"`` with the reason, never raises.
 
+    A compliant machine (``machine_stiffness`` K) holds an elastic sphere on the same
+    branch, which depends on delta alone, stably up to the load minimum (dP/ddelta > 0 > -K
+    there): the pull-off and the radius at it are the rigid machine's, and so is the crack
+    speed, for the sphere moves at the machine's rate where dP/dt = 0. Only the clock
+    differs: the machine's displacement D = delta + P/K falls at rate h0, t = (D0 - D) /
+    (rate h0); the records' ``delta`` is the sphere's.
+
     A scene with a test protocol (approach, dwell, retract) runs on the branch too
     (:func:`_protocol_start`): an elastic bulk has no memory, so the approach follows the
     branch from first contact up to the preload, the dwell (held at force or at depth) changes
@@ -553,7 +560,11 @@ def _simulate_elastic(scene, numerics, scale: float):
     res.status = "ok"
     res.reason = po.reason
     res.pull_off, res.a_pulloff, res.delta_pulloff = po.pull_off, po.a, po.delta
-    res.t_pulloff = t_start + (d0 - po.delta) / speed
+    # the machine's displacement, D = delta + P/K (a compliant machine's; delta for a rigid
+    # one), falls at rate h0 and sets the clock
+    compliance = 0.0 if scene.machine_stiffness is None else 1.0 / scene.machine_stiffness
+    D0 = d0 + compliance * float(loads[0])
+    res.t_pulloff = t_start + (D0 - (po.delta - compliance * po.pull_off)) / speed
     res.crack_speed = speed / po.ddelta_da
     res.vhat = res.crack_speed / scales.process_zone
     res.rhat_pb = scales.loading_speed
@@ -571,7 +582,8 @@ def _simulate_elastic(scene, numerics, scale: float):
             res.status, res.reason = "failed", f"protocol: {err}"
             res.wall_s = time.perf_counter() - t0
             return res
-    res.trajectory = {"t": t_start + (d0 - d_tr) / speed, "delta": d_tr, "P": P_tr, "a": a_tr,
+    res.trajectory = {"t": t_start + (D0 - (d_tr + compliance * P_tr)) / speed, "delta": d_tr,
+                      "P": P_tr, "a": a_tr,
                       "a_inner": np.full(a_tr.size, np.nan)}
     if approach is not None:
         _join_protocol(res, approach)

@@ -130,11 +130,41 @@ def test_a_rigid_machine_keeps_the_scene_id():
 
 
 def test_other_models_refuse_a_compliant_machine_and_auto_runs_the_bem():
-    scene = Scene(**ELASTIC, machine_stiffness=1.0)
-    for model in ("crack", "elastic", "pb"):
+    scene = Scene(**VISCO, machine_stiffness=1.0)
+    for model in ("crack", "pb"):
         res = simulate_model(scene, model, FAST)
         assert res.status == "failed" and res.reason == MACHINE_REFUSALS[model]
     assert model_choice(scene, FAST).model == "bem"
+    assert model_choice(Scene(**ELASTIC, machine_stiffness=1.0), FAST).model == "elastic"
+
+
+def test_the_elastic_branch_holds_a_soft_spring_at_the_rigid_machines_pull_off():
+    """An elastic sphere on a spring (k = 1): the branch, which depends on delta alone, is held
+    up to the load minimum for any K > 0, so its pull-off, radius and crack speed are the
+    rigid machine's; the records' machine displacement delta + P/K falls at rate h0. Soft
+    springs the BEM's coarse mesh cannot cross (K 0.03 at the balanced preset, mu 5: "no
+    equilibrium found", a user test of session 51; 1.52571 on a finer mesh) run on it, and
+    model bem and auto send such scenes there."""
+    scene = dict(n=0.5, k=1.0, mu=5.0, a0=2.0, rate=10.0)
+    balanced = Numerics.preset("balanced")
+    rigid = simulate_model(Scene(**scene), "elastic", balanced)
+    assert rigid.ok
+    for K in (0.01, 0.03, 1.0):
+        sc = Scene(**scene, machine_stiffness=K)
+        res = simulate_model(sc, "elastic", balanced)
+        assert res.ok, res.reason
+        for name in ("pull_off", "a_pulloff", "delta_pulloff", "crack_speed"):
+            assert getattr(res, name) == getattr(rigid, name), name
+        tr = res.trajectory
+        D = tr["delta"] + tr["P"] / K
+        h0 = prepare(sc, balanced).h0
+        np.testing.assert_allclose(D, D[0] - sc.rate * h0 * tr["t"], rtol=0, atol=1e-12)
+        assert np.all(np.diff(tr["t"]) > 0.0)
+        assert res.t_pulloff > rigid.t_pulloff    # the spring stretches first
+        via_bem = simulate_model(sc, "bem", balanced)
+        assert via_bem.model_used == "elastic" and via_bem.pull_off == rigid.pull_off
+    # the finer BEM on the soft spring (band resolution 32, as the user test): 1.52571
+    assert abs(rigid.pull_off / 1.52571 - 1.0) < 2e-4
 
 
 def test_a_protocol_with_a_compliant_machine_is_refused():
