@@ -9,7 +9,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export NUMBA_NUM_THREADS ?= 1
 
-.PHONY: help venv demo test test-slow test-other-blas coverage-kernels bench bench-detail bench-reference \
+.PHONY: help venv demo test test-slow test-other-blas coverage-kernels bench bench-detail bench-reference bench-accurate held-tip \
         tradeoff bench-convergence clean threshold vr fig3 figures report reproduce pdms pdms-bem pdms-protocol \
         agreement agreement-high-mu extremes tip-convergence elastic-table calibrate-demo \
         model-errors error-coverage extrapolation crack-speed random-sample docs-check docs
@@ -26,6 +26,8 @@ help:
 	@echo "make bench  - speed benchmarks of issues 9 and 24 (results/bench.json, ~5 min)"
 	@echo "make bench-detail - the scene, presets and scheduler benchmarks apart (results/bench/)"
 	@echo "make bench-reference - converged references of the tradeoff and vs-numpy scenes (configs/references.json, ~3 min)"
+	@echo "make held-tip - accuracy requests where the nodes may hold the crack tip, relaxed starts and protocols (results/error_coverage/held_tip.json, ~5 min)"
+	@echo "make bench-accurate - the engine against the plain numpy solver at the accurate preset (results/bench/vs_numpy_accurate.json, ~10 min)"
 	@echo "make bench-convergence - the BEM's pull-off against the node count at mu = 6 (results/bench/)"
 	@echo "make tradeoff [QUICK=1] - accuracy vs time over a grid of numerics (results/tradeoff/)"
 	@echo "make coverage-kernels - kernel tests with NUMBA_DISABLE_JIT=1 under coverage"
@@ -128,6 +130,9 @@ tradeoff: $(STAMP)
 # converged references of the tradeoff and vs-numpy scenes (configs/references.json; slow)
 bench-reference: $(STAMP)
 	$(BIN)/python -m sweep.bench.benchmarks reference
+
+bench-accurate: $(STAMP)
+	$(BIN)/python -m sweep.bench.benchmarks vs-numpy-accurate --out results/bench/vs_numpy_accurate.json
 
 bench-detail: $(STAMP)
 	$(BIN)/python -m sweep.bench.benchmarks scene --out results/bench/scene.json
@@ -268,6 +273,10 @@ extrapolation: $(STAMP)
 	$(BIN)/python -m sweep.bench.extrapolation
 	test -f $(SEED11) || $(BIN)/python -m sweep.bench.extrapolation --references 40 --seed 11 --coverage $(SEED11)
 	$(BIN)/python -m sweep.bench.extrapolation --coverage $(SEED11) --out results/error_coverage/extrapolation_seed11.json
+
+# requests where the nodes may hold the crack tip (relaxed starts and protocols; ~5 min)
+held-tip: $(STAMP)
+	$(BIN)/python -m sweep.bench.held_tip --out results/error_coverage/held_tip.json
 
 error-coverage: $(STAMP)
 	$(BIN)/python -m sweep.bench.error_coverage $(if $(filter 1,$(QUICK)),--scenes 6 --out results/quick/error_coverage)

@@ -1327,6 +1327,50 @@ def convergence_cmd(mu, nodes, out):
     _write(bench_convergence(mu=mu, nodes=tuple(int(x) for x in nodes.split(","))), out)
 
 
+#: the plain solver's ladder towards the accurate preset's errors (a few 1e-6 on two bench
+#: scenes): runs of 4-110 s each on this machine
+ACCURATE_PLAIN_LADDER = ((600, 0.05), (900, 0.05), (900, 0.025), (1200, 0.025), (1600, 0.025),
+                         (2000, 0.025))
+#: a check of the stored references at the accurate preset's errors: the same scene on the
+#: graded mesh at 108 spacings per tip zone, step 0.025 h0 (a discretization unlike the
+#: references' uniform 2000 nodes)
+REFERENCE_CHECK = dict(band_resolution=108.0, step=0.025, da_max=0.1, prony_rtol=1e-8,
+                       tol=1e-11, pull_off_rtol=0.0, max_nodes=5000, time_budget_s=900.0)
+
+
+def bench_vs_numpy_accurate(repeat: int = 3, progress=print) -> dict:
+    """:func:`bench_vs_numpy` at the accurate preset: the speed-up at equal accuracy where
+    the errors are a few 1e-6 (the plain solver's ladder :data:`ACCURATE_PLAIN_LADDER`, up
+    to 150 s a run), and each stored reference checked against a second discretization
+    (:data:`REFERENCE_CHECK`): where the two differ by as much as the engine's error, the
+    ratio there cannot be read."""
+    plan = BenchPlan(engine_numerics={"balanced": {"preset": "balanced"},
+                                      "accurate": {"preset": "accurate"}},
+                     plain_ladder=ACCURATE_PLAIN_LADDER, plain_time_limit_s=150.0,
+                     repeat=repeat)
+    out = bench_vs_numpy(plan, progress=progress)
+    refs = load_references()
+    for name, sdict in plan.vs_numpy_scenes.items():
+        check = simulate(Scene(**sdict), Numerics.preset("accurate", **REFERENCE_CHECK))
+        ref = refs[name]["pull_off"]
+        out[name]["reference_check"] = {
+            "numerics": REFERENCE_CHECK, "status": check.status, "pull_off": check.pull_off,
+            "wall_s": check.wall_s, "relative_difference": relative_error(check.pull_off, ref)}
+        progress(f"vs_numpy_accurate {name}: reference check {check.pull_off:.9g} "
+                 f"({relative_error(check.pull_off, ref):.2e} from the stored reference)")
+    return {"kind": "vs_numpy_accurate", "machine": _machine(), "scenes": out}
+
+
+@bench.command("vs-numpy-accurate")
+@click.option("--repeat", type=int, default=3, show_default=True)
+@click.option("--out", default="results/bench/vs_numpy_accurate.json", show_default=True,
+              help="JSON report path.")
+def vs_numpy_accurate_cmd(repeat, out):
+    """The engine against the plain numpy solver at the accurate preset (about 10 min)."""
+    _write(bench_vs_numpy_accurate(repeat=repeat, progress=lambda m: click.echo(m, err=True)),
+           out)
+
+
 @bench.command("all")
 @click.option("--tiny", is_flag=True, help="Seconds-long configuration (harness check).")
 @click.option("--out", default="results/bench.json", show_default=True, help="JSON report path.")
