@@ -326,6 +326,15 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
         res.reason = f"step limit ({res.numerics.max_steps}) reached before pull-off"
         return
     if status == STATUS_NEWTON_FAILED and not passed:
+        if machine_stiffness is not None and len(P) - first <= 1:
+            # no step from the start: a spring cannot hold a start whose load falls faster
+            # than K per unit indentation, which no mesh changes (a user test of session 51)
+            res.reason = (f"{FOLD_REASON} (delta={delta[-1]:.6g}, a={a[-1]:.4g}), at the first "
+                          f"step: the compliant machine (K = {machine_stiffness:.4g}) cannot "
+                          f"hold a start whose load falls faster than K per unit indentation "
+                          f"(dP/ddelta < -K, a contact below its pull-off radius); a stiffer "
+                          f"machine or a larger a0 holds it, else {advice}")
+            return
         res.reason = (f"{FOLD_REASON} (delta={delta[-1]:.6g}, a={a[-1]:.4g}): the discrete "
                       f"path folds where the crack tip is under-resolved; {advice}")
         return

@@ -434,7 +434,10 @@ def simulate_elastic(scene, numerics=None):
     there): the pull-off and the radius at it are the rigid machine's, and so is the crack
     speed, for the sphere moves at the machine's rate where dP/dt = 0. Only the clock
     differs: the machine's displacement D = delta + P/K falls at rate h0, t = (D0 - D) /
-    (rate h0); the records' ``delta`` is the sphere's.
+    (rate h0); the records' ``delta`` is the sphere's. A start below the pull-off radius is
+    the load minimum itself (no crack speed, as with a rigid machine); where its load falls
+    faster than K per unit indentation (dP/ddelta < -K) the spring cannot hold it, and the
+    row fails with that reason.
 
     A scene with a test protocol (approach, dwell, retract) runs on the branch too
     (:func:`_protocol_start`): an elastic bulk has no memory, so the approach follows the
@@ -553,6 +556,17 @@ def _simulate_elastic(scene, numerics, scale: float):
     scales = derive(scene, res.numerics)
     radii, loads, deltas = po.branch
     stop = int(np.argmin(deltas)) + 1          # the displacement-controlled fold
+    if scene.machine_stiffness is not None and approach is None:
+        # a start whose load falls faster than the spring's stiffness per unit indentation
+        # (below the pull-off radius) cannot be held: the sphere jumps off at once
+        slope = float((loads[1] - loads[0]) / (deltas[1] - deltas[0]))
+        if slope < -scene.machine_stiffness:
+            res.reason = (f"the compliant machine cannot hold the start: there dP/ddelta = "
+                          f"{slope:.4g} < -K = {-scene.machine_stiffness:.4g} (the contact "
+                          f"starts below its pull-off radius, and the sphere jumps off at "
+                          f"once); a stiffer machine or a larger a0 holds it")
+            res.wall_s = time.perf_counter() - t0
+            return res
     keep = radii[:stop] >= po.a
     d0 = float(deltas[0])
     speed = scales.loading_speed

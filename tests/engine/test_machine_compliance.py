@@ -172,3 +172,25 @@ def test_a_protocol_with_a_compliant_machine_is_refused():
     with pytest.raises(InputError, match="machine_stiffness: a compliant machine"):
         Scene(n=0.5, k=0.1, mu=5.0, rate=10.0, approach_rate=10.0, preload=1.0, dwell=0.0,
               machine_stiffness=1.0)
+
+
+def test_a_start_the_spring_cannot_hold_is_refused_with_the_reason():
+    """An elastic contact started below its pull-off radius (mu 5, a0 0.8 < 1.04) is the load
+    minimum itself, where JKR's dP/ddelta = (4a^2 - 3 sqrt2 sqrt a)/(2a - 1/sqrt(2a)) = -1.525:
+    a spring of K = 1 cannot hold it (the sphere jumps off at once). The elastic branch
+    returned it `ok` and the BEM blamed its mesh (a user test of session 51); a spring of
+    K = 3 holds it at the rigid machine's pull-off."""
+    scene = dict(n=0.5, k=1.0, mu=5.0, a0=0.8, rate=10.0)
+    balanced = Numerics.preset("balanced")
+    rigid = simulate_model(Scene(**scene), "elastic", balanced)
+    assert rigid.ok and rigid.reason == "largest tension at the start"
+    weak = simulate_model(Scene(**scene, machine_stiffness=1.0), "elastic", balanced)
+    assert weak.status == "failed" and "cannot hold the start" in weak.reason
+    slope = float(weak.reason.split("dP/ddelta = ")[1].split(" ")[0])
+    assert abs(slope / -1.525 - 1.0) < 0.05          # the branch's slope, JKR's closed form
+    stiff = simulate_model(Scene(**scene, machine_stiffness=3.0), "elastic", balanced)
+    assert stiff.ok and stiff.pull_off == rigid.pull_off
+    # the hereditary BEM (forced by an explicit domain) names the spring, not only the mesh
+    bem = simulate(Scene(**scene, machine_stiffness=1.0),
+                   dataclasses.replace(balanced, domain=6.0, pull_off_rtol=0.0))
+    assert bem.status == "failed" and "cannot hold a start" in bem.reason
