@@ -320,3 +320,66 @@ def test_the_lennard_jones_tail_beyond_the_mesh_is_in_the_load():
     # (1.5458048848394892, main 474f0b5), for references that drop the tail too
     truncated = simulate(scene, Numerics.preset("accurate", lj_tail=False))
     assert truncated.pull_off == pytest.approx(1.5458048848394892, rel=1e-12)
+
+
+# ------------------------------------------------------------------ the recursion's ringing
+
+def test_the_recursions_amplification_is_the_trapezoids_for_an_sls():
+    """One SLS mode, Chat = 1 - (1 - k) exp(-t): the traction relaxes in tau_R = k, and the
+    recursion's step carries an error by about the trapezoid's (1 - x/2)/(1 + x/2), x =
+    dt/tau_R (the exact exponentials of b_i make it differ by less than 0.02), its other
+    eigenvalue 0: the most negative of the two is min(factor, 0)."""
+    from sweep.engine.bem import ringing_amplification
+
+    for k in (3e-4, 3e-3, 0.1):
+        for dt in (1e-3, 1e-2):                 # dt << tau: b = 1 - dt/2, the trapezoid's
+            x = dt / k
+            trapezoid = min((1 - x / 2) / (1 + x / 2), 0.0)   # the other eigenvalue is 0
+            got = ringing_amplification([1 - k], [1.0], dt)
+            assert abs(got - trapezoid) < 0.02, (k, dt, got, trapezoid)
+        # any dt: the recursion itself, iterated at a fixed displacement from a traction
+        # error, settles to that factor a step (power iteration)
+        dt = 0.1
+        e, b = math.exp(-dt), -math.expm1(-dt) / dt
+        c, ceff = 1 - k, 1 - (1 - k) * b
+        sigma, q, ratio = 1.0, 0.0, 0.0
+        for _ in range(400):
+            new = c * (e * q - b * sigma) / ceff
+            q = e * q + b * (new - sigma)
+            ratio, sigma = new / sigma, new
+            if abs(sigma) < 1e-200:
+                break
+        assert abs(ringing_amplification([1 - k], [1.0], dt) - min(ratio, 0.0)) < 1e-6, (k, ratio)
+    assert ringing_amplification([], [], 0.1) == 1.0
+
+
+def test_a_stiffly_relaxing_start_does_not_ring_into_a_false_pull_off(monkeypatch):
+    """An SLS of k 2.9e-4 relaxes its traction in 3e-4 tau0, and the recursion rang at the
+    accurate preset's steps (factor -0.96): the load alternated step by step after the
+    start, and the stop rule took the first dip for the pull-off, `ok` at 0.55 where the
+    pull-off is 4.18 (session 51). With the lead-in the load falls smoothly from the start,
+    and the pull-off is the one a run on steps too short to ring finds."""
+    import sweep.engine.bem as bem
+
+    scene = Scene(n=2.119, k=2.873e-4, mu=2.622, a0=1.9, rate=2.463, material="sls")
+    fine = Numerics.preset("accurate", band_resolution=72.0, pull_off_rtol=0.0)
+    res = simulate(scene, fine)
+    assert res.ok, res.reason
+    P = res.trajectory["P"][:20]
+    assert np.count_nonzero(np.diff(np.sign(np.diff(P)))) <= 2      # no period-two ringing
+    with monkeypatch.context() as m:
+        m.setattr(bem, "RINGING_FACTOR", -math.inf)                # no lead-in: as before
+        rang = simulate(scene, fine)
+        # an independent run: steps short enough that the recursion does not ring
+        # (factor -0.47 at 4e-3 h0), no lead-in: 4.17715
+        short = simulate(scene, Numerics.preset("accurate", band_resolution=36.0, step=4e-3,
+                                                pull_off_rtol=0.0))
+    assert rang.ok and rang.pull_off < 1.0                          # the false pull-off
+    assert short.ok and abs(short.pull_off - 4.177) < 1e-3
+    assert abs(res.pull_off / short.pull_off - 1.0) < 1e-3
+    # a paper scene's broad spectrum does not ring: no lead-in, as before
+    from sweep.engine.problem import prepare
+
+    paper = prepare(Scene(n=0.8, k=0.1, mu=3.24, a0=2.0, rate=10 ** 2.5),
+                    Numerics.preset("balanced"))
+    assert bem.ringing_lead_in(paper) == 0.0

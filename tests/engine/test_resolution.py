@@ -468,11 +468,15 @@ def test_a_pull_off_the_nodes_hold_at_the_start_is_checked_at_twice_the_resoluti
     assert pinned(fast) or fast.pull_off != pytest.approx(mpl["held_pull_off"], rel=1e-6)
     err = abs(fast.pull_off - mpl["pull_off"]) / mpl["pull_off"]
     assert not fast.ok or err <= fast.error_estimate
-    # the balanced row of the SLS scene: its held value now unresolved, the estimate covering
+    # the balanced row of the SLS scene: no longer its held value, the estimate covering.
+    # Session 51 found both tips held by the Prony recursion's ringing after the start (the
+    # load alternating step by step; bem.ringing_lead_in): started with a lead-in, their
+    # tips move 1.9 and 4.8 spacings at balanced and the rows are 0.26 % and 0.27 % off,
+    # unresolved on their pairs' estimates of 3.4 % and 1.3 % (no longer on the held check)
     bal = simulate(Scene(**sls["scene"]), Numerics.preset("balanced"))
-    # (held_pull_off was computed without the Lennard-Jones tail: 2.4e-4 lower)
-    assert bal.pull_off == pytest.approx(sls["held_pull_off"], rel=1e-3) and pinned(bal)
-    assert unresolved(bal) and "at twice the resolution" in bal.reason
+    assert bal.pull_off != pytest.approx(sls["held_pull_off"], rel=1e-2)
+    assert abs(bal.pull_off / sls["pull_off"] - 1.0) < 5e-3
+    assert not bal.ok or unresolved(bal)
     assert bal.error_estimate >= abs(bal.pull_off - sls["pull_off"]) / sls["pull_off"]
     # asked for an accuracy, each is refined until it is met (within the reference's spread)
     for case in (mpl, sls):
