@@ -818,14 +818,20 @@ SCENE_ID_VERSION = 1
 #: (column ``engine_revision``; rows written before it have none: revision 1). Revision 1:
 #: the hereditary BEM's load left out the Lennard-Jones attraction beyond its mesh
 #: (visco-sweep 0.2.0 and earlier); revision 2: that tail is in every load
-#: (``Numerics.lj_tail``), pull-offs up to about 3e-4 higher (docs/design.md, "Meshes").
-#: Raise it, and say what changed in :data:`REVISION_CHANGES`, where the numbers of unchanged
+#: (``Numerics.lj_tail``), pull-offs up to about 3e-4 higher (docs/design.md, "Meshes");
+#: revision 3: an unloading whose Prony recursion would ring starts with a lead-in
+#: (:func:`sweep.engine.bem.ringing_lead_in`; docs/design.md section 4). Raise it, and say what changed in :data:`REVISION_CHANGES`, where the numbers of unchanged
 #: ids move by design; resuming a file with rows of an earlier revision says so.
-ENGINE_REVISION = 2
+ENGINE_REVISION = 3
 
 #: What each earlier engine revision computed otherwise than :data:`ENGINE_REVISION`
-REVISION_CHANGES = {1: "loads without the Lennard-Jones tail beyond the mesh: pull-offs lower, "
-                       "by up to about 3e-4 on the default domain"}
+REVISION_CHANGES = {
+    1: "loads without the Lennard-Jones tail beyond the mesh: pull-offs lower, by up to about "
+       "3e-4 on the default domain; and revision 2's start",
+    2: "unloadings whose Prony recursion rings (a small k with a narrow spectrum, or an SLS) "
+       "started without a lead-in: their first steps' load alternated, and a pull-off could "
+       "be read at its first dip; every other scene is the same",
+}
 
 #: The fields of Scene and Numerics when ids were introduced (version 1). They are always
 #: part of the id, so that the ids of files written then stay what they were.
