@@ -353,7 +353,7 @@ def finish(res, status: int, trajectory: dict, spacing: float, min_travel: float
                                       scales.loading_speed, machine_stiffness)
         speed = float(crack_speed_on_mesh(clock, a, c_star, spacing, lo, hi))
         if _FIT_LOG is not None:
-            _FIT_LOG.append(dict(t=t.copy(), a=a.copy(), t_star=float(t_star),
+            _FIT_LOG.append(dict(t=clock.copy(), a=a.copy(), t_star=float(c_star),
                                  spacing=float(spacing), lo=int(lo), hi=int(hi)))
     a_star = float(np.interp(t_star, t[span], a[span]))
     held = ""
