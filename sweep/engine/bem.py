@@ -419,7 +419,7 @@ def retraction_start(pb: Problem, march, stats) -> UnloadingState:
     for i, key in enumerate(("t", "delta", "P", "a", "a_inner")):
         run.records[i][0] = rec[key][-1]
     run.n, run.q, run.sigma, run.h_prev = 1, march.q, march.sigma, march.h_prev
-    run.step[0], run.step[2] = _retraction_first_step(pb, march)
+    run.step[0], run.step[2] = _retraction_first_step(pb, march, ringing=run.step[0])
     return run
 
 
@@ -436,12 +436,14 @@ def join_phases(res: Result, march, run: UnloadingState) -> None:
     res.hysteresis_energy = cycle_work(res.trajectory)
 
 
-def _retraction_first_step(pb: Problem, march) -> tuple[float, float]:
+def _retraction_first_step(pb: Problem, march, ringing: float = 0.0) -> tuple[float, float]:
     """(the retraction's first indentation step in h0, the lead-in flag): the march's last
     time step at the retraction's rate (the larger of its last two: the approach's last is cut
     to end at the preload), where that is shorter than ``numerics.step``; the unloading kernel
     then grows it by LEAD_GROWTH a step up to ``numerics.step`` (:func:`kernels.solve.unload`).
-    Else ``numerics.step`` and no lead-in.
+    Where the Prony recursion would ring (``ringing``, :func:`ringing_lead_in`'s step, 0 where
+    it would not), the smaller of that step and the march's. Else ``numerics.step`` and no
+    lead-in.
 
     A retraction that starts right after a fast approach (no dwell, or a short one) starts
     from an unrelaxed contact whose load relaxes on the approach's time scale. A first step of
@@ -452,7 +454,8 @@ def _retraction_first_step(pb: Problem, march) -> tuple[float, float]:
     which steps ten times shorter find)."""
     dt = max(march.dt_prev, march.dt_prev2)
     step = pb.scene.rate * dt
-    ringing = ringing_lead_in(pb)          # a step the recursion does not ring at
+    # ``ringing``: the step the recursion does not ring at (ringing_lead_in, 0 where it
+    # does not ring), as UnloadingState.start found it
     if ringing > 0.0 and not 0.0 < step < ringing:
         return ringing, 1.0
     if 0.0 < step < pb.numerics.step:

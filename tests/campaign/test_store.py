@@ -37,13 +37,15 @@ def make(path, n_scenes=6, trajectories=False, config_hash="h1", **kw):
                        n_scenes=n_scenes, trajectories=trajectories, template_row=TEMPLATE, **kw)
 
 
-def written(path, scenes=3, trajectories=False):
-    """A finished results file of ``scenes`` rows (and their trajectories)."""
-    st = make(path, trajectories=trajectories)
+def written(path, scenes=3, trajectories=False, rows=None):
+    """A finished results file of ``scenes`` rows (and their trajectories), or of ``rows``."""
+    grid = {} if rows is None else {"n_scenes": len(rows)}
+    rows = [row(i) for i in range(scenes)] if rows is None else rows
+    st = make(path, trajectories=trajectories, **grid)
     st.prepare()
     st.begin()
-    for i in range(scenes):
-        st.append(row(i), traj(i) if trajectories else None)
+    for i, r in enumerate(rows):
+        st.append(r, traj(i) if trajectories else None)
     st.finish()
     return path
 
@@ -315,30 +317,15 @@ def test_summary_text(tmp_path):
 def test_summary_names_values_that_differ_in_the_last_bits_once(tmp_path):
     """A table's k read from two formats differs in its last bits: one value, not "2 values
     in [0.05, 0.05]"; two values that print alike at 4 digits print with more."""
-    path = tmp_path / "r.h5"
-    st = make(path, n_scenes=4)
-    st.prepare()
-    st.begin()
     ks = (0.05, 0.05 * (1 + 2 ** -50), 0.3, 0.30001)
-    for i, k in enumerate(ks):
-        st.append({**row(i), "k": k, "rate": 1.0 if i < 2 else 10.0})
-    st.finish()
-    text = summary(path)
-    assert "k: 3 values in [0.05, 0.3]" in text
-    st2 = make(tmp_path / "s.h5", n_scenes=2)
-    st2.prepare()
-    st2.begin()
-    for i, k in enumerate(ks[:2]):
-        st2.append({**row(i), "k": k})
-    st2.finish()
-    assert "k=0.05" in summary(tmp_path / "s.h5")
-    st3 = make(tmp_path / "t.h5", n_scenes=2)
-    st3.prepare()
-    st3.begin()
-    for i, k in enumerate((0.123451, 0.123452)):
-        st3.append({**row(i), "k": k})
-    st3.finish()
-    assert "k: 2 values in [0.123451, 0.123452]" in summary(tmp_path / "t.h5")
+    mixed = written(tmp_path / "r.h5", rows=[{**row(i), "k": k, "rate": 1.0 if i < 2 else 10.0}
+                                             for i, k in enumerate(ks)])
+    assert "k: 3 values in [0.05, 0.3]" in summary(mixed)
+    alike = written(tmp_path / "s.h5", rows=[{**row(i), "k": k} for i, k in enumerate(ks[:2])])
+    assert "k=0.05" in summary(alike)
+    close = written(tmp_path / "t.h5", rows=[{**row(i), "k": k}
+                                             for i, k in enumerate((0.123451, 0.123452))])
+    assert "k: 2 values in [0.123451, 0.123452]" in summary(close)
 
 
 def test_kill_during_consolidation_leaves_old_file(tmp_path):
