@@ -424,9 +424,11 @@ def sweep_figure(df, title: str = "", trajectory=None):
                                             if bare else "") + ")"] = _line("red", "none", "x")
     if right is not None:
         _trajectories(right, ok, lay, colour_of, trajectory, handles)
-    # wrapped to the figure's width (a character at 10 pt: about 0.08 in), never clipped
-    fig.suptitle(textwrap.fill(title, max(40, int(fig.get_figwidth() / 0.08)),
-                               break_long_words=False), fontsize=10)
+    # each line wrapped to the figure's width (a character at 10 pt: about 0.08 in), never
+    # clipped; the title's own line breaks kept
+    width = max(40, int(fig.get_figwidth() / 0.08))
+    fig.suptitle("\n".join(textwrap.fill(line, width, break_long_words=False)
+                           for line in title.split("\n")), fontsize=10)
     # as many columns as fit the figure's width (an entry: its text at 8 pt, about 0.065 in a
     # character, its line and the spacing)
     per_column = 0.065 * max(map(len, handles)) + 0.75
